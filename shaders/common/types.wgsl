@@ -1,0 +1,67 @@
+// Uniform layouts shared by every pass. The Rust twins live in src/raster/uniforms.rs; a test
+// (tests/layouts.rs) checks that each struct here has the size of its Rust twin.
+
+const MAX_LIGHTS: u32 = 16u;
+
+const LIGHT_POINT: u32 = 0u;
+const LIGHT_DIRECTIONAL: u32 = 1u;
+const LIGHT_SPOT: u32 = 2u;
+
+const ATTENUATION_NONE: u32 = 0u;
+const ATTENUATION_INVERSE_SQUARE: u32 = 1u;
+
+// Bits of Frame.terms: which terms of the illumination model are drawn.
+const TERM_AMBIENT: u32 = 1u;
+const TERM_DIFFUSE: u32 = 2u;
+const TERM_SPECULAR: u32 = 4u;
+const TERM_EMISSION: u32 = 8u;
+
+struct Light {
+    position: vec3f,
+    kind: u32,
+    // Unit vector the light travels along (directional and spot lights).
+    direction: vec3f,
+    attenuation: u32,
+    // Colour times intensity.
+    radiance: vec3f,
+    cos_inner: f32,
+    cos_outer: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+// Group 0: changes once per frame.
+struct Frame {
+    clip_from_world: mat4x4f,
+    eye: vec3f,
+    // 1 for an orthographic camera: then every view ray runs along -view_axis.
+    orthographic: u32,
+    // ze of the eye frame: from the scene towards the eye.
+    view_axis: vec3f,
+    light_count: u32,
+    ambient: vec3f,
+    terms: u32,
+    lights: array<Light, MAX_LIGHTS>,
+}
+
+// Group 1: changes per material.
+struct Material {
+    color: vec3f,
+    has_texture: u32,
+    ka: f32,
+    kd: f32,
+    ks: f32,
+    shininess: f32,
+    specular_color: vec3f,
+    _pad0: f32,
+    emission: vec3f,
+    _pad1: f32,
+}
+
+// Group 2: changes per object.
+struct Object {
+    world_from_local: mat4x4f,
+    // Inverse transpose of world_from_local's upper 3×3, stored as a 4×4 for alignment.
+    normal_from_local: mat4x4f,
+}

@@ -1,0 +1,71 @@
+//! Image metrics: FLIP (NVIDIA's perceptual difference, the metric wgpu's own image tests use),
+//! PSNR, and a false-colour error map. Used by the golden-image tests and, with the ray tracer,
+//! by `mirador compare`.
+
+use image::RgbaImage;
+
+/// How two images of the same size differ.
+pub struct Difference {
+    /// Mean FLIP error over all pixels, in [0, 1]; 0 means identical.
+    pub flip_mean: f32,
+    /// Peak signal-to-noise ratio of the 8-bit RGB values, in dB (infinite when identical).
+    pub psnr_db: f64,
+    /// The per-pixel FLIP error through the magma colour map (black: no error; yellow: large).
+    pub error_map: RgbaImage,
+}
+
+/// Why two images cannot be compared.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot compare a {0}×{1} image with a {2}×{3} one")]
+pub struct SizeMismatch(pub u32, pub u32, pub u32, pub u32);
+
+fn rgb_bytes(image: &RgbaImage) -> Vec<u8> {
+    image.pixels().flat_map(|p| [p[0], p[1], p[2]]).collect()
+}
+
+/// Compares `test` against `reference` (alpha is ignored).
+pub fn difference(reference: &RgbaImage, test: &RgbaImage) -> Result<Difference, SizeMismatch> {
+    let (w, h) = reference.dimensions();
+    if test.dimensions() != (w, h) {
+        return Err(SizeMismatch(w, h, test.width(), test.height()));
+    }
+    let (a, b) = (rgb_bytes(reference), rgb_bytes(test));
+    let error = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(w, h, &a),
+        nv_flip::FlipImageRgb8::with_data(w, h, &b),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    let flip_mean = nv_flip::FlipPool::from_image(&error).mean();
+    let colored = error.apply_color_lut(&nv_flip::magma_lut()).to_vec();
+    let error_map = RgbaImage::from_raw(w, h, colored.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 255]).collect())
+        .expect("the error map has one RGB triple per pixel");
+    Ok(Difference { flip_mean, psnr_db: psnr(&a, &b), error_map })
+}
+
+/// PSNR of two equally long byte buffers with peak 255.
+pub fn psnr(a: &[u8], b: &[u8]) -> f64 {
+    let squared: f64 = a.iter().zip(b).map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2)).sum();
+    let mse = squared / a.len().max(1) as f64;
+    if mse == 0.0 { f64::INFINITY } else { 10.0 * (255.0f64 * 255.0 / mse).log10() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn identical_images_have_no_error_and_different_ones_do() {
+        let a = RgbaImage::from_fn(32, 32, |x, y| image::Rgba([(x * 8) as u8, (y * 8) as u8, 128, 255]));
+        let same = difference(&a, &a).unwrap();
+        assert_eq!(same.flip_mean, 0.0);
+        assert!(same.psnr_db.is_infinite());
+        let mut b = a.clone();
+        for p in b.pixels_mut().take(512) {
+            p[0] = 255 - p[0];
+        }
+        let diff = difference(&a, &b).unwrap();
+        assert!(diff.flip_mean > 0.05, "flip mean {}", diff.flip_mean);
+        assert!(diff.psnr_db < 20.0, "psnr {}", diff.psnr_db);
+        assert!(difference(&a, &RgbaImage::new(2, 2)).is_err());
+    }
+}

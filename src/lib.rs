@@ -1,0 +1,20 @@
+//! Mirador: a hybrid renderer for learning, seeing and testing the classic realistic-rendering
+//! techniques. A wgpu z-buffer rasterizer adds the techniques one toggle at a time; a CPU Whitted
+//! ray tracer renders the same scene, pixel-aligned, as the reference.
+//!
+//! - [`scene`]: the CPU scene both renderers read (camera, lights, materials, shapes, files).
+//! - [`gpu`]: the thin wgpu layer.
+//! - [`raster`]: the z-buffer renderer, one pass per technique.
+//! - [`output`]: the output transform both renderers share.
+//! - [`compare`]: image metrics for golden images and raster-vs-trace comparisons.
+
+pub mod compare;
+pub mod gpu;
+pub mod output;
+pub mod raster;
+pub mod scene;
+pub mod settings;
+pub mod shaders;
+
+pub use scene::Scene;
+pub use settings::RenderSettings;

@@ -1,0 +1,116 @@
+//! The present pass: the output transform of `src/output.rs` on the GPU. Reads the linear HDR
+//! target texel for texel, applies exposure and the clamp, and writes an sRGB target (a window's
+//! surface, or an offscreen texture for screenshots), whose format does the sRGB encoding.
+
+use super::uniforms::GpuPresent;
+use crate::gpu::uniform::UniformBuffer;
+use crate::shaders;
+
+pub struct PresentPass {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    uniform: UniformBuffer<GpuPresent>,
+}
+
+impl PresentPass {
+    /// `output_format` must be an sRGB format, so the hardware encodes.
+    pub fn new(device: &wgpu::Device, output_format: wgpu::TextureFormat) -> PresentPass {
+        debug_assert!(output_format.is_srgb(), "the present pass relies on an sRGB target to encode");
+        let module = shaders::module(device, "present::shader", shaders::PRESENT);
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("present::bind_group_layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("present::layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("present::pipeline"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_present"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_present"),
+                compilation_options: Default::default(),
+                targets: &[Some(output_format.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let uniform = UniformBuffer::new(device, "present::uniform", &GpuPresent { exposure: 1.0, _pad: [0.0; 3] });
+        PresentPass { pipeline, layout, uniform }
+    }
+
+    /// The pass's input: made once per HDR target, when the targets are (re)created.
+    pub fn bind(&self, device: &wgpu::Device, hdr: &wgpu::TextureView) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("present::bind_group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(hdr) },
+                wgpu::BindGroupEntry { binding: 1, resource: self.uniform.binding() },
+            ],
+        })
+    }
+
+    /// Draws the HDR target bound in `input` through the output transform into `output`.
+    pub fn record(
+        &self,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        input: &wgpu::BindGroup,
+        output: &wgpu::TextureView,
+        exposure: f32,
+    ) {
+        self.uniform.write(queue, &GpuPresent { exposure, _pad: [0.0; 3] });
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("present::pass"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: output,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.push_debug_group("present");
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, input, &[]);
+        pass.draw(0..3, 0..1);
+        pass.pop_debug_group();
+    }
+}

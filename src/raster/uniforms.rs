@@ -1,0 +1,160 @@
+//! GPU layouts of the scene's CPU types (`Light → GpuLight`, …), `#[repr(C)]` and bytemuck.
+//! Their WGSL twins are in `shaders/common/types.wgsl`; `tests/layouts.rs` compares the sizes
+//! through naga's reflection, so the padding is checked rather than kept in step by hand.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3};
+
+use crate::scene::{Attenuation, Camera, Light, LightKind, Material, Object, Projection};
+use crate::settings::RenderSettings;
+
+pub const MAX_LIGHTS: usize = 16;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuLight {
+    pub position: [f32; 3],
+    pub kind: u32,
+    pub direction: [f32; 3],
+    pub attenuation: u32,
+    pub radiance: [f32; 3],
+    pub cos_inner: f32,
+    pub cos_outer: f32,
+    pub _pad: [f32; 3],
+}
+
+impl Light {
+    pub fn to_gpu(&self) -> GpuLight {
+        let (kind, position, direction, cos_inner, cos_outer) = match self.kind {
+            LightKind::Point { position } => (0, position, Vec3::ZERO, 1.0, 1.0),
+            LightKind::Directional { direction } => (1, Vec3::ZERO, direction, 1.0, 1.0),
+            LightKind::Spot { position, direction, inner, outer } => (2, position, direction, inner.cos(), outer.cos()),
+        };
+        GpuLight {
+            position: position.to_array(),
+            kind,
+            direction: direction.to_array(),
+            attenuation: match self.attenuation {
+                Attenuation::None => 0,
+                Attenuation::InverseSquare => 1,
+            },
+            radiance: (self.color * self.intensity).to_array(),
+            cos_inner,
+            cos_outer,
+            _pad: [0.0; 3],
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuFrame {
+    pub clip_from_world: [[f32; 4]; 4],
+    pub eye: [f32; 3],
+    pub orthographic: u32,
+    pub view_axis: [f32; 3],
+    pub light_count: u32,
+    pub ambient: [f32; 3],
+    pub terms: u32,
+    pub lights: [GpuLight; MAX_LIGHTS],
+}
+
+impl GpuFrame {
+    /// The per-frame uniform. Lights past [`MAX_LIGHTS`] are dropped (the loader warns).
+    pub fn new(camera: &Camera, ambient: Vec3, lights: &[Light], settings: &RenderSettings) -> GpuFrame {
+        let mut gpu_lights = [GpuLight::zeroed(); MAX_LIGHTS];
+        for (slot, light) in gpu_lights.iter_mut().zip(lights) {
+            *slot = light.to_gpu();
+        }
+        let t = settings.terms;
+        let terms =
+            u32::from(t.ambient) | u32::from(t.diffuse) << 1 | u32::from(t.specular) << 2 | u32::from(t.emission) << 3;
+        GpuFrame {
+            clip_from_world: camera.clip_from_world().to_cols_array_2d(),
+            eye: camera.eye.to_array(),
+            orthographic: u32::from(camera.projection == Projection::Orthographic),
+            view_axis: camera.frame().ze.to_array(),
+            light_count: lights.len().min(MAX_LIGHTS) as u32,
+            ambient: ambient.to_array(),
+            terms,
+            lights: gpu_lights,
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuMaterial {
+    pub color: [f32; 3],
+    pub has_texture: u32,
+    pub ka: f32,
+    pub kd: f32,
+    pub ks: f32,
+    pub shininess: f32,
+    pub specular_color: [f32; 3],
+    pub _pad0: f32,
+    pub emission: [f32; 3],
+    pub _pad1: f32,
+}
+
+impl Material {
+    pub fn to_gpu(&self) -> GpuMaterial {
+        GpuMaterial {
+            color: self.color.to_array(),
+            has_texture: u32::from(self.texture.is_some()),
+            ka: self.ka,
+            kd: self.kd,
+            ks: self.ks,
+            shininess: self.shininess,
+            specular_color: self.specular_color.to_array(),
+            _pad0: 0.0,
+            emission: self.emission.to_array(),
+            _pad1: 0.0,
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuObject {
+    pub world_from_local: [[f32; 4]; 4],
+    pub normal_from_local: [[f32; 4]; 4],
+}
+
+impl Object {
+    pub fn to_gpu(&self) -> GpuObject {
+        GpuObject {
+            world_from_local: self.world_from_local.to_cols_array_2d(),
+            normal_from_local: Mat4::from_mat3(self.normal_from_local()).to_cols_array_2d(),
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuPresent {
+    pub exposure: f32,
+    pub _pad: [f32; 3],
+}
+
+/// One vertex of the interleaved vertex buffer.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub uv: [f32; 2],
+}
+
+impl Vertex {
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 3] =
+        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+
+    pub fn layout() -> wgpu::VertexBufferLayout<'static> {
+        wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<Vertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &Self::ATTRIBUTES,
+        }
+    }
+}

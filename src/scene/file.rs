@@ -1,0 +1,742 @@
+//! Scene files: TOML, documented field by field in `docs/scene-format.md`.
+//!
+//! Every value is checked while it is read, so a bad number is reported at its own line and column
+//! (`showcase.toml:12:10: expected a finite number, got nan`); rules that tie several fields
+//! together (a sphere needs a radius, eye ≠ center) are reported at the table they belong to.
+//! Unknown fields are rejected. Paths are relative to the scene file.
+
+use std::collections::HashMap;
+use std::fmt;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
+use serde::Deserialize;
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use toml::Spanned;
+
+use super::camera::{Camera, Projection};
+use super::gltf::{GltfCamera, GltfImport, GltfProjection};
+use super::light::{Attenuation, Light, LightKind};
+use super::material::{ColorSpace, Material, MaterialId, TextureId};
+use super::{Object, Scene, SceneError, Shape, texture};
+use crate::settings::RenderSettings;
+
+/// Reads a scene file: TOML, or a bare glTF model.
+pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    let is_gltf = matches!(
+        path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
+        Some("gltf" | "glb")
+    );
+    if is_gltf {
+        return load_bare_gltf(path);
+    }
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+    parse(&text, path)
+}
+
+/// Parses scene text; `path` names the file in messages and anchors relative paths.
+pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
+    let file: SceneFile = toml::from_str(text).map_err(|e| Located::new(e.message(), e.span()).at(path, text))?;
+    let mut builder = Builder::new(path, text);
+    builder.build(file)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Checked values: each rejects bad input where it is read, so the error carries its location.
+
+/// A number that must be finite (TOML allows `nan` and `inf`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Finite(f32);
+
+impl<'de> Deserialize<'de> for Finite {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let x = f64::deserialize(d)?;
+        finite(x).map(Finite).map_err(de::Error::custom)
+    }
+}
+
+fn finite(x: f64) -> Result<f32, String> {
+    if !x.is_finite() {
+        return Err(format!("expected a finite number, got {x}"));
+    }
+    let y = x as f32;
+    if !y.is_finite() {
+        return Err(format!("{x} is too large for a 32-bit float"));
+    }
+    Ok(y)
+}
+
+/// A number that must be ≥ 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct NonNegative(f32);
+
+impl<'de> Deserialize<'de> for NonNegative {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let Finite(x) = Finite::deserialize(d)?;
+        if x < 0.0 {
+            return Err(de::Error::custom(format!("expected a number ≥ 0, got {x}")));
+        }
+        Ok(NonNegative(x))
+    }
+}
+
+/// A number that must be > 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Positive(f32);
+
+impl<'de> Deserialize<'de> for Positive {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let Finite(x) = Finite::deserialize(d)?;
+        if x <= 0.0 {
+            return Err(de::Error::custom(format!("expected a number > 0, got {x}")));
+        }
+        Ok(Positive(x))
+    }
+}
+
+/// Three finite numbers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct V3(Vec3);
+
+impl<'de> Deserialize<'de> for V3 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let [x, y, z] = <[f64; 3]>::deserialize(d)?;
+        let v = [x, y, z].map(finite);
+        match v {
+            [Ok(x), Ok(y), Ok(z)] => Ok(V3(Vec3::new(x, y, z))),
+            _ => Err(de::Error::custom(format!("expected three finite numbers, got [{x}, {y}, {z}]"))),
+        }
+    }
+}
+
+/// Two positive numbers (sizes, texture repeats).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PositiveV2(Vec2);
+
+impl<'de> Deserialize<'de> for PositiveV2 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let [x, y] = <[f64; 2]>::deserialize(d)?;
+        match [x, y].map(finite) {
+            [Ok(x), Ok(y)] if x > 0.0 && y > 0.0 => Ok(PositiveV2(Vec2::new(x, y))),
+            _ => Err(de::Error::custom(format!("expected two finite numbers > 0, got [{x}, {y}]"))),
+        }
+    }
+}
+
+/// A linear RGB colour: three finite numbers ≥ 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Rgb(Vec3);
+
+impl<'de> Deserialize<'de> for Rgb {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let V3(c) = V3::deserialize(d)?;
+        if c.min_element() < 0.0 {
+            return Err(de::Error::custom(format!("colour components must be ≥ 0, got {c}")));
+        }
+        Ok(Rgb(c))
+    }
+}
+
+/// A scale: one number for all three axes, or three.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Scale(Vec3);
+
+impl<'de> Deserialize<'de> for Scale {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct ScaleVisitor;
+        impl<'de> Visitor<'de> for ScaleVisitor {
+            type Value = Vec3;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number or an array of three numbers")
+            }
+            fn visit_f64<E: de::Error>(self, x: f64) -> Result<Vec3, E> {
+                finite(x).map(Vec3::splat).map_err(E::custom)
+            }
+            fn visit_i64<E: de::Error>(self, x: i64) -> Result<Vec3, E> {
+                self.visit_f64(x as f64)
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Vec3, A::Error> {
+                V3::deserialize(de::value::SeqAccessDeserializer::new(seq)).map(|V3(v)| v)
+            }
+        }
+        let v = d.deserialize_any(ScaleVisitor)?;
+        if v.cmpeq(Vec3::ZERO).any() {
+            return Err(de::Error::custom(format!("a scale of zero flattens the object, got {v}")));
+        }
+        Ok(Scale(v))
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The file's shape.
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    camera: Option<Spanned<CameraDesc>>,
+    #[serde(default)]
+    world: WorldDesc,
+    #[serde(default)]
+    settings: RenderSettings,
+    #[serde(default)]
+    materials: std::collections::BTreeMap<String, Spanned<MaterialDesc>>,
+    #[serde(default)]
+    lights: Vec<Spanned<LightDesc>>,
+    #[serde(default)]
+    objects: Vec<Spanned<ObjectDesc>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraDesc {
+    eye: V3,
+    center: V3,
+    up: Option<V3>,
+    fovy: Option<Finite>,
+    near: Option<Finite>,
+    far: Option<Finite>,
+    width: Option<u32>,
+    height: Option<u32>,
+    projection: Option<Projection>,
+    ortho_height: Option<Finite>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct WorldDesc {
+    ambient: Option<Rgb>,
+    background: Option<Rgb>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialDesc {
+    color: Option<Rgb>,
+    texture: Option<String>,
+    ka: Option<NonNegative>,
+    kd: Option<NonNegative>,
+    ks: Option<NonNegative>,
+    specular_color: Option<Rgb>,
+    shininess: Option<NonNegative>,
+    emission: Option<Rgb>,
+    mirror: Option<NonNegative>,
+    mirror_color: Option<Rgb>,
+    transmission: Option<NonNegative>,
+    transmission_color: Option<Rgb>,
+    ior: Option<Positive>,
+    height_map: Option<String>,
+    bump_scale: Option<Finite>,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
+#[serde(rename_all = "snake_case")]
+enum LightType {
+    Point,
+    Directional,
+    Spot,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightDesc {
+    name: Option<String>,
+    #[serde(rename = "type")]
+    kind: LightType,
+    position: Option<V3>,
+    direction: Option<V3>,
+    color: Option<Rgb>,
+    intensity: Option<NonNegative>,
+    attenuation: Option<Attenuation>,
+    inner_angle: Option<NonNegative>,
+    outer_angle: Option<NonNegative>,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
+#[serde(rename_all = "snake_case")]
+enum ObjectType {
+    Sphere,
+    Box,
+    Plane,
+    Gltf,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObjectDesc {
+    name: Option<String>,
+    #[serde(rename = "type")]
+    kind: ObjectType,
+    material: Option<Spanned<String>>,
+    center: Option<V3>,
+    radius: Option<Positive>,
+    min: Option<V3>,
+    max: Option<V3>,
+    size: Option<PositiveV2>,
+    uv_scale: Option<PositiveV2>,
+    path: Option<String>,
+    lights: Option<bool>,
+    camera: Option<bool>,
+    translate: Option<V3>,
+    rotate: Option<V3>,
+    scale: Option<Scale>,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Errors with a place.
+
+/// A message with an optional byte range in the file, turned into line and column at the end.
+struct Located {
+    message: String,
+    span: Option<Range<usize>>,
+}
+
+impl Located {
+    fn new(message: impl Into<String>, span: Option<Range<usize>>) -> Located {
+        Located { message: message.into(), span }
+    }
+
+    fn at(self, path: &Path, text: &str) -> SceneError {
+        match self.span {
+            Some(span) => {
+                let (line, column) = line_column(text, span.start);
+                SceneError::Syntax { path: path.into(), line, column, message: self.message }
+            }
+            None => SceneError::Invalid { path: path.into(), message: self.message },
+        }
+    }
+}
+
+/// 1-based line and column (in characters) of a byte offset.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+// ---------------------------------------------------------------------------------------------
+// From the file's shape to a Scene.
+
+struct Builder<'a> {
+    path: &'a Path,
+    text: &'a str,
+    dir: PathBuf,
+    scene: Scene,
+    material_ids: HashMap<String, MaterialId>,
+    texture_ids: HashMap<(PathBuf, bool), TextureId>,
+}
+
+impl<'a> Builder<'a> {
+    fn new(path: &'a Path, text: &'a str) -> Builder<'a> {
+        Builder {
+            path,
+            text,
+            dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+            scene: empty_scene(path),
+            material_ids: HashMap::new(),
+            texture_ids: HashMap::new(),
+        }
+    }
+
+    fn error(&self, message: impl Into<String>, span: Range<usize>) -> SceneError {
+        Located::new(message, Some(span)).at(self.path, self.text)
+    }
+
+    fn build(&mut self, file: SceneFile) -> Result<Scene, SceneError> {
+        self.scene.settings = file.settings;
+        if let Err(e) = self.scene.settings.validate() {
+            let span = self.text.find("[settings]").map(|s| s..s + 1);
+            return Err(Located::new(format!("[settings]: {e}"), span).at(self.path, self.text));
+        }
+        self.scene.ambient = file.world.ambient.map_or(Vec3::splat(0.1), |Rgb(c)| c);
+        self.scene.background = file.world.background.map_or(Vec3::ZERO, |Rgb(c)| c);
+        self.materials(file.materials)?;
+        for light in file.lights {
+            let span = light.span();
+            let light = self.light(light.into_inner(), span)?;
+            self.scene.lights.push(light);
+        }
+        let mut gltf_camera = None;
+        for object in file.objects {
+            let span = object.span();
+            if let Some(camera) = self.object(object.into_inner(), span.clone())? {
+                gltf_camera.get_or_insert((camera, span));
+            }
+        }
+        self.scene.camera = match (file.camera, gltf_camera) {
+            (Some(desc), None) => {
+                let span = desc.span();
+                let camera = camera_from(desc.into_inner());
+                camera.validate().map_err(|e| self.error(format!("[camera]: {e}"), span))?;
+                camera
+            }
+            (camera_table, Some((gltf, span))) => {
+                let (width, height) = camera_table
+                    .map(|c| (c.get_ref().width.unwrap_or(1280), c.get_ref().height.unwrap_or(720)))
+                    .unwrap_or((1280, 720));
+                let camera = camera_from_gltf(&gltf, width, height);
+                camera.validate().map_err(|e| self.error(format!("glTF camera `{}`: {e}", gltf.name), span))?;
+                camera
+            }
+            (None, None) => frame_scene(&self.scene),
+        };
+        Ok(std::mem::replace(&mut self.scene, empty_scene(self.path)))
+    }
+
+    fn materials(
+        &mut self,
+        tables: std::collections::BTreeMap<String, Spanned<MaterialDesc>>,
+    ) -> Result<(), SceneError> {
+        for (name, desc) in tables {
+            let span = desc.span();
+            let material = self.material(&name, desc.into_inner(), span)?;
+            self.material_ids.insert(name, MaterialId(self.scene.materials.len()));
+            self.scene.materials.push(material);
+        }
+        Ok(())
+    }
+
+    fn material(&mut self, name: &str, d: MaterialDesc, span: Range<usize>) -> Result<Material, SceneError> {
+        let base = Material::default();
+        let texture = d.texture.map(|p| self.texture(&p, ColorSpace::Srgb, span.clone())).transpose()?;
+        let height_map = d.height_map.map(|p| self.texture(&p, ColorSpace::Linear, span.clone())).transpose()?;
+        Ok(Material {
+            name: name.into(),
+            color: d.color.map_or(base.color, |Rgb(c)| c),
+            texture,
+            ka: d.ka.map_or(base.ka, |NonNegative(x)| x),
+            kd: d.kd.map_or(base.kd, |NonNegative(x)| x),
+            ks: d.ks.map_or(base.ks, |NonNegative(x)| x),
+            specular_color: d.specular_color.map_or(base.specular_color, |Rgb(c)| c),
+            shininess: d.shininess.map_or(base.shininess, |NonNegative(x)| x),
+            emission: d.emission.map_or(base.emission, |Rgb(c)| c),
+            mirror: d.mirror.map_or(base.mirror, |NonNegative(x)| x),
+            mirror_color: d.mirror_color.map_or(base.mirror_color, |Rgb(c)| c),
+            transmission: d.transmission.map_or(base.transmission, |NonNegative(x)| x),
+            transmission_color: d.transmission_color.map_or(base.transmission_color, |Rgb(c)| c),
+            ior: d.ior.map_or(base.ior, |Positive(x)| x),
+            height_map,
+            bump_scale: d.bump_scale.map_or(base.bump_scale, |Finite(x)| x),
+        })
+    }
+
+    fn texture(&mut self, relative: &str, space: ColorSpace, span: Range<usize>) -> Result<TextureId, SceneError> {
+        let path = self.dir.join(relative);
+        let key = (path.clone(), space == ColorSpace::Srgb);
+        if let Some(&id) = self.texture_ids.get(&key) {
+            return Ok(id);
+        }
+        let texture = texture::load(&path, space).map_err(|e| self.error(e.to_string(), span))?;
+        let id = TextureId(self.scene.textures.len());
+        self.scene.textures.push(texture);
+        self.texture_ids.insert(key, id);
+        Ok(id)
+    }
+
+    fn light(&self, d: LightDesc, span: Range<usize>) -> Result<Light, SceneError> {
+        let fail = |message: String| self.error(message, span.clone());
+        let kind_name = format!("{:?}", d.kind).to_lowercase();
+        let direction = |v: Option<V3>| -> Result<Vec3, SceneError> {
+            let V3(v) = v.ok_or_else(|| fail(format!("a {kind_name} light needs a `direction`")))?;
+            v.try_normalize().ok_or_else(|| fail("the light's direction is the zero vector".into()))
+        };
+        let position = |v: Option<V3>| -> Result<Vec3, SceneError> {
+            v.map(|V3(p)| p).ok_or_else(|| fail(format!("a {kind_name} light needs a `position`")))
+        };
+        let unused = |present: bool, field: &str| -> Result<(), SceneError> {
+            if present { Err(fail(format!("`{field}` does not apply to a {kind_name} light"))) } else { Ok(()) }
+        };
+        let kind = match d.kind {
+            LightType::Point => {
+                unused(d.direction.is_some(), "direction")?;
+                unused(d.inner_angle.is_some() || d.outer_angle.is_some(), "inner_angle/outer_angle")?;
+                LightKind::Point { position: position(d.position)? }
+            }
+            LightType::Directional => {
+                unused(d.position.is_some(), "position")?;
+                unused(d.inner_angle.is_some() || d.outer_angle.is_some(), "inner_angle/outer_angle")?;
+                unused(d.attenuation.is_some(), "attenuation")?;
+                LightKind::Directional { direction: direction(d.direction)? }
+            }
+            LightType::Spot => {
+                let inner = d.inner_angle.map_or(20.0, |NonNegative(a)| a);
+                let outer = d.outer_angle.map_or(30.0, |NonNegative(a)| a);
+                if !(inner <= outer && outer < 180.0) {
+                    return Err(fail(format!(
+                        "spot angles must satisfy inner ≤ outer < 180°, got inner = {inner}, outer = {outer}"
+                    )));
+                }
+                LightKind::Spot {
+                    position: position(d.position)?,
+                    direction: direction(d.direction)?,
+                    inner: inner.to_radians(),
+                    outer: outer.to_radians(),
+                }
+            }
+        };
+        Ok(Light {
+            name: d.name.unwrap_or_else(|| format!("light {}", self.scene.lights.len())),
+            kind,
+            color: d.color.map_or(Vec3::ONE, |Rgb(c)| c),
+            intensity: d.intensity.map_or(1.0, |NonNegative(x)| x),
+            attenuation: d.attenuation.unwrap_or_default(),
+        })
+    }
+
+    /// Adds one `[[objects]]` entry; a glTF model may bring a camera, returned for the caller.
+    fn object(&mut self, d: ObjectDesc, span: Range<usize>) -> Result<Option<GltfCamera>, SceneError> {
+        let fail = |message: String| self.error(message, span.clone());
+        let kind_name = format!("{:?}", d.kind).to_lowercase();
+        let fields: [(&str, bool); 10] = [
+            ("center", d.center.is_some()),
+            ("radius", d.radius.is_some()),
+            ("min", d.min.is_some()),
+            ("max", d.max.is_some()),
+            ("size", d.size.is_some()),
+            ("uv_scale", d.uv_scale.is_some()),
+            ("path", d.path.is_some()),
+            ("lights", d.lights.is_some()),
+            ("camera", d.camera.is_some()),
+            ("material", d.material.is_some()),
+        ];
+        let allowed: &[&str] = match d.kind {
+            ObjectType::Sphere => &["center", "radius", "material"],
+            ObjectType::Box => &["min", "max", "material"],
+            ObjectType::Plane => &["size", "uv_scale", "material"],
+            ObjectType::Gltf => &["path", "lights", "camera"],
+        };
+        if let Some((field, _)) = fields.iter().find(|(f, present)| *present && !allowed.contains(f)) {
+            return Err(fail(format!("`{field}` does not apply to a {kind_name}")));
+        }
+        let world_from_local = transform(d.translate, d.rotate, d.scale);
+        let name = d.name.unwrap_or_else(|| format!("{kind_name} {}", self.scene.objects.len()));
+        let shape = match d.kind {
+            ObjectType::Sphere => Shape::Sphere {
+                center: d.center.map_or(Vec3::ZERO, |V3(c)| c),
+                radius: d.radius.map_or(1.0, |Positive(r)| r),
+            },
+            ObjectType::Box => {
+                let (Some(V3(min)), Some(V3(max))) = (d.min, d.max) else {
+                    return Err(fail("a box needs `min` and `max` corners".into()));
+                };
+                if !min.cmplt(max).all() {
+                    return Err(fail(format!("a box needs min < max on every axis, got min = {min}, max = {max}")));
+                }
+                Shape::Cuboid { min, max }
+            }
+            ObjectType::Plane => Shape::Plane {
+                size: d.size.map_or(Vec2::ONE, |PositiveV2(s)| s),
+                uv_scale: d.uv_scale.map_or(Vec2::ONE, |PositiveV2(s)| s),
+            },
+            ObjectType::Gltf => {
+                let relative = d.path.ok_or_else(|| fail("a gltf object needs a `path`".into()))?;
+                let import = super::gltf::import(&self.dir.join(relative))?;
+                let camera = d.camera.unwrap_or(false).then(|| import.cameras.first().cloned()).flatten();
+                self.add_gltf(import, world_from_local, d.lights.unwrap_or(true), &name);
+                return Ok(
+                    camera.map(|c| GltfCamera { world_from_camera: world_from_local * c.world_from_camera, ..c })
+                );
+            }
+        };
+        let material = match d.material {
+            Some(m) => {
+                let span = m.span();
+                *self.material_ids.get(m.get_ref()).ok_or_else(|| {
+                    let known: Vec<&str> = self.material_ids.keys().map(String::as_str).collect();
+                    self.error(format!("no material named `{}` (known: {})", m.get_ref(), known.join(", ")), span)
+                })?
+            }
+            None => self.default_material(),
+        };
+        self.scene.objects.push(Object { name, shape, material, world_from_local });
+        Ok(None)
+    }
+
+    fn default_material(&mut self) -> MaterialId {
+        *self.material_ids.entry("default".into()).or_insert_with(|| {
+            self.scene.materials.push(Material::default());
+            MaterialId(self.scene.materials.len() - 1)
+        })
+    }
+
+    /// Appends an imported model, placed by `world_from_root`, re-indexing its meshes,
+    /// materials and textures.
+    fn add_gltf(&mut self, import: GltfImport, world_from_root: Mat4, with_lights: bool, name: &str) {
+        add_gltf(&mut self.scene, import, world_from_root, with_lights, name);
+    }
+}
+
+fn add_gltf(scene: &mut Scene, import: GltfImport, world_from_root: Mat4, with_lights: bool, name: &str) {
+    let (mesh_base, material_base, texture_base) = (scene.meshes.len(), scene.materials.len(), scene.textures.len());
+    scene.meshes.extend(import.meshes);
+    scene.textures.extend(import.textures);
+    scene.materials.extend(import.materials.into_iter().map(|mut m| {
+        m.texture = m.texture.map(|TextureId(i)| TextureId(i + texture_base));
+        m.height_map = m.height_map.map(|TextureId(i)| TextureId(i + texture_base));
+        m
+    }));
+    scene.objects.extend(import.objects.into_iter().map(|o| Object {
+        name: format!("{name}/{}", o.name),
+        shape: Shape::Mesh(mesh_base + o.mesh),
+        material: MaterialId(material_base + o.material),
+        world_from_local: world_from_root * o.world_from_local,
+    }));
+    if with_lights {
+        scene.lights.extend(import.lights.into_iter().map(|mut light| {
+            light.kind = match light.kind {
+                LightKind::Point { position } => {
+                    LightKind::Point { position: world_from_root.transform_point3(position) }
+                }
+                LightKind::Directional { direction } => {
+                    LightKind::Directional { direction: world_from_root.transform_vector3(direction).normalize() }
+                }
+                LightKind::Spot { position, direction, inner, outer } => LightKind::Spot {
+                    position: world_from_root.transform_point3(position),
+                    direction: world_from_root.transform_vector3(direction).normalize(),
+                    inner,
+                    outer,
+                },
+            };
+            light
+        }));
+    }
+}
+
+/// `translate · rotate(z·y·x) · scale`: scale first, then rotate about X, Y, Z in that order
+/// (degrees), then translate.
+fn transform(translate: Option<V3>, rotate: Option<V3>, scale: Option<Scale>) -> Mat4 {
+    let t = translate.map_or(Vec3::ZERO, |V3(t)| t);
+    let r = rotate.map_or(Vec3::ZERO, |V3(r)| r);
+    let s = scale.map_or(Vec3::ONE, |Scale(s)| s);
+    let rotation = Quat::from_euler(EulerRot::ZYXEx, r.z.to_radians(), r.y.to_radians(), r.x.to_radians());
+    Mat4::from_scale_rotation_translation(s, rotation, t)
+}
+
+fn camera_from(d: CameraDesc) -> Camera {
+    Camera {
+        eye: d.eye.0,
+        center: d.center.0,
+        up: d.up.map_or(Vec3::Y, |V3(u)| u),
+        fovy_degrees: d.fovy.map_or(60.0, |Finite(x)| x),
+        near: d.near.map_or(0.1, |Finite(x)| x),
+        far: d.far.map_or(1000.0, |Finite(x)| x),
+        width: d.width.unwrap_or(1280),
+        height: d.height.unwrap_or(720),
+        projection: d.projection.unwrap_or(Projection::Perspective),
+        ortho_height: d.ortho_height.map_or(10.0, |Finite(x)| x),
+    }
+}
+
+fn camera_from_gltf(c: &GltfCamera, width: u32, height: u32) -> Camera {
+    let eye = c.world_from_camera.transform_point3(Vec3::ZERO);
+    let forward = c.world_from_camera.transform_vector3(Vec3::NEG_Z);
+    let up = c.world_from_camera.transform_vector3(Vec3::Y);
+    let (projection, fovy_degrees, near, far, ortho_height) = match c.projection {
+        GltfProjection::Perspective { yfov_radians, znear, zfar } => {
+            (Projection::Perspective, yfov_radians.to_degrees(), znear, zfar.unwrap_or(znear * 1e4), 1.0)
+        }
+        GltfProjection::Orthographic { ymag, znear, zfar } => (Projection::Orthographic, 60.0, znear, zfar, 2.0 * ymag),
+    };
+    Camera { eye, center: eye + forward, up, fovy_degrees, near, far, width, height, projection, ortho_height }
+}
+
+/// A camera that sees the whole scene from above and to the front-right, for files without one.
+pub fn frame_scene(scene: &Scene) -> Camera {
+    let (lo, hi) = scene.bounds().unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)));
+    let center = (lo + hi) / 2.0;
+    let radius = ((hi - lo).length() / 2.0).max(1e-3);
+    let fovy: f32 = 45.0;
+    let distance = 1.1 * radius / (fovy.to_radians() / 2.0).sin();
+    let eye = center + distance * Vec3::new(0.6, 0.45, 1.0).normalize();
+    Camera {
+        eye,
+        center,
+        up: Vec3::Y,
+        fovy_degrees: fovy,
+        near: (distance - radius).max(distance * 1e-3),
+        far: distance + 2.0 * radius,
+        width: 1280,
+        height: 720,
+        projection: Projection::Perspective,
+        ortho_height: 2.0 * radius,
+    }
+}
+
+fn empty_scene(path: &Path) -> Scene {
+    Scene {
+        source: Some(path.to_path_buf()),
+        camera: Camera {
+            eye: Vec3::Z,
+            center: Vec3::ZERO,
+            up: Vec3::Y,
+            fovy_degrees: 60.0,
+            near: 0.1,
+            far: 100.0,
+            width: 1280,
+            height: 720,
+            projection: Projection::Perspective,
+            ortho_height: 10.0,
+        },
+        ambient: Vec3::splat(0.1),
+        background: Vec3::ZERO,
+        lights: Vec::new(),
+        materials: Vec::new(),
+        textures: Vec::new(),
+        meshes: Vec::new(),
+        objects: Vec::new(),
+        settings: RenderSettings::default(),
+    }
+}
+
+/// A bare model: its own camera if it has one, else one framing it; its own lights if it has
+/// any, else a white directional light from over the viewer's shoulder.
+fn load_bare_gltf(path: &Path) -> Result<Scene, SceneError> {
+    let import = super::gltf::import(path)?;
+    let mut scene = empty_scene(path);
+    let camera = import.cameras.first().cloned();
+    let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("model").to_string();
+    add_gltf(&mut scene, import, Mat4::IDENTITY, true, &name);
+    scene.camera = match camera {
+        Some(c) => camera_from_gltf(&c, 1280, 720),
+        None => frame_scene(&scene),
+    };
+    scene.camera.validate().map_err(|e| SceneError::Invalid { path: path.into(), message: format!("camera: {e}") })?;
+    if scene.lights.is_empty() {
+        let frame = scene.camera.frame();
+        scene.lights.push(Light {
+            name: "headlight".into(),
+            kind: LightKind::Directional { direction: (-frame.ze - 0.5 * frame.ye + 0.3 * frame.xe).normalize() },
+            color: Vec3::ONE,
+            intensity: 1.0,
+            attenuation: Attenuation::None,
+        });
+    }
+    Ok(scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_and_column_count_characters_from_one() {
+        let text = "a = 1\nbé = nan\n";
+        assert_eq!(line_column(text, 0), (1, 1));
+        assert_eq!(line_column(text, text.find("nan").unwrap()), (2, 6));
+    }
+
+    #[test]
+    fn transform_scales_then_rotates_x_y_z_then_translates() {
+        let m = transform(
+            Some(V3(Vec3::new(1.0, 2.0, 3.0))),
+            Some(V3(Vec3::new(0.0, 90.0, 0.0))),
+            Some(Scale(Vec3::splat(2.0))),
+        );
+        // +x scaled to 2, turned 90° about y to −z, moved by (1, 2, 3).
+        assert!(m.transform_point3(Vec3::X).abs_diff_eq(Vec3::new(1.0, 2.0, 1.0), 1e-5));
+        let m = transform(None, Some(V3(Vec3::new(90.0, 90.0, 0.0))), None);
+        // X first: +y → +z; then Y: +z → +x.
+        assert!(m.transform_point3(Vec3::Y).abs_diff_eq(Vec3::X, 1e-5));
+    }
+}

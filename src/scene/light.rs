@@ -1,0 +1,98 @@
+//! Light sources of the course notes (seed 004: "Onidirecional", "Direcional", "Farolete").
+//!
+//! Each light gives, at a surface point `p`, the unit vector `l` towards it, the distance to it and
+//! the radiance `S_i` it delivers there: `colour · intensity · fat · spot`. `fat` is the
+//! attenuation factor of seed 003 (1 as in the course notes, or the physical `1/d²`); `spot` is a
+//! smooth cone falloff. The WGSL twin is `light_incidence` in `shaders/common/lighting.wgsl`.
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+/// How a positional light's radiance falls off with distance `d`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Attenuation {
+    /// `fat = 1`, as in the course notes' examples.
+    #[default]
+    None,
+    /// `fat = 1/d²`, the physical falloff of a point source.
+    InverseSquare,
+}
+
+impl Attenuation {
+    pub fn factor(self, distance: f32) -> f32 {
+        match self {
+            Attenuation::None => 1.0,
+            Attenuation::InverseSquare => 1.0 / (distance * distance).max(f32::MIN_POSITIVE),
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Radiates equally in all directions from `position`.
+    Point { position: Vec3 },
+    /// Parallel light travelling along `direction` (unit), from infinitely far away.
+    Directional { direction: Vec3 },
+    /// A point light restricted to a cone around `direction` (unit): full strength inside
+    /// `inner` radians of the axis, none beyond `outer`, smoothstep in between.
+    Spot { position: Vec3, direction: Vec3, inner: f32, outer: f32 },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Light {
+    pub name: String,
+    pub kind: LightKind,
+    /// Linear RGB colour; multiplied by `intensity`.
+    pub color: Vec3,
+    pub intensity: f32,
+    /// Ignored by directional lights.
+    pub attenuation: Attenuation,
+}
+
+/// What one light delivers at one surface point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Incidence {
+    /// Unit vector from the point towards the light.
+    pub l: Vec3,
+    /// Distance to the light (`f32::INFINITY` for directional lights): shadow rays stop there.
+    pub distance: f32,
+    /// `S_i`: colour · intensity · attenuation · spot falloff.
+    pub radiance: Vec3,
+}
+
+impl Light {
+    /// Light arriving at `p`, or `None` when `p` is at the light's own position.
+    pub fn incidence(&self, p: Vec3) -> Option<Incidence> {
+        let emitted = self.color * self.intensity;
+        match self.kind {
+            LightKind::Directional { direction } => {
+                Some(Incidence { l: -direction, distance: f32::INFINITY, radiance: emitted })
+            }
+            LightKind::Point { position } => {
+                let (l, distance) = towards(p, position)?;
+                Some(Incidence { l, distance, radiance: emitted * self.attenuation.factor(distance) })
+            }
+            LightKind::Spot { position, direction, inner, outer } => {
+                let (l, distance) = towards(p, position)?;
+                let cone = smoothstep(outer.cos(), inner.cos(), (-l).dot(direction));
+                Some(Incidence { l, distance, radiance: emitted * self.attenuation.factor(distance) * cone })
+            }
+        }
+    }
+}
+
+fn towards(p: Vec3, position: Vec3) -> Option<(Vec3, f32)> {
+    let to_light = position - p;
+    let distance = to_light.length();
+    (distance > 0.0).then(|| (to_light / distance, distance))
+}
+
+/// Hermite interpolation of WGSL's `smoothstep`, with `edge0 == edge1` read as a hard step.
+pub fn smoothstep(edge0: f32, edge1: f32, x: f32) -> f32 {
+    if edge1 <= edge0 {
+        return if x >= edge0 { 1.0 } else { 0.0 };
+    }
+    let t = ((x - edge0) / (edge1 - edge0)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}

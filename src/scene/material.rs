@@ -1,0 +1,87 @@
+//! Materials: the whole illumination model of TECHNIQUES.md §1 and §7, even where a later issue
+//! is the one that draws a term (mirrors, transparency, bump maps).
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+
+/// Index into [`crate::scene::Scene::materials`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct MaterialId(pub usize);
+
+/// Index into [`crate::scene::Scene::textures`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct TextureId(pub usize);
+
+/// How a texture's stored values are to be read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorSpace {
+    /// Colour textures: stored sRGB-encoded, decoded to linear before any filtering.
+    Srgb,
+    /// Data textures (height maps, normal maps): the stored values are the data.
+    Linear,
+}
+
+/// A decoded image, 8 bits per channel, RGBA.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    pub path: PathBuf,
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+    pub color_space: ColorSpace,
+}
+
+/// One material of the model
+/// `ME + AG + Σ V·S·(ka·C + kd·C·max(0, n·l) + ks·S·max(0, r·v)^e) + kps·MPS·L(r) + kt·MT·L(t)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    /// `C`: linear RGB surface colour, multiplied by `texture` where there is one.
+    pub color: Vec3,
+    pub texture: Option<TextureId>,
+    /// Per-light ambient coefficient (seed 000's `Directa`: `ka·C`, counted only where the light
+    /// is visible).
+    pub ka: f32,
+    pub kd: f32,
+    pub ks: f32,
+    /// Specular colour `S` of the `ks` term (white for plastics, the base colour for metals).
+    pub specular_color: Vec3,
+    /// Phong exponent `e`.
+    pub shininess: f32,
+    /// `ME`: emitted radiance, linear RGB.
+    pub emission: Vec3,
+    /// `kps` and `MPS`: perfect mirror reflection.
+    pub mirror: f32,
+    pub mirror_color: Vec3,
+    /// `kt` and `MT`: transmission through the surface, with index of refraction `ior`.
+    pub transmission: f32,
+    pub transmission_color: Vec3,
+    pub ior: f32,
+    /// Grey-level height field and its scale `k` for bump mapping (TECHNIQUES.md §3).
+    pub height_map: Option<TextureId>,
+    pub bump_scale: f32,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            name: "default".into(),
+            color: Vec3::splat(0.8),
+            texture: None,
+            ka: 0.0,
+            kd: 1.0,
+            ks: 0.0,
+            specular_color: Vec3::ONE,
+            shininess: 32.0,
+            emission: Vec3::ZERO,
+            mirror: 0.0,
+            mirror_color: Vec3::ONE,
+            transmission: 0.0,
+            transmission_color: Vec3::ONE,
+            ior: 1.0,
+            height_map: None,
+            bump_scale: 1.0,
+        }
+    }
+}

@@ -1,0 +1,218 @@
+//! Triangle meshes, and the tessellation the rasterizer draws analytic shapes with.
+//!
+//! The ray tracer intersects spheres, boxes and planes exactly; the z-buffer needs triangles.
+//! Boxes and planes tessellate exactly; a sphere becomes a UV sphere of `segments × segments/2`
+//! quads whose vertices lie on the true sphere, so its silhouette is a polygon inscribed in the
+//! true one (a raster-vs-trace difference of at most `r·(1 − cos(π/segments))`).
+
+use glam::{Vec2, Vec3};
+
+/// An indexed triangle mesh in its local coordinates.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub name: String,
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
+    /// Three indices per triangle, counter-clockwise seen from the front.
+    pub indices: Vec<u32>,
+}
+
+/// Why a mesh could not be used.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    #[error("mesh `{mesh}`: index {index} at position {at} is out of range ({vertices} vertices)")]
+    IndexOutOfRange { mesh: String, index: u32, at: usize, vertices: usize },
+    #[error("mesh `{mesh}`: {count} indices is not a whole number of triangles")]
+    PartialTriangle { mesh: String, count: usize },
+    #[error("mesh `{mesh}`: vertex {vertex} has a NaN or infinite {what}")]
+    NotFinite { mesh: String, vertex: usize, what: &'static str },
+    #[error("mesh `{mesh}`: {positions} positions but {other} {what}")]
+    AttributeCount { mesh: String, positions: usize, other: usize, what: &'static str },
+}
+
+impl Mesh {
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// Checks indices and attribute values, and removes zero-area triangles (they have no normal
+    /// and no pixels). Returns how many triangles were removed, so the caller can warn.
+    pub fn validate_and_repair(&mut self) -> Result<usize, MeshError> {
+        let mesh = self.name.clone();
+        let vertices = self.positions.len();
+        for (other, what) in [(self.normals.len(), "normals"), (self.uvs.len(), "texture coordinates")] {
+            if other != vertices {
+                return Err(MeshError::AttributeCount { mesh, positions: vertices, other, what });
+            }
+        }
+        if self.indices.len() % 3 != 0 {
+            return Err(MeshError::PartialTriangle { mesh, count: self.indices.len() });
+        }
+        if let Some((at, &index)) = self.indices.iter().enumerate().find(|&(_, &i)| i as usize >= vertices) {
+            return Err(MeshError::IndexOutOfRange { mesh, index, at, vertices });
+        }
+        let checks: [(&'static str, Option<usize>); 3] = [
+            ("position", self.positions.iter().position(|p| !p.is_finite())),
+            ("normal", self.normals.iter().position(|n| !n.is_finite())),
+            ("texture coordinate", self.uvs.iter().position(|t| !t.is_finite())),
+        ];
+        if let Some((what, Some(vertex))) = checks.into_iter().find(|(_, at)| at.is_some()) {
+            return Err(MeshError::NotFinite { mesh, vertex, what });
+        }
+        let before = self.indices.len() / 3;
+        let positions = &self.positions;
+        let kept: Vec<u32> = self
+            .indices
+            .chunks_exact(3)
+            .filter(|t| {
+                let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
+                (b - a).cross(c - a).length_squared() > 0.0
+            })
+            .flatten()
+            .copied()
+            .collect();
+        self.indices = kept;
+        Ok(before - self.indices.len() / 3)
+    }
+
+    /// Per-vertex normals as the area-weighted average of the adjacent faces, for meshes that
+    /// come without normals.
+    pub fn compute_normals(&mut self) {
+        let mut normals = vec![Vec3::ZERO; self.positions.len()];
+        for t in self.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);
+            let face = (self.positions[b] - self.positions[a]).cross(self.positions[c] - self.positions[a]);
+            for i in [a, b, c] {
+                normals[i] += face;
+            }
+        }
+        self.normals = normals.into_iter().map(|n| n.try_normalize().unwrap_or(Vec3::Y)).collect();
+    }
+
+    fn push_vertex(&mut self, position: Vec3, normal: Vec3, uv: Vec2) -> u32 {
+        self.positions.push(position);
+        self.normals.push(normal);
+        self.uvs.push(uv);
+        (self.positions.len() - 1) as u32
+    }
+
+    /// Appends the quad `origin + s·edge_u + t·edge_v`, s, t ∈ [0, 1], facing `edge_u × edge_v`,
+    /// with texture coordinates `(s·uv_scale.x, (1 − t)·uv_scale.y)`.
+    fn push_quad(&mut self, origin: Vec3, edge_u: Vec3, edge_v: Vec3, uv_scale: Vec2) {
+        let normal = edge_u.cross(edge_v).normalize();
+        let corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)];
+        let [a, b, c, d] = corners
+            .map(|(s, t)| self.push_vertex(origin + s * edge_u + t * edge_v, normal, Vec2::new(s, 1.0 - t) * uv_scale));
+        self.indices.extend_from_slice(&[a, b, c, a, c, d]);
+    }
+
+    /// The quad `[−sx/2, sx/2] × [−sz/2, sz/2]` in the plane y = 0, facing +y; texture coordinates
+    /// run over `[0, uv_scale]`.
+    pub fn plane(size: Vec2, uv_scale: Vec2) -> Mesh {
+        let mut mesh = Mesh { name: "plane".into(), ..Mesh::default() };
+        let origin = Vec3::new(-size.x / 2.0, 0.0, size.y / 2.0);
+        mesh.push_quad(origin, Vec3::X * size.x, Vec3::NEG_Z * size.y, uv_scale);
+        mesh
+    }
+
+    /// The six faces of the axis-aligned box `[min, max]`, each with its own flat normal and
+    /// texture coordinates over `[0, 1]²`.
+    pub fn cuboid(min: Vec3, max: Vec3) -> Mesh {
+        let mut mesh = Mesh { name: "box".into(), ..Mesh::default() };
+        let d = max - min;
+        let (dx, dy, dz) = (Vec3::X * d.x, Vec3::Y * d.y, Vec3::Z * d.z);
+        let faces = [
+            (Vec3::new(max.x, min.y, max.z), -dz, dy), // +x
+            (min, dz, dy),                             // −x
+            (Vec3::new(min.x, max.y, max.z), dx, -dz), // +y
+            (min, dx, dz),                             // −y
+            (Vec3::new(min.x, min.y, max.z), dx, dy),  // +z
+            (Vec3::new(max.x, min.y, min.z), -dx, dy), // −z
+        ];
+        for (origin, u, v) in faces {
+            mesh.push_quad(origin, u, v, Vec2::ONE);
+        }
+        mesh
+    }
+
+    /// A UV sphere with `segments` slices around the y axis and `segments / 2` stacks; texture
+    /// coordinates are longitude and latitude (`u = φ/2π`, `v = θ/π` from the north pole).
+    pub fn sphere(center: Vec3, radius: f32, segments: u32) -> Mesh {
+        let slices = segments.max(3);
+        let stacks = (segments / 2).max(2);
+        let mut mesh = Mesh { name: "sphere".into(), ..Mesh::default() };
+        for j in 0..=stacks {
+            let v = j as f32 / stacks as f32;
+            let theta = v * std::f32::consts::PI;
+            for i in 0..=slices {
+                let u = i as f32 / slices as f32;
+                let phi = u * std::f32::consts::TAU;
+                let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+                mesh.push_vertex(center + radius * n, n, Vec2::new(u, v));
+            }
+        }
+        let row = slices + 1;
+        for j in 0..stacks {
+            for i in 0..slices {
+                let (a, b) = (j * row + i, j * row + i + 1);
+                let (c, d) = (a + row, b + row);
+                // Skip the triangles that collapse to a point at each pole.
+                if j != 0 {
+                    mesh.indices.extend_from_slice(&[a, c, b]);
+                }
+                if j != stacks - 1 {
+                    mesh.indices.extend_from_slice(&[b, c, d]);
+                }
+            }
+        }
+        mesh
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn assert_outward_and_ccw(mesh: &Mesh, center: Vec3) {
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| mesh.positions[i as usize]);
+            let face = (b - a).cross(c - a);
+            assert!(face.length() > 0.0, "degenerate triangle in {}", mesh.name);
+            let centroid = (a + b + c) / 3.0;
+            assert!(face.dot(centroid - center) > 0.0, "{} has an inward-facing triangle", mesh.name);
+            let n = mesh.normals[t[0] as usize];
+            assert!(n.dot(face) > 0.0, "{}: vertex normal disagrees with winding", mesh.name);
+        }
+    }
+
+    #[test]
+    fn analytic_shapes_tessellate_outward_counter_clockwise() {
+        let center = Vec3::new(1.0, 2.0, 3.0);
+        assert_outward_and_ccw(&Mesh::sphere(center, 2.0, 16), center);
+        assert_outward_and_ccw(&Mesh::cuboid(center - 1.0, center + Vec3::new(1.0, 2.0, 3.0)), center);
+        assert_outward_and_ccw(&Mesh::plane(Vec2::new(4.0, 2.0), Vec2::ONE), Vec3::NEG_Y);
+    }
+
+    #[test]
+    fn sphere_vertices_lie_on_the_sphere() {
+        let mesh = Mesh::sphere(Vec3::ZERO, 25.0, 32);
+        assert!(mesh.positions.iter().all(|p| (p.length() - 25.0).abs() < 1e-4));
+        assert_eq!(mesh.triangle_count(), 32 * 16 * 2 - 2 * 32);
+    }
+
+    #[test]
+    fn repair_drops_zero_area_triangles_and_rejects_bad_indices() {
+        let mut mesh = Mesh {
+            name: "t".into(),
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X * 2.0],
+            normals: vec![Vec3::Z; 4],
+            uvs: vec![Vec2::ZERO; 4],
+            indices: vec![0, 1, 2, 0, 1, 3],
+        };
+        assert_eq!(mesh.validate_and_repair(), Ok(1));
+        assert_eq!(mesh.indices, vec![0, 1, 2]);
+        mesh.indices.extend_from_slice(&[0, 1, 7]);
+        assert!(matches!(mesh.validate_and_repair(), Err(MeshError::IndexOutOfRange { index: 7, .. })));
+    }
+}

@@ -1,0 +1,153 @@
+//! The scene: pure CPU data read by both renderers. No wgpu here.
+//!
+//! A [`Scene`] holds a camera, lights, materials, textures, meshes and objects. Objects are
+//! analytic shapes (sphere, axis-aligned box, plane) or triangle meshes, each placed by a
+//! `world_from_local` transform; glTF models are imported into meshes, materials, lights and
+//! cameras. Scenes are written in TOML ([`file`], documented in `docs/scene-format.md`).
+
+pub mod camera;
+pub mod file;
+pub mod gltf;
+pub mod light;
+pub mod material;
+pub mod mesh;
+pub mod shading;
+pub mod texture;
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat3, Mat4, Vec2, Vec3};
+
+pub use camera::{Camera, Projection, Ray};
+pub use light::{Attenuation, Light, LightKind};
+pub use material::{ColorSpace, Material, MaterialId, Texture, TextureId};
+pub use mesh::Mesh;
+
+use crate::settings::RenderSettings;
+
+/// The geometry of an object, in its local coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    /// Axis-aligned (in local coordinates) box between two corners.
+    Cuboid {
+        min: Vec3,
+        max: Vec3,
+    },
+    /// The finite quad `|x| ≤ size.x/2, |z| ≤ size.y/2` in the plane y = 0, facing +y, with
+    /// texture coordinates over `[0, uv_scale]`.
+    Plane {
+        size: Vec2,
+        uv_scale: Vec2,
+    },
+    /// Index into [`Scene::meshes`].
+    Mesh(usize),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    pub name: String,
+    pub shape: Shape,
+    pub material: MaterialId,
+    pub world_from_local: Mat4,
+}
+
+impl Object {
+    /// The matrix that carries local normals to world normals (inverse transpose).
+    pub fn normal_from_local(&self) -> Mat3 {
+        Mat3::from_mat4(self.world_from_local).inverse().transpose()
+    }
+}
+
+/// Everything both renderers draw.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The file the scene came from, for messages; `None` for scenes built in code.
+    pub source: Option<PathBuf>,
+    pub camera: Camera,
+    /// `A`: global ambient radiance (see `shading.rs` for how it is reflected).
+    pub ambient: Vec3,
+    /// Radiance of rays that hit nothing.
+    pub background: Vec3,
+    pub lights: Vec<Light>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<Texture>,
+    pub meshes: Vec<Mesh>,
+    pub objects: Vec<Object>,
+    /// The scene file's defaults for the toggles; the CLI and the viewer start from these.
+    pub settings: RenderSettings,
+}
+
+/// Why a scene could not be loaded. Every variant names the file it is about.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("{path}: cannot read the file: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{path}:{line}:{column}: {message}")]
+    Syntax { path: PathBuf, line: usize, column: usize, message: String },
+    #[error("{path}: {message}")]
+    Invalid { path: PathBuf, message: String },
+    #[error("{path}: glTF: {message}")]
+    Gltf { path: PathBuf, message: String },
+    #[error("{path}: texture: {message}")]
+    Texture { path: PathBuf, message: String },
+}
+
+impl SceneError {
+    pub fn path(&self) -> &Path {
+        match self {
+            SceneError::Io { path, .. }
+            | SceneError::Syntax { path, .. }
+            | SceneError::Invalid { path, .. }
+            | SceneError::Gltf { path, .. }
+            | SceneError::Texture { path, .. } => path,
+        }
+    }
+}
+
+impl Scene {
+    /// Loads a TOML scene file (or a bare `.gltf` / `.glb` model, framed by a default camera and
+    /// light).
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        file::load(path)
+    }
+
+    /// The built-in default scene, `assets/scenes/showcase.toml`.
+    pub fn showcase() -> Result<Scene, SceneError> {
+        Scene::load(&builtin_path("showcase.toml"))
+    }
+
+    /// The triangles the rasterizer draws for `object`, in its local coordinates.
+    pub fn tessellate(&self, object: &Object) -> std::borrow::Cow<'_, Mesh> {
+        use std::borrow::Cow;
+        match object.shape {
+            Shape::Sphere { center, radius } => Cow::Owned(Mesh::sphere(center, radius, self.settings.sphere_segments)),
+            Shape::Cuboid { min, max } => Cow::Owned(Mesh::cuboid(min, max)),
+            Shape::Plane { size, uv_scale } => Cow::Owned(Mesh::plane(size, uv_scale)),
+            Shape::Mesh(index) => Cow::Borrowed(&self.meshes[index]),
+        }
+    }
+
+    /// A world-space bounding box of everything in the scene, `None` for an empty scene.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut bounds: Option<(Vec3, Vec3)> = None;
+        for object in &self.objects {
+            for p in self.tessellate(object).positions.iter() {
+                let w = object.world_from_local.transform_point3(*p);
+                bounds = Some(match bounds {
+                    None => (w, w),
+                    Some((lo, hi)) => (lo.min(w), hi.max(w)),
+                });
+            }
+        }
+        bounds
+    }
+}
+
+/// Where the built-in scenes live: `assets/scenes/` of the source tree this binary was built from.
+pub fn builtin_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets").join("scenes").join(name)
+}

@@ -1,0 +1,122 @@
+//! The local illumination model ("MIL", TECHNIQUES.md §1; seed 000 §2.1, `EvaluaMILRec` and
+//! `Directa`), evaluated once here for the ray tracer and once in `shaders/common/lighting.wgsl`
+//! for the rasterizer. `tests/illumination.rs` runs both on the same inputs.
+//!
+//! ```text
+//! L = ME + AG(p) + Σ_i V_i · S_i ⊗ ( ka·C + [n·l > 0] · ( kd·C·(n·l) + ks·Sc·max(0, r·v)^e ) )
+//! r = 2(n·l)n − l          AG(p) = A ⊗ kd·C
+//! ```
+//!
+//! `S_i` is what light `i` delivers (colour, intensity, attenuation; see `light.rs`), `V_i` its
+//! visibility (1 without shadows), `A` the scene's global ambient radiance. Two choices the notes
+//! leave open, made once for both renderers:
+//! - `AG(p)`: the notes call it "radiancia ambiente global"; seed 004 writes it `Ia ⊗ kd`. We
+//!   reflect `A` by the diffuse colour, so a perfect mirror (kd = 0) shows no ambient haze.
+//! - A light behind the surface (n·l ≤ 0) adds no diffuse or specular term. The notes' own shadow
+//!   test gives the same for closed objects; for open ones (a quad seen from its back) it stops
+//!   a highlight leaking through.
+//! The normal is turned to face the viewer first, so thin surfaces are lit on both sides.
+
+use glam::Vec3;
+
+use super::light::Incidence;
+use super::material::Material;
+
+/// The material parameters at one surface point, after texturing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceSample {
+    /// `C(p)`: material colour times texture, linear RGB.
+    pub color: Vec3,
+    pub ka: f32,
+    pub kd: f32,
+    pub ks: f32,
+    pub specular_color: Vec3,
+    pub shininess: f32,
+    pub emission: Vec3,
+}
+
+impl SurfaceSample {
+    /// The material's constants with `C` replaced by the textured colour.
+    pub fn new(material: &Material, color: Vec3) -> SurfaceSample {
+        SurfaceSample {
+            color,
+            ka: material.ka,
+            kd: material.kd,
+            ks: material.ks,
+            specular_color: material.specular_color,
+            shininess: material.shininess,
+            emission: material.emission,
+        }
+    }
+}
+
+/// Which terms of the model are drawn: the teaching toggles of `RenderSettings::terms`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Terms {
+    pub ambient: bool,
+    pub diffuse: bool,
+    pub specular: bool,
+    pub emission: bool,
+}
+
+impl Terms {
+    pub const ALL: Terms = Terms { ambient: true, diffuse: true, specular: true, emission: true };
+}
+
+/// `n` turned to the viewer's side: the shading normal of a two-sided surface.
+pub fn facing_viewer(n: Vec3, v: Vec3) -> Vec3 {
+    if n.dot(v) < 0.0 { -n } else { n }
+}
+
+/// `L_dir(p, v, l)` of seed 000, times the light's radiance `S_i`: the contribution of one
+/// visible light. `n` and `v` are unit vectors; `n` already faces the viewer.
+pub fn direct(surface: &SurfaceSample, n: Vec3, v: Vec3, light: &Incidence, terms: Terms) -> Vec3 {
+    let mut rad = Vec3::ZERO;
+    if terms.ambient {
+        rad += surface.ka * surface.color;
+    }
+    let n_dot_l = n.dot(light.l);
+    if n_dot_l > 0.0 {
+        if terms.diffuse {
+            rad += surface.kd * surface.color * n_dot_l;
+        }
+        if terms.specular && surface.ks > 0.0 {
+            let r = 2.0 * n_dot_l * n - light.l;
+            rad += surface.ks * surface.specular_color * r.dot(v).max(0.0).powf(surface.shininess);
+        }
+    }
+    light.radiance * rad
+}
+
+/// `ME + AG(p)`: the light a point gives off whatever the lights do.
+pub fn emitted_and_ambient(surface: &SurfaceSample, ambient: Vec3, terms: Terms) -> Vec3 {
+    let mut rad = Vec3::ZERO;
+    if terms.emission {
+        rad += surface.emission;
+    }
+    if terms.ambient {
+        rad += ambient * surface.kd * surface.color;
+    }
+    rad
+}
+
+/// The whole local model at one point: `ME + AG + Σ V_i·S_i·L_dir`, with each light given as its
+/// incidence and its visibility `V_i`, an RGB fraction (0 or 1 behind opaque occluders, seed 003's
+/// 0 < s < 1 through transparent ones). The recursive mirror and transmission terms are the tracer's.
+pub fn local_illumination<'a>(
+    surface: &SurfaceSample,
+    n: Vec3,
+    v: Vec3,
+    ambient: Vec3,
+    lights: impl IntoIterator<Item = (&'a Incidence, Vec3)>,
+    terms: Terms,
+) -> Vec3 {
+    let n = facing_viewer(n, v);
+    let mut rad = emitted_and_ambient(surface, ambient, terms);
+    for (incidence, visibility) in lights {
+        if visibility != Vec3::ZERO {
+            rad += visibility * direct(surface, n, v, incidence, terms);
+        }
+    }
+    rad
+}

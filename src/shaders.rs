@@ -1,0 +1,32 @@
+//! WGSL composition, in one place: every pass's shader is the shared files of `shaders/common/`
+//! followed by the pass's own file. Shared code is never copied between shaders.
+
+/// The shared WGSL, in dependency order.
+pub const COMMON: &[(&str, &str)] = &[
+    ("common/types.wgsl", include_str!("../shaders/common/types.wgsl")),
+    ("common/lighting.wgsl", include_str!("../shaders/common/lighting.wgsl")),
+];
+
+pub const OPAQUE: &str = include_str!("../shaders/opaque.wgsl");
+pub const PRESENT: &str = include_str!("../shaders/present.wgsl");
+
+/// The full source of a pass: the common files, then the pass's own.
+pub fn compose(pass: &str) -> String {
+    let mut source = String::new();
+    for (name, text) in COMMON {
+        source.push_str("// ---- ");
+        source.push_str(name);
+        source.push('\n');
+        source.push_str(text);
+        source.push('\n');
+    }
+    source.push_str(pass);
+    source
+}
+
+pub fn module(device: &wgpu::Device, label: &str, pass: &str) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(compose(pass).into()),
+    })
+}
