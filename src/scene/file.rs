@@ -10,7 +10,7 @@ use std::fmt;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
+use glam::{Mat4, Quat, Vec2, Vec3};
 use serde::Deserialize;
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use toml::Spanned;
@@ -258,6 +258,8 @@ enum ObjectType {
     Sphere,
     Box,
     Plane,
+    Torus,
+    RoundedBox,
     Gltf,
 }
 
@@ -273,6 +275,9 @@ struct ObjectDesc {
     min: Option<V3>,
     max: Option<V3>,
     size: Option<PositiveV2>,
+    major_radius: Option<Positive>,
+    minor_radius: Option<Positive>,
+    half_extents: Option<V3>,
     uv_scale: Option<PositiveV2>,
     path: Option<String>,
     lights: Option<bool>,
@@ -488,7 +493,10 @@ impl<'a> Builder<'a> {
     fn object(&mut self, d: ObjectDesc, span: Range<usize>) -> Result<Option<GltfCamera>, SceneError> {
         let fail = |message: String| self.error(message, span.clone());
         let kind_name = format!("{:?}", d.kind).to_lowercase();
-        let fields: [(&str, bool); 10] = [
+        let fields: [(&str, bool); 13] = [
+            ("major_radius", d.major_radius.is_some()),
+            ("minor_radius", d.minor_radius.is_some()),
+            ("half_extents", d.half_extents.is_some()),
             ("center", d.center.is_some()),
             ("radius", d.radius.is_some()),
             ("min", d.min.is_some()),
@@ -504,6 +512,8 @@ impl<'a> Builder<'a> {
             ObjectType::Sphere => &["center", "radius", "material"],
             ObjectType::Box => &["min", "max", "material"],
             ObjectType::Plane => &["size", "uv_scale", "material"],
+            ObjectType::Torus => &["major_radius", "minor_radius", "material"],
+            ObjectType::RoundedBox => &["half_extents", "radius", "material"],
             ObjectType::Gltf => &["path", "lights", "camera"],
         };
         if let Some((field, _)) = fields.iter().find(|(f, present)| *present && !allowed.contains(f)) {
@@ -529,6 +539,21 @@ impl<'a> Builder<'a> {
                 size: d.size.map_or(Vec2::ONE, |PositiveV2(s)| s),
                 uv_scale: d.uv_scale.map_or(Vec2::ONE, |PositiveV2(s)| s),
             },
+            ObjectType::Torus => {
+                let major = d.major_radius.map_or(1.0, |Positive(r)| r);
+                let minor = d.minor_radius.map_or(0.25, |Positive(r)| r);
+                if minor >= major {
+                    return Err(fail(format!("a torus needs minor_radius < major_radius, got {minor} and {major}")));
+                }
+                Shape::Torus { major, minor }
+            }
+            ObjectType::RoundedBox => {
+                let half = d.half_extents.map_or(Vec3::splat(0.5), |V3(h)| h);
+                if half.min_element() < 0.0 {
+                    return Err(fail(format!("half_extents must be ≥ 0, got {half}")));
+                }
+                Shape::RoundedBox { half, radius: d.radius.map_or(0.1, |Positive(r)| r) }
+            }
             ObjectType::Gltf => {
                 let relative = d.path.ok_or_else(|| fail("a gltf object needs a `path`".into()))?;
                 let import = super::gltf::import(&self.dir.join(relative))?;
@@ -609,7 +634,9 @@ fn transform(translate: Option<V3>, rotate: Option<V3>, scale: Option<Scale>) ->
     let t = translate.map_or(Vec3::ZERO, |V3(t)| t);
     let r = rotate.map_or(Vec3::ZERO, |V3(r)| r);
     let s = scale.map_or(Vec3::ONE, |Scale(s)| s);
-    let rotation = Quat::from_euler(EulerRot::ZYXEx, r.z.to_radians(), r.y.to_radians(), r.x.to_radians());
+    let rotation = Quat::from_rotation_z(r.z.to_radians())
+        * Quat::from_rotation_y(r.y.to_radians())
+        * Quat::from_rotation_x(r.x.to_radians());
     Mat4::from_scale_rotation_translation(s, rotation, t)
 }
 

@@ -168,6 +168,89 @@ impl Mesh {
         }
         mesh
     }
+
+    /// A torus around the y axis: `segments` steps around the ring, `segments / 2` around the
+    /// tube; `u` runs around the ring, `v` around the tube.
+    pub fn torus(major: f32, minor: f32, segments: u32) -> Mesh {
+        let (ring, tube) = (segments.max(3), (segments / 2).max(3));
+        let mut mesh = Mesh { name: "torus".into(), ..Mesh::default() };
+        for j in 0..=tube {
+            let v = j as f32 / tube as f32;
+            let (sin_b, cos_b) = (v * std::f32::consts::TAU).sin_cos();
+            for i in 0..=ring {
+                let u = i as f32 / ring as f32;
+                let (sin_a, cos_a) = (u * std::f32::consts::TAU).sin_cos();
+                let radial = Vec3::new(cos_a, 0.0, -sin_a);
+                let n = cos_b * radial + sin_b * Vec3::Y;
+                mesh.push_vertex(major * radial + minor * n, n, Vec2::new(u, v));
+            }
+        }
+        mesh.grid_indices(ring, tube);
+        mesh
+    }
+
+    /// A box of half extents `half` with edges rounded by `radius`: a finely divided cube of half
+    /// extent `half + radius` whose every vertex is moved onto the exact rounded surface
+    /// `q + radius·normalize(p − q)`, `q` the nearest point of the inner box. Flat faces stay
+    /// flat; the rounded edges get `segments / 4` steps.
+    pub fn rounded_box(half: Vec3, radius: f32, segments: u32) -> Mesh {
+        let steps = (segments / 4).max(2);
+        let mut mesh = Mesh { name: "rounded box".into(), ..Mesh::default() };
+        let outer = half + Vec3::splat(radius);
+        // Along each face axis: the rounded rim, the flat middle, the rim again.
+        let ticks = |h: f32| -> Vec<f32> {
+            let mut t: Vec<f32> = (0..=steps)
+                .map(|k| -h - radius * (std::f32::consts::FRAC_PI_2 * k as f32 / steps as f32).cos())
+                .collect();
+            t.extend(
+                (0..=steps).rev().map(|k| h + radius * (std::f32::consts::FRAC_PI_2 * k as f32 / steps as f32).cos()),
+            );
+            t
+        };
+        let faces = [
+            (Vec3::X, Vec3::NEG_Z, Vec3::Y),
+            (Vec3::NEG_X, Vec3::Z, Vec3::Y),
+            (Vec3::Y, Vec3::X, Vec3::NEG_Z),
+            (Vec3::NEG_Y, Vec3::X, Vec3::Z),
+            (Vec3::Z, Vec3::X, Vec3::Y),
+            (Vec3::NEG_Z, Vec3::NEG_X, Vec3::Y),
+        ];
+        for (normal, u_axis, v_axis) in faces {
+            let (us, vs) = (ticks(u_axis.abs().dot(half)), ticks(v_axis.abs().dot(half)));
+            let base = mesh.positions.len() as u32;
+            for (j, &v) in vs.iter().enumerate() {
+                for (i, &u) in us.iter().enumerate() {
+                    let p = normal * normal.abs().dot(outer) + u_axis * u + v_axis * v;
+                    let q = p.clamp(-half, half);
+                    let n = (p - q).try_normalize().unwrap_or(normal);
+                    let uv = Vec2::new(i as f32 / (us.len() - 1) as f32, 1.0 - j as f32 / (vs.len() - 1) as f32);
+                    mesh.push_vertex(q + radius * n, n, uv);
+                }
+            }
+            let row = us.len() as u32;
+            for j in 0..vs.len() as u32 - 1 {
+                for i in 0..row - 1 {
+                    let (a, b) = (base + j * row + i, base + j * row + i + 1);
+                    mesh.indices.extend_from_slice(&[a, b, b + row, a, b + row, a + row]);
+                }
+            }
+        }
+        // Rims meet at the edges in coincident vertices, so some rim quads collapse; drop them.
+        mesh.validate_and_repair().expect("the rounded box's own indices are in range");
+        mesh
+    }
+
+    /// Indices of a `(columns + 1) × (rows + 1)` vertex grid, counter-clockwise seen from the
+    /// side the normals point to when u runs left to right and v bottom to top.
+    fn grid_indices(&mut self, columns: u32, rows: u32) {
+        let row = columns + 1;
+        for j in 0..rows {
+            for i in 0..columns {
+                let (a, b) = (j * row + i, j * row + i + 1);
+                self.indices.extend_from_slice(&[a, b, b + row, a, b + row, a + row]);
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -192,6 +275,31 @@ mod tests {
         assert_outward_and_ccw(&Mesh::sphere(center, 2.0, 16), center);
         assert_outward_and_ccw(&Mesh::cuboid(center - 1.0, center + Vec3::new(1.0, 2.0, 3.0)), center);
         assert_outward_and_ccw(&Mesh::plane(Vec2::new(4.0, 2.0), Vec2::ONE), Vec3::NEG_Y);
+        assert_outward_and_ccw(&Mesh::rounded_box(Vec3::new(1.0, 2.0, 0.5), 0.25, 32), Vec3::ZERO);
+    }
+
+    #[test]
+    fn torus_faces_away_from_its_tube_and_lies_on_the_surface() {
+        let mesh = Mesh::torus(2.0, 0.5, 32);
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| mesh.positions[i as usize]);
+            let centroid = (a + b + c) / 3.0;
+            let ring = Vec3::new(centroid.x, 0.0, centroid.z).normalize() * 2.0;
+            assert!((b - a).cross(c - a).dot(centroid - ring) > 0.0, "inward-facing torus triangle");
+        }
+        for p in &mesh.positions {
+            let ring_distance = (Vec2::new(p.x, p.z).length() - 2.0).hypot(p.y);
+            assert!((ring_distance - 0.5).abs() < 1e-4);
+        }
+    }
+
+    #[test]
+    fn rounded_box_vertices_lie_on_the_rounded_surface() {
+        let (half, radius) = (Vec3::new(1.0, 2.0, 0.5), 0.25);
+        for p in &Mesh::rounded_box(half, radius, 32).positions {
+            let distance = (p.abs() - half).max(Vec3::ZERO).length();
+            assert!((distance - radius).abs() < 1e-4, "{p} is {distance} from the inner box");
+        }
     }
 
     #[test]

@@ -45,6 +45,18 @@ pub enum Shape {
     },
     /// Index into [`Scene::meshes`].
     Mesh(usize),
+    /// Signed-distance-field shapes, which the ray tracer finds by sphere tracing (seed 000 §2.2).
+    /// A torus around the local y axis: `major` radius to the tube's centre, `minor` the tube's.
+    Torus {
+        major: f32,
+        minor: f32,
+    },
+    /// A box of half extents `half` centred at the origin, its edges rounded by `radius`
+    /// (the surface lies `radius` outside the inner box `[−half, half]`).
+    RoundedBox {
+        half: Vec3,
+        radius: f32,
+    },
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -128,6 +140,10 @@ impl Scene {
             Shape::Cuboid { min, max } => Cow::Owned(Mesh::cuboid(min, max)),
             Shape::Plane { size, uv_scale } => Cow::Owned(Mesh::plane(size, uv_scale)),
             Shape::Mesh(index) => Cow::Borrowed(&self.meshes[index]),
+            Shape::Torus { major, minor } => Cow::Owned(Mesh::torus(major, minor, self.settings.sphere_segments)),
+            Shape::RoundedBox { half, radius } => {
+                Cow::Owned(Mesh::rounded_box(half, radius, self.settings.sphere_segments))
+            }
         }
     }
 

@@ -1,0 +1,130 @@
+//! The `mirador` binary as a user meets it: images written whole or not at all, and errors that
+//! name the file and the problem.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn mirador(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mirador")).args(args).output().expect("running the mirador binary")
+}
+
+/// A fresh, empty directory for one test's outputs.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mirador-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("creating a scratch directory");
+    dir
+}
+
+fn asset(relative: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets").join(relative).display().to_string()
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// Fails unless the command failed, said all of `needles`, and left `dir` empty.
+fn assert_fails_cleanly(output: &Output, needles: &[&str], dir: &Path) {
+    let message = stderr(output);
+    assert!(!output.status.success(), "expected a failure, stderr: {message}");
+    assert!(!message.contains("panicked"), "a panic instead of an error: {message}");
+    for needle in needles {
+        assert!(message.contains(needle), "the error should mention `{needle}`: {message}");
+    }
+    let left: Vec<_> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(left.is_empty(), "a failed run left files behind: {left:?}");
+}
+
+#[test]
+fn render_writes_a_png_of_the_requested_size() {
+    let dir = scratch("size");
+    let out = dir.join("seed.png");
+    let output = mirador(&[
+        "render",
+        &asset("scenes/seed-simple.toml"),
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "100",
+        "--height",
+        "60",
+        "--stats",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let image = image::open(&out).expect("the output is a PNG").into_rgba8();
+    assert_eq!(image.dimensions(), (100, 60));
+    let stats = String::from_utf8_lossy(&output.stdout);
+    for step in ["device", "scene load", "upload", "frame"] {
+        assert!(stats.contains(step), "--stats should report `{step}`: {stats}");
+    }
+    let entries = std::fs::read_dir(&dir).unwrap().count();
+    assert_eq!(entries, 1, "only the image is left, no temporary file");
+}
+
+#[test]
+fn no_scene_renders_the_showcase() {
+    let dir = scratch("default");
+    let out = dir.join("showcase.png");
+    let output = mirador(&["render", "-o", out.to_str().unwrap(), "--width", "64", "--height", "36"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert_eq!(image::open(&out).unwrap().into_rgba8().dimensions(), (64, 36));
+}
+
+#[test]
+fn a_missing_scene_is_named_and_nothing_is_written() {
+    let dir = scratch("missing");
+    let out = dir.join("out.png");
+    let output = mirador(&["render", "no/such/scene.toml", "-o", out.to_str().unwrap()]);
+    assert_fails_cleanly(&output, &["no/such/scene.toml", "cannot read"], &dir);
+}
+
+#[test]
+fn a_malformed_scene_is_reported_with_line_and_column() {
+    let dir = scratch("malformed");
+    let scene = dir.join("bad.toml");
+    std::fs::write(&scene, "[camera]\neye = [1, 2, 3]\ncenter = [0, 0, 0]\nfovy = nan\n").unwrap();
+    let out = dir.join("out.png");
+    let output = mirador(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    std::fs::remove_file(&scene).unwrap();
+    assert_fails_cleanly(&output, &["bad.toml:4:8", "finite"], &dir);
+}
+
+#[test]
+fn bad_sizes_and_settings_are_rejected() {
+    let dir = scratch("sizes");
+    let out = dir.join("out.png");
+    let out = out.to_str().unwrap();
+    let seed = asset("scenes/seed-simple.toml");
+    assert_fails_cleanly(&mirador(&["render", &seed, "-o", out, "--width", "0"]), &["at least one pixel"], &dir);
+    assert_fails_cleanly(&mirador(&["render", &seed, "-o", out, "--height", "100000"]), &["at most 16384"], &dir);
+    assert_fails_cleanly(&mirador(&["render", &seed, "-o", out, "--set", "terms.glow=true"]), &["terms.glow"], &dir);
+    assert_fails_cleanly(&mirador(&["render", &seed, "-o", out, "--set", "exposure=-2"]), &["exposure"], &dir);
+    let jpeg = dir.join("out.jpg");
+    assert_fails_cleanly(&mirador(&["render", &seed, "-o", jpeg.to_str().unwrap()]), &["out.jpg", ".png"], &dir);
+}
+
+#[test]
+fn an_unwritable_output_is_named() {
+    let dir = scratch("unwritable");
+    let out = dir.join("no-such-dir").join("out.png");
+    let output = mirador(&["render", &asset("scenes/seed-simple.toml"), "-o", out.to_str().unwrap()]);
+    assert_fails_cleanly(&output, &["no-such-dir/out.png", "cannot write"], &dir);
+}
+
+#[test]
+fn an_existing_image_survives_a_failed_render() {
+    let dir = scratch("survives");
+    let out = dir.join("keep.png");
+    std::fs::write(&out, b"previous image").unwrap();
+    let output = mirador(&["render", "missing.toml", "-o", out.to_str().unwrap()]);
+    assert!(!output.status.success());
+    assert_eq!(std::fs::read(&out).unwrap(), b"previous image");
+}
+
+#[test]
+fn no_arguments_print_help() {
+    let output = mirador(&[]);
+    assert!(output.status.success());
+    assert!(String::from_utf8_lossy(&output.stdout).contains("render"));
+}
