@@ -6,6 +6,16 @@
 @group(1) @binding(1) var color_texture: texture_2d<f32>;
 @group(1) @binding(2) var color_sampler: sampler;
 @group(2) @binding(0) var<uniform> object: Object;
+// Group 3: the shadow maps of this frame (pass 1's output) and how to read them.
+@group(3) @binding(0) var<uniform> shadows: Shadows;
+@group(3) @binding(1) var shadow_maps: texture_depth_2d_array;
+@group(3) @binding(2) var shadow_linear: sampler_comparison;
+@group(3) @binding(3) var shadow_nearest: sampler_comparison;
+@group(3) @binding(4) var transmission_maps: texture_2d_array<f32>;
+@group(3) @binding(5) var projected_mask: texture_2d<f32>;
+
+const SHADOW_METHOD_MAP: u32 = 0u;
+const SHADOW_VIEW_TEXELS: u32 = 2u;
 
 struct VertexIn {
     @location(0) position: vec3f,
@@ -39,6 +49,48 @@ fn view_vector(p: vec3f) -> vec3f {
     return normalize(frame.eye - p);
 }
 
+// V_i for one light at p: 1 lit, 0 in shadow, a colour behind transparent occluders.
+// `facing` is the normal on the side the light is on, for the normal offset.
+fn visibility(light: Light, p: vec3f, facing: vec3f, pixel: vec2f) -> vec3f {
+    if shadows.enabled == 0u || light.shadow_layer < 0 {
+        return vec3f(1.0);
+    }
+    if shadows.method != SHADOW_METHOD_MAP {
+        let mask = textureLoad(projected_mask, vec2i(pixel), 0);
+        return vec3f(1.0 - mask[light.shadow_slot]);
+    }
+    var layer = u32(light.shadow_layer);
+    if light.kind == LIGHT_POINT {
+        layer += cube_face(p - light.position);
+    }
+    let view = shadows.layers[layer];
+    // The texel's world size where p is: fixed for orthographic views, growing with distance
+    // from the light for perspective ones.
+    let texel = select(view.texel_size, view.texel_size * distance(p, light.position), view.perspective != 0u);
+    let q = p + facing * shadows.normal_offset * texel;
+    let coordinates = shadow_coordinates(view.clip_from_world, q);
+    let inside = coordinates.w > 0.0 && all(coordinates.xy >= vec2f(0.0)) && all(coordinates.xy <= vec2f(1.0))
+        && coordinates.z <= 1.0;
+    if !inside {
+        // Outside the light's view: nothing there was drawn into the map, so nothing occludes.
+        return vec3f(1.0);
+    }
+    var v = vec3f(shadow_filtered(
+        shadow_maps, shadow_linear, shadow_nearest, coordinates.xy, coordinates.z, layer, shadows.filter_mode,
+        shadows.map_size,
+    ));
+    // A transparent receiver is not tinted by transparent occluders: in this one-layer
+    // approximation it would be tinted by itself.
+    if shadows.transmission != 0u && material.transparent == 0u {
+        let size = vec2f(textureDimensions(transmission_maps));
+        let tint = textureLoad(transmission_maps, vec2i(coordinates.xy * size), layer, 0);
+        if coordinates.z > tint.a {
+            v *= tint.rgb;
+        }
+    }
+    return v;
+}
+
 @fragment
 fn fs_opaque(in: VertexOut) -> @location(0) vec4f {
     var color = material.color;
@@ -52,11 +104,24 @@ fn fs_opaque(in: VertexOut) -> @location(0) vec4f {
     let v = view_vector(in.world);
     let n = facing_viewer(normalize(in.normal), v);
     var radiance = emitted_and_ambient(surface, frame.ambient, frame.terms);
+    var checker = -1.0;
     for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {
-        let incidence = light_incidence(frame.lights[i], in.world);
+        let light = frame.lights[i];
+        let incidence = light_incidence(light, in.world);
         if incidence.valid {
-            radiance += direct(surface, n, v, incidence, frame.terms);
+            let facing = select(-n, n, dot(n, incidence.l) >= 0.0);
+            radiance += visibility(light, in.world, facing, in.clip.xy) * direct(surface, n, v, incidence, frame.terms);
+            if shadows.view == SHADOW_VIEW_TEXELS && light.shadow_layer >= 0 && checker < 0.0 {
+                var layer = u32(light.shadow_layer);
+                if light.kind == LIGHT_POINT {
+                    layer += cube_face(in.world - light.position);
+                }
+                checker = shadow_texel_checker(shadow_coordinates(shadows.layers[layer].clip_from_world, in.world).xy, shadows.map_size);
+            }
         }
+    }
+    if checker >= 0.0 {
+        radiance *= mix(0.55, 1.0, checker);
     }
     return vec4f(radiance, 1.0);
 }

@@ -15,6 +15,8 @@ pub mod raster;
 pub mod scene;
 pub mod settings;
 pub mod shaders;
+pub mod texture;
+pub mod trace;
 
 pub use scene::Scene;
 pub use settings::RenderSettings;

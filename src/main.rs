@@ -1,5 +1,6 @@
-//! The `mirador` command line: headless screenshots now; the viewer, the ray tracer and
-//! `compare` as their issues land.
+//! The `mirador` command line: headless screenshots from the rasterizer (`render`) and the ray
+//! tracer (`trace`), and the two side by side (`compare`). The viewer takes the bare `mirador`
+//! once it lands.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -7,9 +8,13 @@ use std::process::ExitCode;
 use anyhow::{Context, bail};
 use clap::{CommandFactory, Parser, Subcommand};
 
+use mirador::compare::sheet::{Panel, flip_legend, sheet, with_footer};
 use mirador::gpu::texture::GpuTexture;
 use mirador::gpu::{Gpu, Stopwatch, readback};
 use mirador::raster::{OUTPUT_FORMAT, Renderer};
+use mirador::settings::AntiAliasing;
+use mirador::trace::accel::AccelKind;
+use mirador::trace::{RenderControl, Tracer};
 use mirador::{RenderSettings, Scene, output};
 
 #[derive(Parser)]
@@ -26,16 +31,48 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene with the z-buffer rasterizer into a PNG.
-    Render(RenderArgs),
+    Render {
+        #[command(flatten)]
+        scene: SceneArgs,
+        /// Output PNG, written atomically.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// Render a scene with the Whitted ray tracer into a PNG.
+    Trace {
+        #[command(flatten)]
+        scene: SceneArgs,
+        #[command(flatten)]
+        trace: TraceArgs,
+        /// Output PNG, written atomically.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// Render a scene with both renderers and write a sheet: raster | ray traced | FLIP error.
+    Compare {
+        #[command(flatten)]
+        scene: SceneArgs,
+        #[command(flatten)]
+        trace: TraceArgs,
+        /// The sheet, written atomically.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Also write the raster image here.
+        #[arg(long)]
+        raster_out: Option<PathBuf>,
+        /// Also write the ray-traced image here.
+        #[arg(long)]
+        trace_out: Option<PathBuf>,
+        /// Also write the FLIP error map here.
+        #[arg(long)]
+        error_out: Option<PathBuf>,
+    },
 }
 
 #[derive(clap::Args)]
-struct RenderArgs {
+struct SceneArgs {
     /// Scene file (TOML, or a .gltf/.glb model). Default: the built-in showcase.
     scene: Option<PathBuf>,
-    /// Output PNG, written atomically.
-    #[arg(short, long)]
-    output: PathBuf,
     /// Image width in pixels (default: the scene camera's).
     #[arg(long)]
     width: Option<u32>,
@@ -45,18 +82,43 @@ struct RenderArgs {
     /// Change a render setting, as a dotted key and a TOML value: `--set terms.specular=false`.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
-    /// Print the time of each step.
+    /// Print the time of each step and what was traced.
     #[arg(long)]
     stats: bool,
+}
+
+#[derive(clap::Args)]
+struct TraceArgs {
+    /// Anti-aliasing (default: the scene's `trace.anti_aliasing`, else one ray per pixel centre).
+    #[arg(long, value_enum)]
+    aa: Option<AntiAliasing>,
+    /// Rays per pixel for `regular` and `jittered`: a square number (1, 4, 9, 16, …).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Deepest reflection/refraction recursion.
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Acceleration structure.
+    #[arg(long, value_enum)]
+    accel: Option<AccelKind>,
+    /// Seed of the jittered pattern.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads (default: one per core).
+    #[arg(long)]
+    threads: Option<usize>,
 }
 
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {
-        Some(Command::Render(args)) => render(args),
+        Some(Command::Render { scene, output }) => render(scene, &output),
+        Some(Command::Trace { scene, trace: options, output }) => trace(scene, options, &output),
+        Some(Command::Compare { scene, trace, output, raster_out, trace_out, error_out }) => {
+            compare(scene, trace, &output, [raster_out, trace_out, error_out])
+        }
         None => {
-            // The interactive viewer takes this place once it exists.
             Cli::command().print_help().expect("writing help to stdout");
             Ok(())
         }
@@ -70,41 +132,84 @@ fn main() -> ExitCode {
     }
 }
 
-/// The scene named on the command line, or the built-in showcase.
-fn load_scene(path: Option<&Path>) -> anyhow::Result<Scene> {
-    Ok(match path {
-        Some(path) => Scene::load(path)?,
-        None => Scene::showcase()?,
-    })
-}
-
-/// The scene's settings with the command line's `--set` assignments applied, in order.
-fn settings(scene: &Scene, assignments: &[String]) -> anyhow::Result<RenderSettings> {
-    let mut settings = scene.settings.clone();
-    for assignment in assignments {
-        settings.set(assignment).context("--set")?;
-    }
-    Ok(settings)
-}
-
-fn render(args: RenderArgs) -> anyhow::Result<()> {
-    let extension = args.output.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+/// Every output must be a PNG; checked before any work is done.
+fn check_png(path: &Path) -> anyhow::Result<()> {
+    let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     if extension.as_deref() != Some("png") {
-        bail!("{}: the output must be a .png file", args.output.display());
+        bail!("{}: the output must be a .png file", path.display());
     }
-    let mut clock = Stopwatch::default();
-    let mut scene = clock.time("scene load", || load_scene(args.scene.as_deref()))?;
-    let settings = settings(&scene, &args.set)?;
-    scene.settings = settings.clone();
+    Ok(())
+}
+
+fn write_png(image: &image::RgbaImage, path: &Path) -> anyhow::Result<()> {
+    output::write_png_atomically(image, path).with_context(|| format!("{}: cannot write the image", path.display()))
+}
+
+/// Loads the scene (or the built-in showcase), applies `--set` and the size options.
+fn prepare(args: &SceneArgs, clock: &mut Stopwatch) -> anyhow::Result<Scene> {
+    let mut scene = clock.time("scene load", || match &args.scene {
+        Some(path) => Scene::load(path),
+        None => Scene::showcase(),
+    })?;
+    for assignment in &args.set {
+        scene.settings.set(assignment).context("--set")?;
+    }
     scene.camera.width = args.width.unwrap_or(scene.camera.width);
     scene.camera.height = args.height.unwrap_or(scene.camera.height);
     scene.camera.validate().context("--width/--height")?;
+    Ok(scene)
+}
 
+/// Applies the trace options over the scene's settings.
+fn apply_trace_args(settings: &mut RenderSettings, args: &TraceArgs) -> anyhow::Result<()> {
+    let trace = &mut settings.trace;
+    if let Some(aa) = args.aa {
+        trace.anti_aliasing = aa;
+    }
+    if let Some(spp) = args.spp {
+        let side = (spp as f64).sqrt().round() as u32;
+        if side * side != spp || side == 0 {
+            bail!("--spp {spp}: the rays per pixel form a square grid, so give a square number (1, 4, 9, 16, …)");
+        }
+        trace.samples = side;
+        if args.aa.is_none() && trace.anti_aliasing == AntiAliasing::Center && spp > 1 {
+            trace.anti_aliasing = AntiAliasing::Jittered;
+        }
+    }
+    if let Some(depth) = args.max_depth {
+        trace.max_depth = depth;
+    }
+    if let Some(accel) = args.accel {
+        trace.accelerator = accel;
+    }
+    if let Some(seed) = args.seed {
+        trace.seed = seed;
+    }
+    settings.validate().context("trace options")?;
+    Ok(())
+}
+
+fn render(args: SceneArgs, output_path: &Path) -> anyhow::Result<()> {
+    check_png(output_path)?;
+    let mut clock = Stopwatch::default();
+    let scene = prepare(&args, &mut clock)?;
+    let (image, adapter) = rasterize(&scene, &mut clock, args.stats)?;
+    clock.time("encode + write", || write_png(&image, output_path))?;
+    if args.stats {
+        println!("adapter: {adapter}");
+        print_scene(&scene);
+        println!("{}", clock.report());
+    }
+    Ok(())
+}
+
+/// The rasterizer's image of `scene` with its settings; returns it and the adapter's name.
+fn rasterize(scene: &Scene, clock: &mut Stopwatch, timed_frames: bool) -> anyhow::Result<(image::RgbaImage, String)> {
     let gpu = clock.time("device", Gpu::headless)?;
-    let renderer = clock.time("pipelines", || Renderer::new(&gpu.device, OUTPUT_FORMAT));
+    let mut renderer = clock.time("pipelines", || Renderer::new(&gpu.device, OUTPUT_FORMAT));
     let size = (scene.camera.width, scene.camera.height);
     let (scene_gpu, targets, output) = clock.time("upload", || {
-        let scene_gpu = renderer.upload(&gpu, &scene);
+        let scene_gpu = renderer.upload(&gpu, scene);
         let targets = renderer.targets(&gpu.device, size);
         let output = GpuTexture::target(&gpu.device, "cli::output", size, OUTPUT_FORMAT);
         gpu.wait();
@@ -114,30 +219,99 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     // an interactive frame costs. `--stats` reports both.
     for lap in ["first frame", "frame"] {
         clock.time(lap, || {
-            renderer.render(&gpu, &scene, &scene_gpu, &settings, &targets, &output.view);
+            renderer.render(&gpu, scene, &scene_gpu, &scene.settings, &targets, &output.view);
             gpu.wait();
         });
-        if !args.stats {
+        if !timed_frames {
             break;
         }
     }
     let pixels = clock.time("readback", || readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture));
     let image = image::RgbaImage::from_raw(size.0, size.1, pixels).expect("readback returns one RGBA8 texel per pixel");
-    clock
-        .time("encode + write", || output::write_png_atomically(&image, &args.output))
-        .with_context(|| format!("{}: cannot write the image", args.output.display()))?;
+    Ok((image, gpu.describe()))
+}
+
+/// The tracer's image of `scene` with its settings.
+fn ray_trace(
+    scene: &Scene,
+    threads: Option<usize>,
+    clock: &mut Stopwatch,
+    stats: bool,
+) -> anyhow::Result<image::RgbaImage> {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("--threads")?;
+    let tracer = clock.time("build", || Tracer::new(scene, &scene.settings));
+    let control = RenderControl { cancel: None, progress: true };
+    let (radiance, trace_stats) = clock.time("trace", || pool.install(|| tracer.render(&control)))?;
+    if stats {
+        println!("threads: {}", pool.current_num_threads());
+        println!("{}", tracer.accelerator_stats());
+        println!("{trace_stats}");
+    }
+    Ok(radiance.to_rgba8(scene.settings.exposure))
+}
+
+fn trace(args: SceneArgs, trace_args: TraceArgs, output_path: &Path) -> anyhow::Result<()> {
+    check_png(output_path)?;
+    let mut clock = Stopwatch::default();
+    let mut scene = prepare(&args, &mut clock)?;
+    apply_trace_args(&mut scene.settings, &trace_args)?;
     if args.stats {
-        println!("adapter: {}", gpu.describe());
-        let triangles: usize = scene.objects.iter().map(|o| scene.tessellate(o).triangle_count()).sum();
-        println!(
-            "scene: {} objects, {} triangles, {} lights, {}×{} pixels",
-            scene.objects.len(),
-            triangles,
-            scene.lights.len(),
-            size.0,
-            size.1
-        );
+        print_scene(&scene);
+    }
+    let image = ray_trace(&scene, trace_args.threads, &mut clock, args.stats)?;
+    clock.time("encode + write", || write_png(&image, output_path))?;
+    if args.stats {
         println!("{}", clock.report());
     }
     Ok(())
+}
+
+fn compare(
+    args: SceneArgs,
+    trace_args: TraceArgs,
+    sheet_path: &Path,
+    extra: [Option<PathBuf>; 3],
+) -> anyhow::Result<()> {
+    check_png(sheet_path)?;
+    for path in extra.iter().flatten() {
+        check_png(path)?;
+    }
+    let mut clock = Stopwatch::default();
+    let mut scene = prepare(&args, &mut clock)?;
+    apply_trace_args(&mut scene.settings, &trace_args)?;
+    let (raster, adapter) = rasterize(&scene, &mut clock, false)?;
+    let traced = ray_trace(&scene, trace_args.threads, &mut clock, args.stats)?;
+    let difference = mirador::compare::difference(&traced, &raster).expect("both images have the camera's size");
+    println!("adapter: {adapter}");
+    println!("FLIP mean: {:.5}", difference.flip_mean);
+    println!("PSNR: {:.2} dB", difference.psnr_db);
+    let panels = [
+        Panel::new("raster", raster.clone()),
+        Panel::new("ray traced", traced.clone()),
+        Panel::new(format!("FLIP {:.4}", difference.flip_mean), difference.error_map.clone()),
+    ];
+    let sheet_image = with_footer(&sheet(&panels), &flip_legend(scene.camera.width.clamp(200, 400)));
+    let [raster_out, trace_out, error_out] = extra;
+    for (image, path) in [(&raster, raster_out), (&traced, trace_out), (&difference.error_map, error_out)] {
+        if let Some(path) = path {
+            write_png(image, &path)?;
+        }
+    }
+    clock.time("encode + write", || write_png(&sheet_image, sheet_path))?;
+    if args.stats {
+        println!("{}", clock.report());
+    }
+    Ok(())
+}
+
+fn print_scene(scene: &Scene) {
+    let triangles: usize = scene.objects.iter().map(|o| scene.tessellate(o).triangle_count()).sum();
+    println!(
+        "scene: {} objects ({} raster triangles), {} lights, {}×{} pixels",
+        scene.objects.len(),
+        triangles,
+        scene.lights.len(),
+        scene.camera.width,
+        scene.camera.height
+    );
 }

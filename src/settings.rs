@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::scene::shading::Terms;
+use crate::trace::accel::AccelKind;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -15,6 +16,144 @@ pub struct RenderSettings {
     pub exposure: f32,
     /// Slices around a tessellated sphere (the rasterizer's; the tracer's spheres are exact).
     pub sphere_segments: u32,
+    /// Cast shadows: shadow rays in the tracer (shadow maps in the rasterizer are the shadows
+    /// issue's; until then the rasterizer draws none).
+    pub shadows: ShadowSettings,
+    /// The ray tracer's own settings.
+    pub trace: TraceSettings,
+}
+
+/// How the rasterizer finds cast shadows (TECHNIQUES.md §4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum ShadowMethod {
+    /// Image precision: the two-pass z-buffer algorithm (shadow maps).
+    Map,
+    /// Object precision: casters projected from the light onto planar receivers and clipped to
+    /// them (seed 000's brute force), drawn as detail polygons.
+    Projected,
+}
+
+/// How a shadow map is filtered where a receiver looks it up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum ShadowFilter {
+    /// One comparison with the nearest texel: hard, aliased edges.
+    None,
+    /// The hardware's 2×2 comparison with bilinear weights (4 taps).
+    Hardware,
+    /// 3×3 hardware taps.
+    Pcf3x3,
+    /// 5×5 hardware taps.
+    Pcf5x5,
+    /// 16 hardware taps on a Poisson disc of radius 2.5 texels.
+    Poisson,
+}
+
+/// What the teaching view shows instead of, or over, the shaded image.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum ShadowView {
+    Off,
+    /// The shadow map of `view_layer` as grey levels, near black and far white.
+    Map,
+    /// A checker of the map's texels as they land on the receivers.
+    Texels,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ShadowSettings {
+    pub enabled: bool,
+    pub method: ShadowMethod,
+    /// Side of each shadow map in texels (256 to 4096).
+    pub map_size: u32,
+    pub filter: ShadowFilter,
+    /// Constant depth bias, in the depth buffer's smallest steps (acne cure; too much detaches
+    /// shadows from their casters: peter-panning).
+    pub depth_bias: i32,
+    /// Depth bias proportional to the surface's depth slope as the light sees it.
+    pub slope_bias: f32,
+    /// The receiver's lookup point is pushed along its normal by this many shadow-map texels.
+    pub normal_offset: f32,
+    /// How far from the eye a directional light's map reaches, in scene units (0: four times the
+    /// distance from the eye to the view centre, at most the far plane).
+    pub distance: f32,
+    /// Transparent occluders (kt > 0) cast coloured, partial shadows.
+    pub transmission: bool,
+    pub view: ShadowView,
+    /// Which map layer the `map` view shows (a point light has six).
+    pub view_layer: u32,
+    /// Draw each shadowed light's frustum into the scene.
+    pub show_frusta: bool,
+}
+
+impl Default for ShadowSettings {
+    fn default() -> Self {
+        ShadowSettings {
+            enabled: true,
+            method: ShadowMethod::Map,
+            map_size: 2048,
+            filter: ShadowFilter::Pcf3x3,
+            depth_bias: 4,
+            slope_bias: 1.5,
+            normal_offset: 1.0,
+            distance: 0.0,
+            transmission: true,
+            view: ShadowView::Off,
+            view_layer: 0,
+            show_frusta: false,
+        }
+    }
+}
+
+/// How the ray tracer samples pixels (seeds 003 and 004).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum AntiAliasing {
+    /// One ray through each pixel centre: pixel-aligned with the rasterizer.
+    Center,
+    /// `samples × samples` rays on a regular sub-pixel grid.
+    Regular,
+    /// `samples × samples` strata, one seeded random ray in each.
+    Jittered,
+    /// Rays through the pixel corners, each shared by the four pixels that meet there:
+    /// `(width + 1)(height + 1)` rays.
+    Corners,
+    /// Whitted's adaptive subdivision: corner rays, and a square split in four while its corners
+    /// differ by more than `adaptive_threshold`, down to `adaptive_max_level`.
+    Adaptive,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TraceSettings {
+    /// Deepest recursion: primary rays are depth 0; reflected and refracted rays add one.
+    pub max_depth: u32,
+    pub anti_aliasing: AntiAliasing,
+    /// Rays per pixel side for `regular` and `jittered` (`samples²` rays a pixel).
+    pub samples: u32,
+    /// Seed of the jittered pattern: the same seed gives the same image.
+    pub seed: u64,
+    /// Largest per-channel difference, in output values (0–1), between a square's corners that
+    /// adaptive subdivision leaves unsplit.
+    pub adaptive_threshold: f32,
+    pub adaptive_max_level: u32,
+    pub accelerator: AccelKind,
+}
+
+impl Default for TraceSettings {
+    fn default() -> Self {
+        TraceSettings {
+            max_depth: 5,
+            anti_aliasing: AntiAliasing::Center,
+            samples: 2,
+            seed: 0,
+            adaptive_threshold: 0.1,
+            adaptive_max_level: 3,
+            accelerator: AccelKind::Bvh,
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -40,7 +179,13 @@ impl From<TermSettings> for Terms {
 
 impl Default for RenderSettings {
     fn default() -> Self {
-        RenderSettings { terms: TermSettings::default(), exposure: 1.0, sphere_segments: 96 }
+        RenderSettings {
+            terms: TermSettings::default(),
+            exposure: 1.0,
+            sphere_segments: 96,
+            shadows: ShadowSettings::default(),
+            trace: TraceSettings::default(),
+        }
     }
 }
 
@@ -94,6 +239,46 @@ impl RenderSettings {
             return Err(SettingsError::Invalid(format!(
                 "sphere_segments must lie in 3..=4096, got {}",
                 self.sphere_segments
+            )));
+        }
+        let shadows = &self.shadows;
+        if !(256..=4096).contains(&shadows.map_size) {
+            return Err(SettingsError::Invalid(format!(
+                "shadows.map_size must lie in 256..=4096, got {}",
+                shadows.map_size
+            )));
+        }
+        let finite_non_negative = [
+            ("shadows.slope_bias", shadows.slope_bias),
+            ("shadows.normal_offset", shadows.normal_offset),
+            ("shadows.distance", shadows.distance),
+        ];
+        if let Some((name, value)) = finite_non_negative.iter().find(|(_, v)| !(v.is_finite() && *v >= 0.0)) {
+            return Err(SettingsError::Invalid(format!("{name} must be a finite number ≥ 0, got {value}")));
+        }
+        if !(0..=10_000).contains(&shadows.depth_bias) {
+            return Err(SettingsError::Invalid(format!(
+                "shadows.depth_bias must lie in 0..=10000, got {}",
+                shadows.depth_bias
+            )));
+        }
+        let trace = &self.trace;
+        if !(1..=16).contains(&trace.samples) {
+            return Err(SettingsError::Invalid(format!("trace.samples must lie in 1..=16, got {}", trace.samples)));
+        }
+        if trace.max_depth > 64 {
+            return Err(SettingsError::Invalid(format!("trace.max_depth must be at most 64, got {}", trace.max_depth)));
+        }
+        if !(trace.adaptive_threshold.is_finite() && trace.adaptive_threshold >= 0.0) {
+            return Err(SettingsError::Invalid(format!(
+                "trace.adaptive_threshold must be ≥ 0, got {}",
+                trace.adaptive_threshold
+            )));
+        }
+        if trace.adaptive_max_level > 6 {
+            return Err(SettingsError::Invalid(format!(
+                "trace.adaptive_max_level must be at most 6, got {}",
+                trace.adaptive_max_level
             )));
         }
         Ok(())

@@ -5,10 +5,14 @@
 pub const COMMON: &[(&str, &str)] = &[
     ("common/types.wgsl", include_str!("../shaders/common/types.wgsl")),
     ("common/lighting.wgsl", include_str!("../shaders/common/lighting.wgsl")),
+    ("common/bump.wgsl", include_str!("../shaders/common/bump.wgsl")),
+    ("common/shadow.wgsl", include_str!("../shaders/common/shadow.wgsl")),
 ];
 
 pub const OPAQUE: &str = include_str!("../shaders/opaque.wgsl");
 pub const PRESENT: &str = include_str!("../shaders/present.wgsl");
+pub const SHADOW: &str = include_str!("../shaders/shadow.wgsl");
+pub const SHADOW_PROJECTED: &str = include_str!("../shaders/shadow_projected.wgsl");
 
 /// The full source of a pass: the common files, then the pass's own.
 pub fn compose(pass: &str) -> String {

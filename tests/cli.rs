@@ -128,3 +128,66 @@ fn no_arguments_print_help() {
     assert!(output.status.success());
     assert!(String::from_utf8_lossy(&output.stdout).contains("render"));
 }
+
+#[test]
+fn trace_writes_the_ray_traced_image_and_reports_rays() {
+    let dir = scratch("trace");
+    let out = dir.join("rt.png");
+    let output = mirador(&[
+        "trace",
+        &asset("scenes/seed-simple.toml"),
+        "-o",
+        out.to_str().unwrap(),
+        "--stats",
+        "--spp",
+        "4",
+        "--threads",
+        "1",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    assert_eq!(image::open(&out).unwrap().into_rgba8().dimensions(), (230, 230));
+    let stats = String::from_utf8_lossy(&output.stdout);
+    for word in ["bvh", "primary", "shadow", "Mrays/s", "threads: 1"] {
+        assert!(stats.contains(word), "--stats should report `{word}`: {stats}");
+    }
+    // 4 jittered rays per pixel.
+    assert!(stats.contains(&format!("{} primary", 230 * 230 * 4)), "{stats}");
+}
+
+#[test]
+fn trace_rejects_a_sample_count_that_is_not_a_square() {
+    let dir = scratch("spp");
+    let out = dir.join("rt.png");
+    let output = mirador(&["trace", &asset("scenes/seed-simple.toml"), "-o", out.to_str().unwrap(), "--spp", "3"]);
+    assert_fails_cleanly(&output, &["--spp 3", "square"], &dir);
+}
+
+#[test]
+fn compare_writes_a_sheet_and_prints_the_metrics() {
+    let dir = scratch("compare");
+    let sheet = dir.join("sheet.png");
+    let traced = dir.join("traced.png");
+    let output = mirador(&[
+        "compare",
+        &asset("scenes/seed-simple.toml"),
+        "-o",
+        sheet.to_str().unwrap(),
+        "--trace-out",
+        traced.to_str().unwrap(),
+        "--set",
+        "shadows.enabled=false",
+    ]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let flip: f32 = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("FLIP mean: "))
+        .unwrap_or_else(|| panic!("no FLIP line in {stdout}"))
+        .parse()
+        .unwrap();
+    assert!(flip < 0.01, "seed-simple without shadows agrees closely, got {flip}");
+    assert!(stdout.lines().any(|l| l.starts_with("PSNR: ") && l.ends_with(" dB")), "{stdout}");
+    let sheet = image::open(&sheet).unwrap().into_rgba8();
+    assert!(sheet.width() > 3 * 230 && sheet.height() > 230, "three panels side by side: {:?}", sheet.dimensions());
+    assert_eq!(image::open(&traced).unwrap().into_rgba8().dimensions(), (230, 230));
+}

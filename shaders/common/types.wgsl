@@ -26,9 +26,12 @@ struct Light {
     radiance: vec3f,
     cos_inner: f32,
     cos_outer: f32,
+    // First shadow-map layer of this light, −1 when it casts no shadows.
+    shadow_layer: i32,
+    // Which of the (at most four) shadowed lights this is: its channel in the projected-shadow
+    // mask; −1 when it casts no shadows.
+    shadow_slot: i32,
     _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
 }
 
 // Group 0: changes once per frame.
@@ -54,8 +57,12 @@ struct Material {
     ks: f32,
     shininess: f32,
     specular_color: vec3f,
-    _pad0: f32,
+    // 1 when kt > 0: drawn into the transmission maps instead of the depth maps.
+    transparent: u32,
     emission: vec3f,
+    _pad0: f32,
+    // kt·MT: what a transparent surface lets through.
+    transmission: vec3f,
     _pad1: f32,
 }
 

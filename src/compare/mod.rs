@@ -2,6 +2,8 @@
 //! PSNR, and a false-colour error map. Used by the golden-image tests and, with the ray tracer,
 //! by `mirador compare`.
 
+pub mod sheet;
+
 use image::RgbaImage;
 
 /// How two images of the same size differ.

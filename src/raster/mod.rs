@@ -2,24 +2,30 @@
 //! name in `shaders/`); [`Renderer::render`] records them in order, top to bottom:
 //!
 //! ```text
-//! opaque (z-buffer + illumination model) → present (output transform to sRGB)
+//! shadow maps (pass 1 of §4)  ─┐
+//! or projected shadow polygons ┴→ opaque (z-buffer + illumination model + pass 2 of §4)
+//!                                 → teaching views → present (output transform to sRGB)
 //! ```
 //!
-//! Later techniques slot in where DESIGN.md puts them: shadow maps, environment captures and
-//! mirror views before `opaque`; the sky and sorted transparent surfaces after it.
+//! Later techniques slot in where DESIGN.md puts them: environment captures and mirror views
+//! before `opaque`; the sky and sorted transparent surfaces after it.
 
 pub mod opaque;
 pub mod present;
 pub mod scene_gpu;
+pub mod shadow;
 pub mod uniforms;
 
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::{Gpu, readback};
 use crate::scene::Scene;
-use crate::settings::RenderSettings;
+use crate::settings::{RenderSettings, ShadowMethod};
 use opaque::{OpaquePass, OpaqueTargets};
 use present::PresentPass;
 use scene_gpu::{SceneGpu, SceneLayouts};
+use shadow::ShadowPass;
+use shadow::projected::{MASK_FORMAT, ProjectedPass, projected_shadows};
+use shadow::views::shadow_layout;
 
 /// Linear radiance, before the output transform.
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -30,8 +36,13 @@ pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSr
 /// The passes, built once per device and output format.
 pub struct Renderer {
     pub layouts: SceneLayouts,
+    pub shadow: ShadowPass,
+    projected: ProjectedPass,
     opaque: OpaquePass,
     present: PresentPass,
+    /// The opaque pass's shadow inputs, and the (shadow targets, frame targets) generations they
+    /// were made for.
+    shadow_inputs: Option<((u64, u64), wgpu::BindGroup)>,
 }
 
 /// The intermediate images of a frame, recreated when the output size changes.
@@ -39,15 +50,25 @@ pub struct FrameTargets {
     pub size: (u32, u32),
     pub hdr: GpuTexture,
     pub depth: GpuTexture,
+    /// Object-precision shadows: one channel per shadowed light.
+    pub shadow_mask: GpuTexture,
     present_input: wgpu::BindGroup,
+    generation: u64,
 }
 
 impl Renderer {
     pub fn new(device: &wgpu::Device, output_format: wgpu::TextureFormat) -> Renderer {
         let layouts = SceneLayouts::new(device);
-        let opaque = OpaquePass::new(device, &layouts);
-        let present = PresentPass::new(device, output_format);
-        Renderer { layouts, opaque, present }
+        let shadow = ShadowPass::new(device, &layouts);
+        let opaque = OpaquePass::new(device, &layouts, &shadow.input_layout);
+        Renderer {
+            projected: ProjectedPass::new(device),
+            present: PresentPass::new(device, output_format),
+            layouts,
+            shadow,
+            opaque,
+            shadow_inputs: None,
+        }
     }
 
     pub fn upload(&self, gpu: &Gpu, scene: &Scene) -> SceneGpu {
@@ -55,15 +76,18 @@ impl Renderer {
     }
 
     pub fn targets(&self, device: &wgpu::Device, size: (u32, u32)) -> FrameTargets {
+        static GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
         let hdr = GpuTexture::target(device, "frame::hdr", size, HDR_FORMAT);
         let depth = GpuTexture::target(device, "frame::depth", size, DEPTH_FORMAT);
+        let shadow_mask = GpuTexture::target(device, "frame::shadow_mask", size, MASK_FORMAT);
         let present_input = self.present.bind(device, &hdr.view);
-        FrameTargets { size, hdr, depth, present_input }
+        let generation = GENERATION.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        FrameTargets { size, hdr, depth, shadow_mask, present_input, generation }
     }
 
     /// Records and submits one frame of `scene` into `output`, whose size must match `targets`.
     pub fn render(
-        &self,
+        &mut self,
         gpu: &Gpu,
         scene: &Scene,
         scene_gpu: &SceneGpu,
@@ -71,16 +95,56 @@ impl Renderer {
         targets: &FrameTargets,
         output: &wgpu::TextureView,
     ) {
-        scene_gpu.update_frame(gpu, scene, settings);
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let shadows = &settings.shadows;
+        let layout = shadow_layout(scene, shadows);
+        scene_gpu.update_frame(gpu, scene, &layout.first_layer, settings);
+        self.shadow.prepare(device, queue, &layout, shadows, scene_gpu.has_transparent());
+        let key = (self.shadow.generation, targets.generation);
+        if self.shadow_inputs.as_ref().is_none_or(|(k, _)| *k != key) {
+            self.shadow_inputs = Some((key, self.shadow.inputs(device, &targets.shadow_mask.view)));
+        }
+        let (_, shadow_inputs) = self.shadow_inputs.as_ref().expect("made just above");
+
         let mut encoder =
-            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame::encoder") });
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame::encoder") });
+        let projected = shadows.enabled && shadows.method == ShadowMethod::Projected;
+        if projected {
+            let polygons = projected_shadows(scene, &layout);
+            self.opaque.record_prepass(&mut encoder, scene_gpu, shadow_inputs, &targets.depth.view);
+            let clip_from_world = scene.camera.clip_from_world();
+            self.projected.record(
+                device,
+                queue,
+                &mut encoder,
+                &polygons,
+                clip_from_world,
+                &targets.shadow_mask.view,
+                &targets.depth.view,
+            );
+        } else {
+            self.shadow.record(&mut encoder, scene_gpu, &layout);
+        }
         self.opaque.record(
             &mut encoder,
             scene_gpu,
+            shadow_inputs,
             &OpaqueTargets { hdr: &targets.hdr.view, depth: &targets.depth.view, background: scene.background },
+            projected,
         );
-        self.present.record(&gpu.queue, &mut encoder, &targets.present_input, output, settings.exposure);
-        gpu.queue.submit([encoder.finish()]);
+        self.shadow.record_views(
+            device,
+            queue,
+            &mut encoder,
+            shadows,
+            &layout,
+            scene.camera.clip_from_world(),
+            &targets.hdr.view,
+            &targets.depth.view,
+            targets.size,
+        );
+        self.present.record(queue, &mut encoder, &targets.present_input, output, settings.exposure);
+        queue.submit([encoder.finish()]);
     }
 }
 
@@ -103,7 +167,7 @@ impl Headless {
         Headless { renderer, scene_gpu, targets, output }
     }
 
-    pub fn render(&self, gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> image::RgbaImage {
+    pub fn render(&mut self, gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> image::RgbaImage {
         self.renderer.render(gpu, scene, &self.scene_gpu, settings, &self.targets, &self.output.view);
         let (width, height) = self.targets.size;
         let pixels = readback::read_rgba8(&gpu.device, &gpu.queue, &self.output.texture);

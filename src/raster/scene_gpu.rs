@@ -66,11 +66,6 @@ impl SceneLayouts {
         });
         SceneLayouts { frame, material, object }
     }
-
-    /// In bind-group order, for pipeline layouts.
-    pub fn all(&self) -> [Option<&wgpu::BindGroupLayout>; 3] {
-        [Some(&self.frame), Some(&self.material), Some(&self.object)]
-    }
 }
 
 /// One drawable: an object's geometry with its material and transform bind groups.
@@ -80,6 +75,8 @@ pub struct Drawable {
     pub indices: wgpu::Buffer,
     pub index_count: u32,
     pub material: usize,
+    /// Its material lets light through (kt > 0): it tints shadows rather than casting them.
+    pub transparent: bool,
     pub object: wgpu::BindGroup,
 }
 
@@ -103,7 +100,7 @@ impl SceneGpu {
         let frame = UniformBuffer::new(
             device,
             "scene::frame",
-            &GpuFrame::new(&scene.camera, scene.ambient, &scene.lights, &scene.settings),
+            &GpuFrame::new(&scene.camera, scene.ambient, &scene.lights, &[], &scene.settings),
         );
         let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene::frame_group"),
@@ -169,6 +166,7 @@ impl SceneGpu {
                     indices,
                     index_count: mesh.indices.len() as u32,
                     material: object.material.0,
+                    transparent: scene.materials[object.material.0].is_transparent(),
                     object: object_group,
                 }
             })
@@ -176,9 +174,14 @@ impl SceneGpu {
         SceneGpu { frame, frame_group, materials, drawables }
     }
 
-    /// Rewrites the per-frame uniform: camera, lights and toggles.
-    pub fn update_frame(&self, gpu: &Gpu, scene: &Scene, settings: &RenderSettings) {
-        self.frame.write(&gpu.queue, &GpuFrame::new(&scene.camera, scene.ambient, &scene.lights, settings));
+    /// Rewrites the per-frame uniform: camera, lights, their shadow layers, and toggles.
+    pub fn update_frame(&self, gpu: &Gpu, scene: &Scene, shadow_layers: &[Option<u32>], settings: &RenderSettings) {
+        self.frame
+            .write(&gpu.queue, &GpuFrame::new(&scene.camera, scene.ambient, &scene.lights, shadow_layers, settings));
+    }
+
+    pub fn has_transparent(&self) -> bool {
+        self.drawables.iter().any(|d| d.transparent)
     }
 }
 

@@ -20,7 +20,9 @@ pub struct GpuLight {
     pub radiance: [f32; 3],
     pub cos_inner: f32,
     pub cos_outer: f32,
-    pub _pad: [f32; 3],
+    pub shadow_layer: i32,
+    pub shadow_slot: i32,
+    pub _pad: f32,
 }
 
 impl Light {
@@ -41,7 +43,9 @@ impl Light {
             radiance: (self.color * self.intensity).to_array(),
             cos_inner,
             cos_outer,
-            _pad: [0.0; 3],
+            shadow_layer: -1,
+            shadow_slot: -1,
+            _pad: 0.0,
         }
     }
 }
@@ -61,10 +65,23 @@ pub struct GpuFrame {
 
 impl GpuFrame {
     /// The per-frame uniform. Lights past [`MAX_LIGHTS`] are dropped (the loader warns).
-    pub fn new(camera: &Camera, ambient: Vec3, lights: &[Light], settings: &RenderSettings) -> GpuFrame {
+    /// `shadow_layers[i]` is light `i`'s first shadow-map layer, if it casts shadows.
+    pub fn new(
+        camera: &Camera,
+        ambient: Vec3,
+        lights: &[Light],
+        shadow_layers: &[Option<u32>],
+        settings: &RenderSettings,
+    ) -> GpuFrame {
         let mut gpu_lights = [GpuLight::zeroed(); MAX_LIGHTS];
-        for (slot, light) in gpu_lights.iter_mut().zip(lights) {
-            *slot = light.to_gpu();
+        let mut slots = 0;
+        for (i, (gpu, light)) in gpu_lights.iter_mut().zip(lights).enumerate() {
+            *gpu = light.to_gpu();
+            if let Some(layer) = shadow_layers.get(i).copied().flatten() {
+                gpu.shadow_layer = layer as i32;
+                gpu.shadow_slot = slots;
+                slots += 1;
+            }
         }
         let t = settings.terms;
         let terms =
@@ -92,8 +109,10 @@ pub struct GpuMaterial {
     pub ks: f32,
     pub shininess: f32,
     pub specular_color: [f32; 3],
-    pub _pad0: f32,
+    pub transparent: u32,
     pub emission: [f32; 3],
+    pub _pad0: f32,
+    pub transmission: [f32; 3],
     pub _pad1: f32,
 }
 
@@ -107,8 +126,10 @@ impl Material {
             ks: self.ks,
             shininess: self.shininess,
             specular_color: self.specular_color.to_array(),
-            _pad0: 0.0,
+            transparent: u32::from(self.is_transparent()),
             emission: self.emission.to_array(),
+            _pad0: 0.0,
+            transmission: (self.transmission * self.transmission_color).to_array(),
             _pad1: 0.0,
         }
     }
@@ -150,11 +171,9 @@ impl Vertex {
     pub const ATTRIBUTES: [wgpu::VertexAttribute; 3] =
         wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
 
-    pub fn layout() -> wgpu::VertexBufferLayout<'static> {
-        wgpu::VertexBufferLayout {
-            array_stride: std::mem::size_of::<Vertex>() as u64,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &Self::ATTRIBUTES,
-        }
-    }
+    pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &Self::ATTRIBUTES,
+    };
 }

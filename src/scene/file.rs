@@ -177,8 +177,7 @@ struct SceneFile {
     camera: Option<Spanned<CameraDesc>>,
     #[serde(default)]
     world: WorldDesc,
-    #[serde(default)]
-    settings: RenderSettings,
+    settings: Option<Spanned<RenderSettings>>,
     #[serde(default)]
     materials: std::collections::BTreeMap<String, Spanned<MaterialDesc>>,
     #[serde(default)]
@@ -261,6 +260,20 @@ enum ObjectType {
     Torus,
     RoundedBox,
     Gltf,
+}
+
+impl ObjectType {
+    /// The name the file uses for this type, for messages.
+    fn name(self) -> &'static str {
+        match self {
+            ObjectType::Sphere => "sphere",
+            ObjectType::Box => "box",
+            ObjectType::Plane => "plane",
+            ObjectType::Torus => "torus",
+            ObjectType::RoundedBox => "rounded_box",
+            ObjectType::Gltf => "gltf",
+        }
+    }
 }
 
 #[derive(Deserialize)]
@@ -349,10 +362,10 @@ impl<'a> Builder<'a> {
     }
 
     fn build(&mut self, file: SceneFile) -> Result<Scene, SceneError> {
-        self.scene.settings = file.settings;
-        if let Err(e) = self.scene.settings.validate() {
-            let span = self.text.find("[settings]").map(|s| s..s + 1);
-            return Err(Located::new(format!("[settings]: {e}"), span).at(self.path, self.text));
+        if let Some(settings) = file.settings {
+            let span = settings.span();
+            settings.get_ref().validate().map_err(|e| self.error(format!("[settings]: {e}"), span))?;
+            self.scene.settings = settings.into_inner();
         }
         self.scene.ambient = file.world.ambient.map_or(Vec3::splat(0.1), |Rgb(c)| c);
         self.scene.background = file.world.background.map_or(Vec3::ZERO, |Rgb(c)| c);
@@ -369,22 +382,32 @@ impl<'a> Builder<'a> {
                 gltf_camera.get_or_insert((camera, span));
             }
         }
-        self.scene.camera = match (file.camera, gltf_camera) {
-            (Some(desc), None) => {
+        let table_camera = match file.camera {
+            Some(desc) => {
                 let span = desc.span();
                 let camera = camera_from(desc.into_inner());
                 camera.validate().map_err(|e| self.error(format!("[camera]: {e}"), span))?;
-                camera
+                Some(camera)
             }
-            (camera_table, Some((gltf, span))) => {
-                let (width, height) = camera_table
-                    .map(|c| (c.get_ref().width.unwrap_or(1280), c.get_ref().height.unwrap_or(720)))
-                    .unwrap_or((1280, 720));
+            None => None,
+        };
+        self.scene.camera = match (table_camera, gltf_camera) {
+            (Some(camera), None) => camera,
+            // A model's camera takes the view; the [camera] table still sets the image size.
+            (table, Some((gltf, span))) => {
+                let (width, height) = table.map_or((1280, 720), |c| (c.width, c.height));
                 let camera = camera_from_gltf(&gltf, width, height);
                 camera.validate().map_err(|e| self.error(format!("glTF camera `{}`: {e}", gltf.name), span))?;
                 camera
             }
-            (None, None) => frame_scene(&self.scene),
+            (None, None) => {
+                let camera = frame_scene(&self.scene);
+                camera.validate().map_err(|e| SceneError::Invalid {
+                    path: self.path.into(),
+                    message: format!("the camera framing the scene (the file has no [camera]): {e}"),
+                })?;
+                camera
+            }
         };
         Ok(std::mem::replace(&mut self.scene, empty_scene(self.path)))
     }
@@ -492,7 +515,7 @@ impl<'a> Builder<'a> {
     /// Adds one `[[objects]]` entry; a glTF model may bring a camera, returned for the caller.
     fn object(&mut self, d: ObjectDesc, span: Range<usize>) -> Result<Option<GltfCamera>, SceneError> {
         let fail = |message: String| self.error(message, span.clone());
-        let kind_name = format!("{:?}", d.kind).to_lowercase();
+        let kind_name = d.kind.name();
         let fields: [(&str, bool); 13] = [
             ("major_radius", d.major_radius.is_some()),
             ("minor_radius", d.minor_radius.is_some()),
@@ -556,7 +579,7 @@ impl<'a> Builder<'a> {
             }
             ObjectType::Gltf => {
                 let relative = d.path.ok_or_else(|| fail("a gltf object needs a `path`".into()))?;
-                let import = super::gltf::import(&self.dir.join(relative))?;
+                let import = super::gltf::import(&self.dir.join(relative)).map_err(|e| fail(e.to_string()))?;
                 let camera = d.camera.unwrap_or(false).then(|| import.cameras.first().cloned()).flatten();
                 self.add_gltf(import, world_from_local, d.lights.unwrap_or(true), &name);
                 return Ok(
@@ -565,6 +588,10 @@ impl<'a> Builder<'a> {
             }
         };
         let material = match d.material {
+            // `default` names the implicit default material, defined or not.
+            Some(m) if m.get_ref() == "default" && !self.material_ids.contains_key("default") => {
+                self.default_material()
+            }
             Some(m) => {
                 let span = m.span();
                 *self.material_ids.get(m.get_ref()).ok_or_else(|| {

@@ -63,6 +63,13 @@ pub struct Material {
     pub bump_scale: f32,
 }
 
+impl Material {
+    /// Whether light passes through (kt > 0): such surfaces tint shadows instead of blocking them.
+    pub fn is_transparent(&self) -> bool {
+        self.transmission > 0.0
+    }
+}
+
 impl Default for Material {
     fn default() -> Self {
         Material {

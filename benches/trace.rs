@@ -1,0 +1,364 @@
+//! BVH benchmark: Mirador's BVH against the `bvh` (0.13) and `obvhs` (0.4) crates.
+//!
+//! Scene: a displaced UV sphere of 1024 × 512 quads (1 046 528 triangles after the pole fans).
+//! Rays: 512 × 512 primary rays from a pinhole camera that sees the whole sphere, and one shadow
+//! ray toward a point light from every primary hit (the same rays, from Mirador's hits, for
+//! every library). Each throughput is the best of [`REPEATS`] passes, on one thread and on all
+//! of rayon's threads; builds are single-threaded for all three (obvhs without its `parallel`
+//! feature, `bvh` with `Bvh::build`). Run with `cargo bench --bench trace`; it takes about a
+//! minute on two cores.
+//!
+//! The peers use their own idioms: obvhs its two-sided Möller–Trumbore `Triangle::intersect`
+//! with the triangles reordered into leaf order (as its examples recommend) and its
+//! `medium_build` preset, for its binary BVH (Bvh2) and its 8-wide compressed BVH (CWBVH);
+//! `bvh` its distance-ordered iterator (stopping once the next leaf starts beyond the nearest
+//! hit) with the same two-sided Möller–Trumbore test, since its own triangle test culls back
+//! faces. Mirador uses its watertight test (Woop et al.), which does a little more work per
+//! triangle.
+
+use std::time::{Duration, Instant};
+
+use glam::{Vec2, Vec3, Vec3A};
+use mirador::scene::{MaterialId, Ray};
+use mirador::trace::accel::Accelerator;
+use mirador::trace::accel::bvh::Bvh;
+use mirador::trace::geometry::{Primitive, Triangle};
+use rayon::prelude::*;
+
+const SLICES: u32 = 1024;
+const STACKS: u32 = 512;
+const WIDTH: u32 = 512;
+const HEIGHT: u32 = 512;
+const REPEATS: usize = 3;
+const SHADOW_T_MIN: f32 = 1e-4;
+
+/// A ray as every library is handed it.
+#[derive(Clone, Copy)]
+struct Query {
+    origin: Vec3,
+    direction: Vec3,
+    t_min: f32,
+    t_max: f32,
+}
+
+/// A sphere with bumps of ±4 %: sums of sines in longitude and latitude.
+fn displaced_sphere() -> Vec<[Vec3; 3]> {
+    let point = |i: u32, j: u32| {
+        let (theta, phi) =
+            (std::f32::consts::PI * j as f32 / STACKS as f32, std::f32::consts::TAU * i as f32 / SLICES as f32);
+        let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+        let bumps =
+            0.025 * (7.0 * phi).sin() * (5.0 * theta).sin() + 0.015 * (23.0 * phi + 3.0).sin() * (19.0 * theta).cos();
+        n * (1.0 + bumps * theta.sin())
+    };
+    let mut tris = Vec::with_capacity((2 * SLICES * STACKS) as usize);
+    for j in 0..STACKS {
+        for i in 0..SLICES {
+            // The seam's vertices are the same points (index i wraps), so the mesh is closed.
+            let (a, b, c, d) =
+                (point(i, j), point((i + 1) % SLICES, j), point(i, j + 1), point((i + 1) % SLICES, j + 1));
+            if j != 0 {
+                tris.push([a, c, b]);
+            }
+            if j != STACKS - 1 {
+                tris.push([b, c, d]);
+            }
+        }
+    }
+    tris
+}
+
+fn primary_rays() -> Vec<Query> {
+    let eye = Vec3::new(0.4, 0.8, 3.2);
+    let forward = (Vec3::ZERO - eye).normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    let half = (22.0f32).to_radians().tan();
+    (0..WIDTH * HEIGHT)
+        .map(|k| {
+            let (x, y) = ((k % WIDTH) as f32 + 0.5, (k / WIDTH) as f32 + 0.5);
+            let s = (2.0 * x / WIDTH as f32 - 1.0) * half;
+            let t = (1.0 - 2.0 * y / HEIGHT as f32) * half;
+            Query {
+                origin: eye,
+                direction: (forward + s * right + t * up).normalize(),
+                t_min: 0.0,
+                t_max: f32::INFINITY,
+            }
+        })
+        .collect()
+}
+
+/// The best of [`REPEATS`] timed passes of `run`, which returns a count to check.
+fn best_of(run: impl Fn() -> usize) -> (Duration, usize) {
+    let repeats: usize = std::env::var("BENCH_REPEATS").ok().and_then(|v| v.parse().ok()).unwrap_or(REPEATS);
+    (0..repeats)
+        .map(|_| {
+            let start = Instant::now();
+            let count = run();
+            (start.elapsed(), count)
+        })
+        .min_by_key(|(time, _)| *time)
+        .expect("at least one pass")
+}
+
+/// Rays per second through `hit` on one thread and on all threads, and how many hit.
+struct Throughput {
+    single: f64,
+    parallel: f64,
+    hits: usize,
+}
+
+fn throughput(queries: &[Query], hit: impl Fn(&Query) -> bool + Sync) -> Throughput {
+    // Warm-up: caches, page faults, rayon's threads.
+    let _ = queries.par_iter().take(20_000).filter(|q| hit(q)).count();
+    let (single_time, hits) = best_of(|| queries.iter().filter(|q| hit(q)).count());
+    let (parallel_time, _) = best_of(|| queries.par_chunks(256).map(|c| c.iter().filter(|q| hit(q)).count()).sum());
+    let rate = |t: Duration| queries.len() as f64 / t.as_secs_f64();
+    Throughput { single: rate(single_time), parallel: rate(parallel_time), hits }
+}
+
+struct Row {
+    name: &'static str,
+    build: Duration,
+    primary: Throughput,
+    shadow: Throughput,
+}
+
+/// Two-sided Möller–Trumbore, as obvhs writes it, for the `bvh` crate's shapes.
+fn moller_trumbore(v: &[Vec3A; 3], origin: Vec3A, direction: Vec3A, t_min: f32, t_max: f32) -> Option<f32> {
+    let e1 = v[0] - v[1];
+    let e2 = v[2] - v[0];
+    let n = e1.cross(e2);
+    let c = v[0] - origin;
+    let r = direction.cross(c);
+    let inv_det = 1.0 / n.dot(direction);
+    let u = r.dot(e2) * inv_det;
+    let w = r.dot(e1) * inv_det;
+    let valid = inv_det != 0.0 && u >= 0.0 && w >= 0.0 && u + w <= 1.0;
+    let t = n.dot(c) * inv_det;
+    (valid && t > t_min && t < t_max).then_some(t)
+}
+
+struct BvhShape {
+    v: [Vec3A; 3],
+    node: usize,
+}
+
+impl bvh::aabb::Bounded<f32, 3> for BvhShape {
+    fn aabb(&self) -> bvh::aabb::Aabb<f32, 3> {
+        let (lo, hi) = (self.v[0].min(self.v[1]).min(self.v[2]), self.v[0].max(self.v[1]).max(self.v[2]));
+        bvh::aabb::Aabb::with_bounds(lo.to_array().into(), hi.to_array().into())
+    }
+}
+
+impl bvh::bounding_hierarchy::BHShape<f32, 3> for BvhShape {
+    fn set_bh_node_index(&mut self, index: usize) {
+        self.node = index;
+    }
+
+    fn bh_node_index(&self) -> usize {
+        self.node
+    }
+}
+
+fn mirador_row(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Row {
+    let prims: Vec<Primitive> = tris
+        .iter()
+        .map(|&positions| {
+            let n = (positions[1] - positions[0]).cross(positions[2] - positions[0]).normalize_or_zero();
+            Primitive::Triangle(Triangle {
+                positions,
+                normals: [n; 3],
+                uvs: [Vec2::ZERO; 3],
+                object: 0,
+                material: MaterialId(0),
+            })
+        })
+        .collect();
+    let start = Instant::now();
+    let accel = Bvh::build(&prims);
+    let build = start.elapsed();
+    println!("{}", accel.stats());
+    let ray = |q: &Query| Ray { origin: q.origin, direction: q.direction };
+    Row {
+        name: "mirador bvh",
+        build,
+        primary: throughput(primary, |q| accel.closest(&prims, &ray(q), q.t_min, q.t_max).is_some()),
+        shadow: throughput(shadow, |q| accel.occluded(&prims, &ray(q), q.t_min, q.t_max)),
+    }
+}
+
+fn obvhs_rows(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Vec<Row> {
+    use obvhs::ray::{Ray as ORay, RayHit};
+    let triangles: Vec<obvhs::triangle::Triangle> =
+        tris.iter().map(|t| obvhs::triangle::Triangle { v0: t[0].into(), v1: t[1].into(), v2: t[2].into() }).collect();
+    let oray = |q: &Query| ORay::new(q.origin.into(), q.direction.into(), q.t_min, q.t_max);
+    let mut rows = Vec::new();
+
+    let start = Instant::now();
+    let bvh2 = obvhs::bvh2::builder::build_bvh2_from_tris(
+        &triangles,
+        obvhs::BvhBuildParams::medium_build(),
+        &mut Duration::default(),
+    );
+    let build = start.elapsed();
+    let ordered: Vec<_> = bvh2.primitive_indices.iter().map(|&i| triangles[i as usize]).collect();
+    rows.push(Row {
+        name: "obvhs 0.4 bvh2",
+        build,
+        primary: throughput(primary, |q| {
+            let mut hit = RayHit::none();
+            bvh2.ray_traverse(oray(q), &mut hit, |r, id| ordered[id].intersect(r))
+        }),
+        shadow: throughput(shadow, |q| !bvh2.ray_traverse_miss(oray(q), |r, id| ordered[id].intersect(r))),
+    });
+    drop((bvh2, ordered));
+
+    let start = Instant::now();
+    let cwbvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
+        &triangles,
+        obvhs::BvhBuildParams::medium_build(),
+        &mut Duration::default(),
+    );
+    let build = start.elapsed();
+    let ordered: Vec<_> = cwbvh.primitive_indices.iter().map(|&i| triangles[i as usize]).collect();
+    rows.push(Row {
+        name: "obvhs 0.4 cwbvh",
+        build,
+        primary: throughput(primary, |q| {
+            let mut hit = RayHit::none();
+            cwbvh.ray_traverse(oray(q), &mut hit, |r, id| ordered[id].intersect(r))
+        }),
+        shadow: throughput(shadow, |q| !cwbvh.ray_traverse_miss(oray(q), |r, id| ordered[id].intersect(r))),
+    });
+    rows
+}
+
+fn bvh_crate_row(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Row {
+    let mut shapes: Vec<BvhShape> = tris.iter().map(|t| BvhShape { v: t.map(Vec3A::from), node: 0 }).collect();
+    let start = Instant::now();
+    let tree = bvh::bvh::Bvh::build(&mut shapes);
+    let build = start.elapsed();
+    let bray = |q: &Query| bvh::ray::Ray::new(q.origin.to_array().into(), q.direction.to_array().into());
+    let closest = |q: &Query| {
+        let ray = bray(q);
+        let mut best = q.t_max;
+        for shape in tree.nearest_traverse_iterator(&ray, &shapes) {
+            // Leaves come out by the distance at which the ray enters their box.
+            let entry =
+                ray.intersection_slice_for_aabb(&bvh::aabb::Bounded::aabb(shape)).map_or(f32::INFINITY, |s| s.0);
+            if entry > best {
+                break;
+            }
+            if let Some(t) = moller_trumbore(&shape.v, q.origin.into(), q.direction.into(), q.t_min, best) {
+                best = t;
+            }
+        }
+        best < q.t_max
+    };
+    let occluded = |q: &Query| {
+        let ray = bray(q);
+        tree.traverse_iterator(&ray, &shapes)
+            .any(|shape| moller_trumbore(&shape.v, q.origin.into(), q.direction.into(), q.t_min, q.t_max).is_some())
+    };
+    Row { name: "bvh 0.13", build, primary: throughput(primary, closest), shadow: throughput(shadow, occluded) }
+}
+
+fn main() {
+    let total = Instant::now();
+    let tris = displaced_sphere();
+    let primary = primary_rays();
+    // Shadow rays from Mirador's primary hits toward a point light.
+    let shadow: Vec<Query> = {
+        let prims: Vec<Primitive> = tris
+            .iter()
+            .map(|&positions| {
+                Primitive::Triangle(Triangle {
+                    positions,
+                    normals: [Vec3::Y; 3],
+                    uvs: [Vec2::ZERO; 3],
+                    object: 0,
+                    material: MaterialId(0),
+                })
+            })
+            .collect();
+        let accel = Bvh::build(&prims);
+        let light = Vec3::new(3.0, 4.0, 2.0);
+        primary
+            .par_iter()
+            .filter_map(|q| {
+                let ray = Ray { origin: q.origin, direction: q.direction };
+                let hit = accel.closest(&prims, &ray, q.t_min, q.t_max)?;
+                let p = ray.at(hit.t);
+                let to_light = light - p;
+                Some(Query {
+                    origin: p,
+                    direction: to_light.normalize(),
+                    t_min: SHADOW_T_MIN,
+                    t_max: to_light.length(),
+                })
+            })
+            .collect()
+    };
+    let threads = rayon::current_num_threads();
+    println!(
+        "mesh: displaced sphere, {} triangles; {} primary rays ({WIDTH}×{HEIGHT}), {} shadow rays; best of {REPEATS}; {threads} threads",
+        tris.len(),
+        primary.len(),
+        shadow.len()
+    );
+
+    // `cargo bench --bench trace -- obvhs` runs Mirador and the peers whose names contain "obvhs".
+    let filters: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with("--")).collect();
+    let wanted = |name: &str| filters.is_empty() || filters.iter().any(|f| name.contains(f.as_str()));
+    let mut rows = vec![mirador_row(&tris, &primary, &shadow)];
+    if wanted("obvhs") {
+        rows.extend(obvhs_rows(&tris, &primary, &shadow));
+    }
+    if wanted("bvh 0.13") {
+        rows.push(bvh_crate_row(&tris, &primary, &shadow));
+    }
+
+    println!();
+    println!(
+        "{:<18} {:>9} {:>12} {:>12} {:>12} {:>12} {:>9} {:>9}",
+        "",
+        "build",
+        "primary 1T",
+        "shadow 1T",
+        format!("primary {threads}T"),
+        format!("shadow {threads}T"),
+        "hits",
+        "occluded"
+    );
+    for r in &rows {
+        println!(
+            "{:<18} {:>7.2} s {:>7.2} Mr/s {:>7.2} Mr/s {:>7.2} Mr/s {:>7.2} Mr/s {:>9} {:>9}",
+            r.name,
+            r.build.as_secs_f64(),
+            r.primary.single / 1e6,
+            r.shadow.single / 1e6,
+            r.primary.parallel / 1e6,
+            r.shadow.parallel / 1e6,
+            r.primary.hits,
+            r.shadow.hits
+        );
+    }
+    println!();
+    println!("ratios: ours/peer throughput (> 1: Mirador faster), peer/ours build time (> 1: Mirador builds faster)");
+    let ours = &rows[0];
+    for peer in &rows[1..] {
+        println!(
+            "vs {:<15} {:>7.2}× {:>11.2}× {:>11.2}× {:>11.2}× {:>11.2}×",
+            peer.name,
+            peer.build.as_secs_f64() / ours.build.as_secs_f64(),
+            ours.primary.single / peer.primary.single,
+            ours.shadow.single / peer.shadow.single,
+            ours.primary.parallel / peer.primary.parallel,
+            ours.shadow.parallel / peer.shadow.parallel
+        );
+    }
+    println!();
+    println!("total {:.1} s", total.elapsed().as_secs_f64());
+}

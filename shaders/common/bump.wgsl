@@ -1,0 +1,103 @@
+// Bump mapping (TECHNIQUES.md §3, seed 000 §1.2) and mip-level helpers (§2, seed 000 §1.1): the
+// WGSL twin of src/texture/{bump,height,tangents,lod,mipmap}.rs. Keep the two in step;
+// tests/bump.rs runs both on the same inputs. Pure functions only: the pass supplies texture
+// samples and screen derivatives (dpdx/dpdy are fragment-only, so they are taken by the caller).
+
+const BUMP_TAU: f32 = 6.28318530717958647692;
+
+// One colour per mip level for the level-colour view (linear RGB); levels 7 and smaller are grey.
+// Rust twin: texture::mipmap::LEVEL_PALETTE.
+const MIP_PALETTE_LAST: u32 = 7u;
+const MIP_LEVEL_PALETTE = array<vec3f, 8>(
+    vec3f(1.0, 0.0, 0.0),
+    vec3f(1.0, 0.5, 0.0),
+    vec3f(1.0, 1.0, 0.0),
+    vec3f(0.0, 1.0, 0.0),
+    vec3f(0.0, 1.0, 1.0),
+    vec3f(0.0, 0.0, 1.0),
+    vec3f(1.0, 0.0, 1.0),
+    vec3f(0.5, 0.5, 0.5),
+);
+
+// The level-colour view: the palette blended between levels floor(lod) and floor(lod) + 1, as
+// trilinear filtering blends texels. Clamp lod to the texture's last level first
+// (f32(textureNumLevels(t) - 1u)) to show the level actually read.
+fn mip_level_colour(lod: f32) -> vec3f {
+    let l = clamp(lod, 0.0, f32(MIP_PALETTE_LAST));
+    let lo = floor(l);
+    let hi = min(lo + 1.0, f32(MIP_PALETTE_LAST));
+    // A function-local copy: a const array indexed at run time is not portable.
+    var palette = MIP_LEVEL_PALETTE;
+    return mix(palette[u32(lo)], palette[u32(hi)], l - lo);
+}
+
+// The GPU's level of detail from the screen derivatives of the texture coordinates
+// (duv_dx = dpdx(uv), duv_dy = dpdy(uv)) for a texture of `size` texels:
+// log2 max(|duv_dx ⊙ size|, |duv_dy ⊙ size|) + bias.
+fn mip_lod(duv_dx: vec2f, duv_dy: vec2f, size: vec2f, bias: f32) -> f32 {
+    return log2(max(length(duv_dx * size), length(duv_dy * size))) + bias;
+}
+
+// (d_u, d_v) by central differences from f(u+Δ, v), f(u−Δ, v), f(u, v+Δ), f(u, v−Δ):
+// k·(f₊ − f₋)/2Δ per axis.
+fn bump_central_differences(u_plus: f32, u_minus: f32, v_plus: f32, v_minus: f32, delta: vec2f, k: f32) -> vec2f {
+    return k * vec2f(u_plus - u_minus, v_plus - v_minus) / (2.0 * delta);
+}
+
+// n' = normalize((t_u + d_u·n) × (t_v + d_v·n)), turned to the side of n, so that mirrored
+// texture coordinates (t_u × t_v along −n) move the bumps but never invert them. n is unit;
+// t_u, t_v are ∂p/∂u, ∂p/∂v of any length. Degenerate tangents return n.
+fn perturbed_normal(n: vec3f, tu: vec3f, tv: vec3f, du: f32, dv: f32) -> vec3f {
+    let m = cross(tu + du * n, tv + dv * n);
+    let len = length(m);
+    if !(len > 0.0) || len > 3.0e38 {
+        return n;
+    }
+    let perturbed = m / len;
+    return select(perturbed, -perturbed, dot(perturbed, n) < 0.0);
+}
+
+// The sine height field a·sin(2π·f_u·u)·sin(2π·f_v·v) and its analytic gradient.
+fn sine_height(uv: vec2f, frequency: vec2f, amplitude: f32) -> f32 {
+    let a = BUMP_TAU * frequency * uv;
+    return amplitude * sin(a.x) * sin(a.y);
+}
+
+fn sine_height_gradient(uv: vec2f, frequency: vec2f, amplitude: f32) -> vec2f {
+    let w = BUMP_TAU * frequency;
+    let a = w * uv;
+    return amplitude * vec2f(w.x * cos(a.x) * sin(a.y), w.y * sin(a.x) * cos(a.y));
+}
+
+struct SurfaceTangents {
+    tu: vec3f,
+    tv: vec3f,
+    valid: bool,
+}
+
+// (∂p/∂u, ∂p/∂v) from two position differences and the matching texture-coordinate
+// differences: triangle edges, or screen derivatives in a fragment shader
+// (tangents_from_derivatives(dpdx(p), dpdy(p), dpdx(uv), dpdy(uv))), which is the per-triangle
+// constant for flat triangles. Invalid where the texture coordinates are degenerate.
+fn tangents_from_derivatives(dp1: vec3f, dp2: vec3f, duv1: vec2f, duv2: vec2f) -> SurfaceTangents {
+    let det = duv1.x * duv2.y - duv2.x * duv1.y;
+    if abs(det) <= 1.1920929e-7 * (abs(duv1.x * duv2.y) + abs(duv2.x * duv1.y)) || det == 0.0 {
+        return SurfaceTangents(vec3f(0.0), vec3f(0.0), false);
+    }
+    let r = 1.0 / det;
+    return SurfaceTangents((dp1 * duv2.y - dp2 * duv1.y) * r, (dp2 * duv1.x - dp1 * duv2.x) * r, true);
+}
+
+// glTF normal map: the texel rgb (linear, data) is m = normalize((2·rgb − 1) ⊙ (scale, scale, 1))
+// in the frame (t, b = sign(w)·(n × t), n), t made perpendicular to n. Degenerate input returns n.
+fn normal_map_normal(n: vec3f, tangent: vec4f, sample_rgb: vec3f, scale: f32) -> vec3f {
+    let t_raw = tangent.xyz - dot(tangent.xyz, n) * n;
+    let m_raw = (2.0 * sample_rgb - 1.0) * vec3f(scale, scale, 1.0);
+    if !(length(t_raw) > 0.0) || !(length(m_raw) > 0.0) {
+        return n;
+    }
+    let t = normalize(t_raw);
+    let b = select(1.0, -1.0, tangent.w < 0.0) * cross(n, t);
+    let m = normalize(m_raw);
+    return normalize(m.x * t + m.y * b + m.z * n);
+}

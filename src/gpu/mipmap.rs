@@ -1,0 +1,324 @@
+//! Mip chains on the GPU (TECHNIQUES.md §2, seed 000 §1.1).
+//!
+//! Mipmapping stores a texture at every power-of-two reduction, level `i + 1` the box average of
+//! level `i`, `M_{i+1}[j, k] = ¼ (M_i[2j, 2k] + M_i[2j+1, 2k] + M_i[2j, 2k+1] + M_i[2j+1, 2k+1])`,
+//! so that a distant surface reads a texel that already averages everything its pixel covers
+//! instead of one texel picked at random (aliasing).
+//!
+//! [`MipmapGenerator`] fills levels `1..` of a texture from its level 0 with one render pass per
+//! level: a fullscreen triangle into a view of level `i + 1` whose fragments `textureLoad` their
+//! footprint from a view of level `i` (`shaders/mipmap.wgsl`). Render passes rather than compute:
+//! `Rgba8UnormSrgb` cannot be a storage texture, and through views of the texture's own format
+//! an sRGB texture is decoded to linear when read and encoded when written, so the averages are
+//! taken on linear values on every backend (Vulkan and GL alike).
+//!
+//! Non-power-of-two sizes follow the CPU chain's rule (`src/texture/mipmap.rs`): level sizes
+//! `max(1, ⌊size/2⌋)`, as wgpu gives them, and on an odd axis of `n = 2h + 1` texels each output
+//! texel averages three texels with weights `(h−j)/n, h/n, (j+1)/n`, the exact coverage of its
+//! footprint, so the mean is kept. The GPU chain is rounded to 8 bits at every level; the CPU
+//! chain stays in f32; tests/mipmaps.rs checks they agree within 1/255 on every level.
+//!
+//! Limits: one pass per level (no single-pass downsampler); only 2D textures whose format can be
+//! rendered to and read as float.
+
+use std::collections::HashMap;
+use std::sync::Mutex;
+
+use super::texture::GpuTexture;
+use crate::scene::{ColorSpace, Texture};
+use crate::shaders;
+use crate::texture::mipmap::Filter;
+
+const SHADER: &str = include_str!("../../shaders/mipmap.wgsl");
+
+/// How many levels a full chain of a `width × height` texture has, `⌊log2 max(w, h)⌋ + 1`: the
+/// `mip_level_count` to create it with.
+pub fn mip_level_count(width: u32, height: u32) -> u32 {
+    crate::texture::mipmap::mip_level_count(width, height)
+}
+
+/// The usages a texture needs for [`MipmapGenerator::record`] (plus `COPY_DST` to upload level 0
+/// and `COPY_SRC` to read levels back).
+pub const MIPMAP_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::TEXTURE_BINDING
+    .union(wgpu::TextureUsages::RENDER_ATTACHMENT)
+    .union(wgpu::TextureUsages::COPY_DST)
+    .union(wgpu::TextureUsages::COPY_SRC);
+
+/// The format a [`Texture`] is uploaded as: sRGB colour as `Rgba8UnormSrgb` (the sampler decodes
+/// before filtering), data as `Rgba8Unorm`.
+pub fn texture_format(color_space: ColorSpace) -> wgpu::TextureFormat {
+    match color_space {
+        ColorSpace::Srgb => wgpu::TextureFormat::Rgba8UnormSrgb,
+        ColorSpace::Linear => wgpu::TextureFormat::Rgba8Unorm,
+    }
+}
+
+/// Builds mip chains on the GPU. Made once per device; render pipelines are made on first use of
+/// each texture format and kept.
+pub struct MipmapGenerator {
+    module: wgpu::ShaderModule,
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: Mutex<HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>>,
+}
+
+impl MipmapGenerator {
+    pub fn new(device: &wgpu::Device) -> MipmapGenerator {
+        let module = shaders::module(device, "mipmap::shader", SHADER);
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("mipmap::bind_group_layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    // textureLoad only: no filtering needed, so any float format works.
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            }],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("mipmap::layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        MipmapGenerator { module, layout, pipeline_layout, pipelines: Mutex::new(HashMap::new()) }
+    }
+
+    fn pipeline(&self, device: &wgpu::Device, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
+        let mut pipelines = self.pipelines.lock().expect("no thread panicked while holding the pipeline cache");
+        pipelines
+            .entry(format)
+            .or_insert_with(|| {
+                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some("mipmap::pipeline"),
+                    layout: Some(&self.pipeline_layout),
+                    vertex: wgpu::VertexState {
+                        module: &self.module,
+                        entry_point: Some("vs_mipmap"),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    primitive: Default::default(),
+                    depth_stencil: None,
+                    multisample: Default::default(),
+                    fragment: Some(wgpu::FragmentState {
+                        module: &self.module,
+                        entry_point: Some("fs_mipmap"),
+                        compilation_options: Default::default(),
+                        targets: &[Some(format.into())],
+                    }),
+                    multiview_mask: None,
+                    cache: None,
+                })
+            })
+            .clone()
+    }
+
+    /// Records into `encoder` the passes that fill levels `1..` of `texture` from level 0, each
+    /// level from the one above. Submit the encoder to run them; nothing else is needed before
+    /// sampling the texture in a later submission (or later in the same encoder).
+    ///
+    /// Panics (a programmer error) unless `texture` is 2D, single-layer, single-sample, and has
+    /// `TEXTURE_BINDING | RENDER_ATTACHMENT` usage with a renderable float format.
+    pub fn record(&self, device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture) {
+        let levels = texture.mip_level_count();
+        if levels <= 1 {
+            return;
+        }
+        assert!(
+            texture.dimension() == wgpu::TextureDimension::D2
+                && texture.depth_or_array_layers() == 1
+                && texture.sample_count() == 1,
+            "mipmaps are generated for single-layer, single-sample 2D textures"
+        );
+        assert!(
+            texture.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT),
+            "a texture needs TEXTURE_BINDING | RENDER_ATTACHMENT usage to have its mipmaps generated"
+        );
+        let format = texture.format();
+        let pipeline = self.pipeline(device, format);
+        let level_view = |level: u32| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("mipmap::level_view"),
+                format: Some(format),
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_mip_level: level,
+                mip_level_count: Some(1),
+                ..Default::default()
+            })
+        };
+        encoder.push_debug_group("mipmap");
+        let mut source = level_view(0);
+        for level in 1..levels {
+            let target = level_view(level);
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("mipmap::bind_group"),
+                layout: &self.layout,
+                entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&source) }],
+            });
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("mipmap::pass"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    // Every texel is drawn, so the old contents need not be loaded.
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.push_debug_group("mipmap level");
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.draw(0..3, 0..1);
+            pass.pop_debug_group();
+            drop(pass);
+            source = target;
+        }
+        encoder.pop_debug_group();
+    }
+}
+
+/// Fills levels `1..` of `texture` from its level 0 and submits the work (without waiting). A
+/// one-off: it builds a [`MipmapGenerator`] each call; a renderer keeps one and calls
+/// [`MipmapGenerator::record`].
+pub fn generate_mipmaps(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) {
+    let generator = MipmapGenerator::new(device);
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mipmap::encoder") });
+    generator.record(device, &mut encoder, texture);
+    queue.submit([encoder.finish()]);
+}
+
+/// Uploads `image` as a texture with a full mip chain (`Rgba8UnormSrgb` for sRGB colour,
+/// `Rgba8Unorm` for data, usage [`MIPMAP_USAGE`]), writes level 0 and submits the generation of
+/// the other levels. The view covers every level.
+pub fn upload_with_mipmaps(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    generator: &MipmapGenerator,
+    label: &str,
+    image: &Texture,
+) -> GpuTexture {
+    let size = wgpu::Extent3d { width: image.width, height: image.height, depth_or_array_layers: 1 };
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size,
+        mip_level_count: mip_level_count(image.width, image.height),
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: texture_format(image.color_space),
+        usage: MIPMAP_USAGE,
+        view_formats: &[],
+    });
+    let row = 4 * image.width as usize;
+    let expected = row * image.height as usize;
+    // A short pixel buffer (a malformed file) is padded with transparent black rather than
+    // rejected by wgpu's validation.
+    let mut padded;
+    let data = if image.rgba8.len() >= expected {
+        &image.rgba8[..expected]
+    } else {
+        padded = image.rgba8.clone();
+        padded.resize(expected, 0);
+        &padded[..]
+    };
+    queue.write_texture(
+        texture.as_image_copy(),
+        data,
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row as u32), rows_per_image: Some(image.height) },
+        size,
+    );
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mipmap::encoder") });
+    generator.record(device, &mut encoder, &texture);
+    queue.submit([encoder.finish()]);
+    let view = texture.create_view(&wgpu::TextureViewDescriptor { label: Some("mipmap::view"), ..Default::default() });
+    GpuTexture { texture, view }
+}
+
+/// The sampler that makes the GPU read a mipmapped texture as [`crate::texture::MipChain::sample`]
+/// does with `filter`: repeat wrapping; level 0 only (`lod_max_clamp = 0`) for nearest and
+/// bilinear; linear within a level and nearest or linear between levels for nearest-mip and
+/// trilinear. `max_anisotropy > 1` turns on anisotropic filtering for trilinear only (wgpu
+/// requires every filter to be linear for it, and ignores it where the device lacks it);
+/// the level-colour view is computed in the shader and samples nothing, so it gets trilinear.
+pub fn sampler_descriptor(filter: Filter, max_anisotropy: u16) -> wgpu::SamplerDescriptor<'static> {
+    use wgpu::{FilterMode, MipmapFilterMode};
+    let (label, texel, mip, max_lod) = match filter {
+        Filter::Nearest => ("mipmap::sampler_nearest", FilterMode::Nearest, MipmapFilterMode::Nearest, 0.0),
+        Filter::Bilinear => ("mipmap::sampler_bilinear", FilterMode::Linear, MipmapFilterMode::Nearest, 0.0),
+        Filter::NearestMip => ("mipmap::sampler_nearest_mip", FilterMode::Linear, MipmapFilterMode::Nearest, 32.0),
+        Filter::Trilinear | Filter::LevelColour => {
+            ("mipmap::sampler_trilinear", FilterMode::Linear, MipmapFilterMode::Linear, 32.0)
+        }
+    };
+    let anisotropy = if filter == Filter::Trilinear { max_anisotropy.clamp(1, 16) } else { 1 };
+    wgpu::SamplerDescriptor {
+        label: Some(label),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        address_mode_w: wgpu::AddressMode::Repeat,
+        mag_filter: texel,
+        min_filter: texel,
+        mipmap_filter: mip,
+        lod_min_clamp: 0.0,
+        lod_max_clamp: max_lod,
+        compare: None,
+        anisotropy_clamp: anisotropy,
+        border_color: None,
+    }
+}
+
+/// Copies mip level `level` of a 2D texture with 4 bytes per texel (RGBA8, sRGB or not: the
+/// stored bytes) into a tightly packed `Vec<u8>`, rows from the top. The texture needs
+/// `COPY_SRC` usage. ([`super::readback::read_texels`] reads level 0 only.)
+pub fn read_level_rgba8(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, level: u32) -> Vec<u8> {
+    let size = texture.size().mip_level_size(level, texture.dimension());
+    let row = 4 * size.width;
+    let padded_row = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("mipmap::readback_buffer"),
+        size: u64::from(padded_row) * u64::from(size.height),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder =
+        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mipmap::readback_encoder") });
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: level,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded_row),
+                rows_per_image: Some(size.height),
+            },
+        },
+        wgpu::Extent3d { depth_or_array_layers: 1, ..size },
+    );
+    queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |result| result.expect("mapping the mip readback buffer"));
+    device.poll(wgpu::PollType::wait_indefinitely()).expect("waiting for the mip readback copy");
+    let mapped = slice.get_mapped_range().expect("the buffer was mapped for reading above");
+    let mut packed = Vec::with_capacity((row * size.height) as usize);
+    for padded in mapped.chunks_exact(padded_row as usize) {
+        packed.extend_from_slice(&padded[..row as usize]);
+    }
+    drop(mapped);
+    buffer.unmap();
+    packed
+}

@@ -1,0 +1,316 @@
+//! Cast shadows at object precision (seed 000 §1.3, "algoritmo de fuerza bruta"): for every pair
+//! of a caster polygon `P` and a planar receiver `Q`, the shadow polygon `S` that `P` casts on
+//! `Q`'s plane from the light, clipped by `Q` (Sutherland–Hodgman). The results are detail
+//! polygons in which the light is not visible (drawn by `shaders/shadow_projected.wgsl`).
+//!
+//! Projection from a light at `y` onto the plane `n·x = d`, with heights `h(x) = n·x − d`:
+//! `x' = y + (x − y)·h(y)/(h(y) − h(x))`; for a directional light travelling along `D`:
+//! `x' = x − D·h(x)/(n·D)`. Only the part of a caster between the light and the plane casts, so
+//! each triangle is first clipped to that slab.
+//!
+//! Limits, as the notes say: quadratic cost (every caster triangle against every receiver), and
+//! receivers must be planar: here, the scene's `plane` objects. Transparent casters are skipped
+//! (their coloured shadows need the shadow-map method). A light in the receiver's plane, or a
+//! directional light parallel to it, casts nothing on it.
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use super::views::ShadowLayout;
+use crate::gpu::uniform::UniformBuffer;
+use crate::raster::DEPTH_FORMAT;
+use crate::scene::{LightKind, Scene, Shape};
+use crate::shaders;
+
+/// The screen-sized mask the polygons are drawn into: one channel per shadowed light.
+pub const MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
+
+/// A convex shadow polygon on a receiver, for the shadowed light in mask channel `slot`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShadowPolygon {
+    pub slot: u32,
+    pub points: Vec<Vec3>,
+}
+
+/// Keeps the part of a convex polygon where `inside(x) ≥ 0`, `inside` being affine in `x`.
+fn clip(polygon: &[Vec3], inside: impl Fn(Vec3) -> f32) -> Vec<Vec3> {
+    let mut out = Vec::with_capacity(polygon.len() + 2);
+    for (k, &a) in polygon.iter().enumerate() {
+        let b = polygon[(k + 1) % polygon.len()];
+        let (fa, fb) = (inside(a), inside(b));
+        if fa >= 0.0 {
+            out.push(a);
+        }
+        if (fa >= 0.0) != (fb >= 0.0) {
+            out.push(a + (b - a) * (fa / (fa - fb)));
+        }
+    }
+    out
+}
+
+/// A planar receiver: its corners counter-clockwise seen from `normal`.
+struct Receiver {
+    object: usize,
+    corners: [Vec3; 4],
+    normal: Vec3,
+    offset: f32,
+}
+
+fn receivers(scene: &Scene) -> Vec<Receiver> {
+    scene
+        .objects
+        .iter()
+        .enumerate()
+        .filter_map(|(index, object)| {
+            let Shape::Plane { size, .. } = object.shape else { return None };
+            let (hx, hz) = (size.x / 2.0, size.y / 2.0);
+            let local =
+                [Vec3::new(-hx, 0.0, hz), Vec3::new(hx, 0.0, hz), Vec3::new(hx, 0.0, -hz), Vec3::new(-hx, 0.0, -hz)];
+            let corners = local.map(|p| object.world_from_local.transform_point3(p));
+            let normal = (corners[1] - corners[0]).cross(corners[3] - corners[0]).try_normalize()?;
+            Some(Receiver { object: index, corners, normal, offset: normal.dot(corners[0]) })
+        })
+        .collect()
+}
+
+/// Every shadow polygon of every shadowed light on every planar receiver.
+pub fn projected_shadows(scene: &Scene, layout: &ShadowLayout) -> Vec<ShadowPolygon> {
+    let receivers = receivers(scene);
+    let casters: Vec<(usize, Vec<[Vec3; 3]>)> = scene
+        .objects
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| !scene.materials[o.material.0].is_transparent())
+        .map(|(index, object)| {
+            let mesh = scene.tessellate(object);
+            let triangles = mesh
+                .indices
+                .chunks_exact(3)
+                .map(|t| {
+                    [t[0], t[1], t[2]].map(|i| object.world_from_local.transform_point3(mesh.positions[i as usize]))
+                })
+                .collect();
+            (index, triangles)
+        })
+        .collect();
+    let mut polygons = Vec::new();
+    let mut slot = 0;
+    for (light_index, first_layer) in layout.first_layer.iter().enumerate() {
+        if first_layer.is_none() {
+            continue;
+        }
+        let kind = scene.lights[light_index].kind;
+        for receiver in &receivers {
+            let height = |x: Vec3| receiver.normal.dot(x) - receiver.offset;
+            // Which side of the receiver is lit, and how a point projects onto its plane.
+            let (side, light_height) = match kind {
+                LightKind::Point { position } | LightKind::Spot { position, .. } => {
+                    (height(position).signum(), height(position))
+                }
+                LightKind::Directional { direction } => (-receiver.normal.dot(direction).signum(), f32::INFINITY),
+            };
+            let grazing = match kind {
+                LightKind::Directional { direction } => receiver.normal.dot(direction).abs() < 1e-6,
+                _ => light_height.abs() < 1e-6,
+            };
+            if grazing {
+                continue;
+            }
+            let project = |x: Vec3| match kind {
+                LightKind::Point { position } | LightKind::Spot { position, .. } => {
+                    position + (x - position) * (light_height / (light_height - height(x)))
+                }
+                LightKind::Directional { direction } => x - direction * (height(x) / receiver.normal.dot(direction)),
+            };
+            let scale = receiver.corners.iter().map(|c| c.abs().max_element()).fold(1.0, f32::max);
+            let lift = receiver.normal * side * 1e-4 * scale;
+            for (object, triangles) in &casters {
+                if *object == receiver.object {
+                    continue;
+                }
+                for triangle in triangles {
+                    // The part strictly between the receiver's plane and the light.
+                    let mut piece = clip(triangle, |x| side * height(x));
+                    if light_height.is_finite() {
+                        piece = clip(&piece, |x| side * (light_height - height(x)) - 1e-6 * light_height.abs());
+                    }
+                    if piece.len() < 3 {
+                        continue;
+                    }
+                    let mut shadow: Vec<Vec3> = piece.into_iter().map(project).collect();
+                    for k in 0..4 {
+                        let (a, b) = (receiver.corners[k], receiver.corners[(k + 1) % 4]);
+                        shadow = clip(&shadow, |x| receiver.normal.dot((b - a).cross(x - a)));
+                        if shadow.len() < 3 {
+                            break;
+                        }
+                    }
+                    if shadow.len() >= 3 {
+                        polygons.push(ShadowPolygon { slot, points: shadow.into_iter().map(|p| p + lift).collect() });
+                    }
+                }
+            }
+        }
+        slot += 1;
+    }
+    polygons
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct MaskVertex {
+    position: [f32; 3],
+    slot: u32,
+}
+
+/// Draws the shadow polygons into the mask, depth-tested against the opaque depth prepass.
+pub struct ProjectedPass {
+    pipeline: wgpu::RenderPipeline,
+    camera: UniformBuffer<[[f32; 4]; 4]>,
+    group: wgpu::BindGroup,
+}
+
+impl ProjectedPass {
+    pub fn new(device: &wgpu::Device) -> ProjectedPass {
+        let module = shaders::module(device, "shadow_projected::shader", shaders::SHADOW_PROJECTED);
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow_projected::layout"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow_projected::pipeline_layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let max = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Max,
+        };
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("shadow_projected::pipeline"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_shadow_projected"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<MaskVertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32],
+                })],
+            },
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(false),
+                depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                stencil: Default::default(),
+                // The polygons lie on their receivers: pulled slightly towards the eye so that
+                // they win the depth test against the very surface they cover.
+                bias: wgpu::DepthBiasState { constant: -8, slope_scale: -2.0, clamp: 0.0 },
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_shadow_projected"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: MASK_FORMAT,
+                    blend: Some(wgpu::BlendState { color: max, alpha: max }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let camera = UniformBuffer::new(device, "shadow_projected::camera", &glam::Mat4::IDENTITY.to_cols_array_2d());
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow_projected::group"),
+            layout: &layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: camera.binding() }],
+        });
+        ProjectedPass { pipeline, camera, group }
+    }
+
+    /// Clears `mask` and draws `polygons` into it. The mask starts cleared even when there is
+    /// nothing to draw, since the opaque pass reads it whenever this method is chosen.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        polygons: &[ShadowPolygon],
+        clip_from_world: glam::Mat4,
+        mask: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+    ) {
+        self.camera.write(queue, &clip_from_world.to_cols_array_2d());
+        let vertices: Vec<MaskVertex> = polygons
+            .iter()
+            .flat_map(|polygon| {
+                let fan = (1..polygon.points.len() - 1).flat_map(move |k| [0, k, k + 1]);
+                fan.map(move |i| MaskVertex { position: polygon.points[i].to_array(), slot: polygon.slot })
+            })
+            .collect();
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("shadow_projected::pass"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: mask,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        if vertices.is_empty() {
+            return;
+        }
+        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("shadow_projected::vertices"),
+            contents: bytemuck::cast_slice(&vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        pass.push_debug_group("projected shadows");
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.set_vertex_buffer(0, buffer.slice(..));
+        pass.draw(0..vertices.len() as u32, 0..1);
+        pass.pop_debug_group();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn clipping_keeps_the_inside_part() {
+        let square = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let half = clip(&square, |p| 0.5 - p.x);
+        assert_eq!(half.len(), 4);
+        assert!(half.iter().all(|p| p.x <= 0.5 + 1e-6));
+        assert!(clip(&square, |p| -1.0 - p.x).is_empty());
+    }
+}
