@@ -1,8 +1,9 @@
 // Mip generation (TECHNIQUES.md §2, seed 000 §1.1): one fullscreen triangle per level, each
 // fragment the box average of its footprint in the level above. src/gpu/mipmap.rs draws it and
 // its header states the rule; the CPU twin is src/texture/mipmap.rs (box_taps). The source is
-// read with textureLoad through a view of the texture's own format, so an sRGB texture is decoded
-// to linear before averaging, and the sRGB render target encodes the result again.
+// read with textureLoad, so an sRGB texture is decoded to linear before averaging; the result is
+// written twice: to the texture's level (an sRGB target encodes it again) and, unrounded, to a
+// 16-bit float scratch level that the next level reads, so 8-bit rounding never accumulates.
 
 @group(0) @binding(0) var mip_source: texture_2d<f32>;
 
@@ -35,8 +36,15 @@ fn vs_mipmap(@builtin(vertex_index) index: u32) -> @builtin(position) vec4f {
     return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
 }
 
+struct MipmapOut {
+    // The scratch level the next level is computed from.
+    @location(0) linear: vec4f,
+    // The texture's own level.
+    @location(1) stored: vec4f,
+}
+
 @fragment
-fn fs_mipmap(@builtin(position) pixel: vec4f) -> @location(0) vec4f {
+fn fs_mipmap(@builtin(position) pixel: vec4f) -> MipmapOut {
     let size = vec2i(textureDimensions(mip_source));
     let out = vec2i(pixel.xy);
     let tx = mip_box_taps(out.x, size.x);
@@ -49,5 +57,5 @@ fn fs_mipmap(@builtin(position) pixel: vec4f) -> @location(0) vec4f {
             sum += texel * (tx.weights[a] * ty.weights[b]);
         }
     }
-    return sum;
+    return MipmapOut(sum, sum);
 }

@@ -31,9 +31,16 @@ fn fs_shadow_transmission(in: ShadowVertexOut) -> @location(0) vec4f {
 
 // ---- Teaching view: one layer of the shadow maps, depth as grey.
 
+struct ShownLayer {
+    layer: u32,
+    width: u32,
+    height: u32,
+    // near/far of a perspective view, 0 for an orthographic one.
+    depth_ratio: f32,
+}
+
 @group(0) @binding(1) var shadow_maps: texture_depth_2d_array;
-// x: the layer shown; y, z: the output's size.
-@group(0) @binding(2) var<uniform> shown_layer: vec4u;
+@group(0) @binding(2) var<uniform> shown_layer: ShownLayer;
 
 @vertex
 fn vs_shadow_map_view(@builtin(vertex_index) index: u32) -> @builtin(position) vec4f {
@@ -44,16 +51,18 @@ fn vs_shadow_map_view(@builtin(vertex_index) index: u32) -> @builtin(position) v
 @fragment
 fn fs_shadow_map_view(@builtin(position) pixel: vec4f) -> @location(0) vec4f {
     // The map fills the largest centred square of the image.
-    let size = vec2f(f32(shown_layer.y), f32(shown_layer.z));
+    let size = vec2f(f32(shown_layer.width), f32(shown_layer.height));
     let side = min(size.x, size.y);
     let uv = (pixel.xy - 0.5 * (size - side)) / side;
     if any(uv < vec2f(0.0)) || any(uv >= vec2f(1.0)) {
         return vec4f(0.02, 0.02, 0.03, 1.0);
     }
     let dims = textureDimensions(shadow_maps);
-    let depth = textureLoad(shadow_maps, vec2i(uv * vec2f(dims)), shown_layer.x, 0);
-    // Depth is far from linear under a perspective light; a power curve spreads it for the eye.
-    return vec4f(vec3f(pow(depth, 8.0)), 1.0);
+    let depth = textureLoad(shadow_maps, vec2i(uv * vec2f(dims)), shown_layer.layer, 0);
+    // A perspective view's depth crowds towards 1; shown as distance over the far plane instead.
+    let r = shown_layer.depth_ratio;
+    let distance = select(depth, r / (1.0 - depth * (1.0 - r)), r > 0.0);
+    return vec4f(vec3f(distance), 1.0);
 }
 
 // ---- Teaching view: the lights' view volumes as lines in the scene.

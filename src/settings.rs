@@ -16,11 +16,78 @@ pub struct RenderSettings {
     pub exposure: f32,
     /// Slices around a tessellated sphere (the rasterizer's; the tracer's spheres are exact).
     pub sphere_segments: u32,
-    /// Cast shadows: shadow rays in the tracer (shadow maps in the rasterizer are the shadows
-    /// issue's; until then the rasterizer draws none).
+    /// Texture filtering: mipmaps and the sampling modes (TECHNIQUES.md §2).
+    pub textures: TextureSettings,
+    /// Bump mapping from height fields (TECHNIQUES.md §3).
+    pub bump: BumpSettings,
+    /// Cast shadows: shadow maps or projected polygons in the rasterizer, shadow rays in the
+    /// tracer (TECHNIQUES.md §4).
     pub shadows: ShadowSettings,
     /// The ray tracer's own settings.
     pub trace: TraceSettings,
+}
+
+/// How colour textures are filtered.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum TextureFilter {
+    /// The nearest texel of the full-size image: aliasing and moiré in the distance.
+    Nearest,
+    /// Bilinear on the full-size image, no mipmaps: still moiré.
+    Bilinear,
+    /// Bilinear within the nearest mip level: hard seams where the level changes.
+    NearestMip,
+    /// Bilinear in the two nearest levels, blended by the fractional level.
+    Trilinear,
+    /// Anisotropic filtering, up to `anisotropy` samples along the footprint's long axis (the
+    /// rasterizer only; the tracer uses trilinear).
+    Anisotropic,
+    /// Each mip level painted in its own colour: where the level changes, and the blend.
+    LevelColour,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TextureSettings {
+    pub filter: TextureFilter,
+    /// Largest anisotropy, 1 to 16, where the device allows.
+    pub anisotropy: u16,
+    /// Added to the level of detail: positive is blurrier, negative sharper (and aliased).
+    pub lod_bias: f32,
+}
+
+impl Default for TextureSettings {
+    fn default() -> Self {
+        TextureSettings { filter: TextureFilter::Trilinear, anisotropy: 16, lod_bias: 0.0 }
+    }
+}
+
+/// What the bump-mapping teaching view shows instead of the shaded colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum BumpView {
+    Off,
+    /// The (perturbed) shading normal as colour: `0.5 + 0.5·n`.
+    Normals,
+    /// The tangent `t_u` as colour, the frame the bumps are built in.
+    Tangents,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BumpSettings {
+    pub enabled: bool,
+    /// Multiplies every material's bump scale `k` (sign allowed).
+    pub scale: f32,
+    /// The finite-difference step `Δ`, in texels of the height map.
+    pub delta_texels: f32,
+    pub view: BumpView,
+}
+
+impl Default for BumpSettings {
+    fn default() -> Self {
+        BumpSettings { enabled: true, scale: 1.0, delta_texels: 1.0, view: BumpView::Off }
+    }
 }
 
 /// How the rasterizer finds cast shadows (TECHNIQUES.md §4).
@@ -183,6 +250,8 @@ impl Default for RenderSettings {
             terms: TermSettings::default(),
             exposure: 1.0,
             sphere_segments: 96,
+            textures: TextureSettings::default(),
+            bump: BumpSettings::default(),
             shadows: ShadowSettings::default(),
             trace: TraceSettings::default(),
         }
@@ -240,6 +309,20 @@ impl RenderSettings {
                 "sphere_segments must lie in 3..=4096, got {}",
                 self.sphere_segments
             )));
+        }
+        let textures = &self.textures;
+        if !(1..=16).contains(&textures.anisotropy) {
+            return Err(SettingsError::Invalid(format!("textures.anisotropy must lie in 1..=16, got {}", textures.anisotropy)));
+        }
+        if !(textures.lod_bias.is_finite() && textures.lod_bias.abs() <= 8.0) {
+            return Err(SettingsError::Invalid(format!("textures.lod_bias must lie in −8..=8, got {}", textures.lod_bias)));
+        }
+        let bump = &self.bump;
+        if !bump.scale.is_finite() {
+            return Err(SettingsError::Invalid(format!("bump.scale must be finite, got {}", bump.scale)));
+        }
+        if !(bump.delta_texels.is_finite() && bump.delta_texels > 0.0 && bump.delta_texels <= 64.0) {
+            return Err(SettingsError::Invalid(format!("bump.delta_texels must lie in (0, 64], got {}", bump.delta_texels)));
         }
         let shadows = &self.shadows;
         if !(256..=4096).contains(&shadows.map_size) {

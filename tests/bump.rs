@@ -318,30 +318,41 @@ fn max_normal_error(field: &dyn HeightField, delta: f32, k: f32) -> f64 {
 
 #[test]
 fn finite_differences_converge_quadratically_to_the_analytic_normal() {
-    let fields: [(&str, &dyn HeightField); 2] = [
-        ("sine 3×2, a = 0.05", &SineField { amplitude: 0.05, frequency: Vec2::new(3.0, 2.0) }),
-        ("value noise 2 cells, 2 octaves, a = 0.02", &ValueNoise { seed: 11, cells: 2, octaves: 2, amplitude: 0.02 }),
+    // Each field with its feature size: the shortest period of the sine, the finest cell of the
+    // noise. Central differences are O(Δ²) once Δ is small against it; before that (the noise's
+    // quintic changes its third derivative from 60 to −30 within half a cell) the error falls
+    // more slowly, though still faster than first order.
+    let fields: [(&str, &dyn HeightField, f32); 2] = [
+        ("sine 3×2, a = 0.05", &SineField { amplitude: 0.05, frequency: Vec2::new(3.0, 2.0) }, 1.0 / 3.0),
+        (
+            "value noise 2 cells, 2 octaves, a = 0.02",
+            &ValueNoise { seed: 11, cells: 2, octaves: 2, amplitude: 0.02 },
+            1.0 / 4.0,
+        ),
     ];
     let deltas = [1.0 / 16.0, 1.0 / 64.0, 1.0 / 256.0, 1.0 / 1024.0];
     // Truncation error is O(Δ²); f32 rounding of f(u ± Δ) adds an error that grows like 1/Δ and
     // reaches ~2·10⁻⁵ rad at Δ = 1/1024 for these fields. Above QUADRATIC the first dominates.
     const QUADRATIC: f64 = 1e-3;
     const FLOAT_FLOOR: f64 = 1e-4;
-    println!("max angle between finite-difference and analytic normals (radians), k = 1:");
+    println!("max angle between finite-difference and analytic normals (radians), k = 1, 2000 points:");
     println!("{:<44} {:>10} {:>10} {:>10} {:>10}", "field", "Δ = 1/16", "1/64", "1/256", "1/1024");
-    for (name, field) in fields {
+    for (name, field, feature) in fields {
         let errors: Vec<f64> = deltas.iter().map(|&d| max_normal_error(field, d, 1.0)).collect();
         println!("{name:<44} {:>10.3e} {:>10.3e} {:>10.3e} {:>10.3e}", errors[0], errors[1], errors[2], errors[3]);
         let ratios: Vec<String> = errors.windows(2).map(|w| format!("{:.1}", w[0] / w[1])).collect();
         println!("{:<44} ratios {}", "", ratios.join(", "));
-        assert!(errors[0] > 1e-3, "{name}: the coarsest step should show a real error, got {}", errors[0]);
+        assert!(errors[0] > 1e-2, "{name}: the coarsest step should show a real error, got {}", errors[0]);
         for (pair, w) in errors.windows(2).enumerate() {
-            if w[0] > QUADRATIC {
-                // Δ/4 divides an O(Δ²) error by 16 (an O(Δ) one by 4).
-                assert!(w[0] / w[1] > 12.0, "{name}: step {pair}: {:.3e} → {:.3e} is not quadratic", w[0], w[1]);
-            } else {
+            let ratio = w[0] / w[1];
+            if w[0] <= QUADRATIC {
                 // Near f32's floor: still decreasing, and small.
                 assert!(w[1] < w[0] && w[1] < FLOAT_FLOOR, "{name}: step {pair}: {:.3e} → {:.3e}", w[0], w[1]);
+            } else if deltas[pair] <= feature / 16.0 {
+                // Δ/4 divides an O(Δ²) error by 16 (an O(Δ) one by 4).
+                assert!(ratio > 12.0, "{name}: step {pair}: {:.3e} → {:.3e} is not quadratic", w[0], w[1]);
+            } else {
+                assert!(ratio > 6.0, "{name}: step {pair}: {:.3e} → {:.3e} is not better than O(Δ)", w[0], w[1]);
             }
         }
     }

@@ -21,6 +21,20 @@ fn showcase() {
     common::assert_golden("showcase", &common::raster(&scene, &scene.settings), MAX_FLIP_MEAN);
 }
 
+#[test]
+fn shadow_stage_with_shadow_maps() {
+    let scene = common::load("scenes/shadows.toml");
+    common::assert_golden("shadows-map", &common::raster(&scene, &scene.settings), MAX_FLIP_MEAN);
+}
+
+#[test]
+fn shadow_stage_with_projected_polygons() {
+    let scene = common::load("scenes/shadows.toml");
+    let mut settings = scene.settings.clone();
+    settings.shadows.method = mirador::settings::ShadowMethod::Projected;
+    common::assert_golden("shadows-projected", &common::raster(&scene, &settings), MAX_FLIP_MEAN);
+}
+
 /// The threshold is meaningful: small but visible changes to the scene exceed it.
 #[test]
 fn the_threshold_catches_visible_changes() {

@@ -329,6 +329,18 @@ fn raster_and_ray_traced_seed_simple_agree_without_shadows() {
     assert!(difference.psnr_db > 45.0, "PSNR {} dB", difference.psnr_db);
 }
 
+/// The orthographic camera of seed 003: parallel rays along −ze in both renderers.
+#[test]
+fn raster_and_ray_traced_agree_through_an_orthographic_camera() {
+    let mut scene = common::load("scenes/shadows.toml");
+    scene.camera.projection = mirador::scene::Projection::Orthographic;
+    scene.camera.ortho_height = 5.0;
+    let raster = common::raster(&scene, &scene.settings);
+    let traced = mirador::trace::render_image(&scene, &scene.settings);
+    let difference = mirador::compare::difference(&traced, &raster).unwrap();
+    assert!(difference.flip_mean < 0.015, "FLIP mean {}", difference.flip_mean);
+}
+
 /// With shadows on, the tracer darkens exactly the sphere's shadow on the floor: every pixel
 /// that changes is darker, and they form one blob below and to the left of the sphere.
 #[test]

@@ -101,6 +101,19 @@ pub fn flip_legend(width: u32) -> RgbaImage {
     legend
 }
 
+/// Rows of panels (each made by [`sheet`]) one under the other, left-aligned.
+pub fn rows(rows: &[RgbaImage]) -> RgbaImage {
+    let width = rows.iter().map(RgbaImage::width).max().unwrap_or(0);
+    let height = rows.iter().map(RgbaImage::height).sum();
+    let mut out = RgbaImage::from_pixel(width, height, BACKGROUND);
+    let mut y = 0;
+    for row in rows {
+        image::imageops::replace(&mut out, row, 0, i64::from(y));
+        y += row.height();
+    }
+    out
+}
+
 /// Puts `footer` under `image`, right-aligned with the last panel's edge, on the sheet background.
 pub fn with_footer(image: &RgbaImage, footer: &RgbaImage) -> RgbaImage {
     let width = image.width().max(footer.width() + MARGIN);

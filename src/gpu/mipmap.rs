@@ -7,10 +7,17 @@
 //!
 //! [`MipmapGenerator`] fills levels `1..` of a texture from its level 0 with one render pass per
 //! level: a fullscreen triangle into a view of level `i + 1` whose fragments `textureLoad` their
-//! footprint from a view of level `i` (`shaders/mipmap.wgsl`). Render passes rather than compute:
+//! footprint from level `i` (`shaders/mipmap.wgsl`). Render passes rather than compute:
 //! `Rgba8UnormSrgb` cannot be a storage texture, and through views of the texture's own format
 //! an sRGB texture is decoded to linear when read and encoded when written, so the averages are
 //! taken on linear values on every backend (Vulkan and GL alike).
+//!
+//! Each pass also writes its level, unrounded, to a transient `Rgba16Float` scratch chain, and
+//! the next level is computed from that rather than from the 8-bit level: computing level
+//! `i + 1` from the rounded level `i` would add up to half a step of rounding per level (a
+//! smooth gradient rounds the same way everywhere, so the errors do not average out; on lavapipe
+//! that reached 2/255 by level 3). The scratch costs 8 bytes per texel of levels `1..` (a third
+//! of level 0's texel count) until the work is done.
 //!
 //! Non-power-of-two sizes follow the CPU chain's rule (`src/texture/mipmap.rs`): level sizes
 //! `max(1, ⌊size/2⌋)`, as wgpu gives them, and on an odd axis of `n = 2h + 1` texels each output
@@ -19,7 +26,8 @@
 //! chain stays in f32; tests/mipmaps.rs checks they agree within 1/255 on every level.
 //!
 //! Limits: one pass per level (no single-pass downsampler); only 2D textures whose format can be
-//! rendered to and read as float.
+//! rendered to and read as float; meant for 8-bit textures (a 32-bit float texture's levels would
+//! pass through the 16-bit scratch and lose precision).
 
 use std::collections::HashMap;
 use std::sync::Mutex;
@@ -52,6 +60,10 @@ pub fn texture_format(color_space: ColorSpace) -> wgpu::TextureFormat {
         ColorSpace::Linear => wgpu::TextureFormat::Rgba8Unorm,
     }
 }
+
+/// The format of the unrounded chain the levels are computed from: renderable and readable on
+/// every backend, with 11 significant bits (an error under 1/16 of an 8-bit step per level).
+const SCRATCH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// Builds mip chains on the GPU. Made once per device; render pipelines are made on first use of
 /// each texture format and kept.
@@ -108,7 +120,7 @@ impl MipmapGenerator {
                         module: &self.module,
                         entry_point: Some("fs_mipmap"),
                         compilation_options: Default::default(),
-                        targets: &[Some(format.into())],
+                        targets: &[Some(SCRATCH_FORMAT.into()), Some(format.into())],
                     }),
                     multiview_mask: None,
                     cache: None,
@@ -118,8 +130,9 @@ impl MipmapGenerator {
     }
 
     /// Records into `encoder` the passes that fill levels `1..` of `texture` from level 0, each
-    /// level from the one above. Submit the encoder to run them; nothing else is needed before
-    /// sampling the texture in a later submission (or later in the same encoder).
+    /// level from the unrounded level above (kept in a scratch chain made for this call and
+    /// released with the command buffer). Submit the encoder to run them; nothing else is needed
+    /// before sampling the texture in a later submission (or later in the same encoder).
     ///
     /// Panics (a programmer error) unless `texture` is 2D, single-layer, single-sample, and has
     /// `TEXTURE_BINDING | RENDER_ATTACHMENT` usage with a renderable float format.
@@ -140,10 +153,22 @@ impl MipmapGenerator {
         );
         let format = texture.format();
         let pipeline = self.pipeline(device, format);
-        let level_view = |level: u32| {
+        let level1 = texture.size().mip_level_size(1, wgpu::TextureDimension::D2);
+        // Scratch level i holds texture level i + 1 before rounding.
+        let scratch = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("mipmap::scratch"),
+            size: level1,
+            mip_level_count: levels - 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: SCRATCH_FORMAT,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let level_view = |texture: &wgpu::Texture, level: u32| {
             texture.create_view(&wgpu::TextureViewDescriptor {
                 label: Some("mipmap::level_view"),
-                format: Some(format),
+                format: Some(texture.format()),
                 dimension: Some(wgpu::TextureViewDimension::D2),
                 base_mip_level: level,
                 mip_level_count: Some(1),
@@ -151,26 +176,29 @@ impl MipmapGenerator {
             })
         };
         encoder.push_debug_group("mipmap");
-        let mut source = level_view(0);
         for level in 1..levels {
-            let target = level_view(level);
+            let source = if level == 1 { level_view(texture, 0) } else { level_view(&scratch, level - 2) };
+            let targets = [level_view(&scratch, level - 1), level_view(texture, level)];
             let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("mipmap::bind_group"),
                 layout: &self.layout,
                 entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&source) }],
             });
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("mipmap::pass"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target,
+            // Every texel is drawn, so the old contents need not be loaded.
+            let attachment = |view| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
                     depth_slice: None,
                     resolve_target: None,
-                    // Every texel is drawn, so the old contents need not be loaded.
                     ops: wgpu::Operations {
                         load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
                         store: wgpu::StoreOp::Store,
                     },
-                })],
+                })
+            };
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("mipmap::pass"),
+                color_attachments: &[attachment(&targets[0]), attachment(&targets[1])],
                 depth_stencil_attachment: None,
                 timestamp_writes: None,
                 occlusion_query_set: None,
@@ -181,8 +209,6 @@ impl MipmapGenerator {
             pass.set_bind_group(0, &group, &[]);
             pass.draw(0..3, 0..1);
             pass.pop_debug_group();
-            drop(pass);
-            source = target;
         }
         encoder.pop_debug_group();
     }

@@ -128,7 +128,7 @@ pub struct BoxTaps {
 pub fn box_taps(j: u32, n: u32) -> BoxTaps {
     if n <= 1 {
         BoxTaps { first: 0, count: 1, weights: [1.0, 0.0, 0.0] }
-    } else if n % 2 == 0 {
+    } else if n.is_multiple_of(2) {
         BoxTaps { first: 2 * j, count: 2, weights: [0.5, 0.5, 0.0] }
     } else {
         // Written exactly as in shaders/mipmap.wgsl, so both round the same way.

@@ -102,7 +102,7 @@ pub fn mesh_tangents(mesh: &Mesh) -> Vec<Vec4> {
     let vertices = mesh.positions.len();
     let usable = mesh.normals.len() == vertices
         && mesh.uvs.len() == vertices
-        && mesh.indices.len() % 3 == 0
+        && mesh.indices.len().is_multiple_of(3)
         && mesh.indices.iter().all(|&i| (i as usize) < vertices);
     let mut geometry = MikkMesh { mesh, tangents: vec![None; vertices] };
     if usable && !mesh.indices.is_empty() {

@@ -496,7 +496,8 @@ impl ShadowPass {
         let Some(targets) = self.targets.as_ref() else { return };
         if settings.view == ShadowView::Map && !layout.views.is_empty() {
             let layer = settings.view_layer.min(layout.views.len() as u32 - 1);
-            self.map_view.record(device, queue, encoder, &targets.depth_array, layer, size, hdr);
+            let ratio = layout.views[layer as usize].depth_ratio;
+            self.map_view.record(device, queue, encoder, &targets.depth_array, layer, ratio, size, hdr);
         }
         if settings.show_frusta && !layout.views.is_empty() {
             self.frusta.record(device, queue, encoder, layout, camera_clip_from_world, hdr, depth);
@@ -536,7 +537,16 @@ fn draw(pass: &mut wgpu::RenderPass<'_>, scene: &SceneGpu, transparent: bool) {
 struct MapView {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
-    uniform: UniformBuffer<[u32; 4]>,
+    uniform: UniformBuffer<GpuShownLayer>,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct GpuShownLayer {
+    layer: u32,
+    width: u32,
+    height: u32,
+    depth_ratio: f32,
 }
 
 impl MapView {
@@ -574,7 +584,7 @@ impl MapView {
             multiview_mask: None,
             cache: None,
         });
-        let uniform = UniformBuffer::new(device, "shadow::map_view_uniform", &[0u32; 4]);
+        let uniform = UniformBuffer::new(device, "shadow::map_view_uniform", &GpuShownLayer::zeroed());
         MapView { pipeline, layout, uniform }
     }
 
@@ -586,10 +596,11 @@ impl MapView {
         encoder: &mut wgpu::CommandEncoder,
         maps: &wgpu::TextureView,
         layer: u32,
+        depth_ratio: f32,
         size: (u32, u32),
         hdr: &wgpu::TextureView,
     ) {
-        self.uniform.write(queue, &[layer, size.0, size.1, 0]);
+        self.uniform.write(queue, &GpuShownLayer { layer, width: size.0, height: size.1, depth_ratio });
         // A teaching view, drawn only while it is on: a bind group made here costs nothing when off.
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shadow::map_view_group"),

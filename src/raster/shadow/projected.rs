@@ -124,7 +124,7 @@ pub fn projected_shadows(scene: &Scene, layout: &ShadowLayout) -> Vec<ShadowPoly
                 LightKind::Directional { direction } => x - direction * (height(x) / receiver.normal.dot(direction)),
             };
             let scale = receiver.corners.iter().map(|c| c.abs().max_element()).fold(1.0, f32::max);
-            let lift = receiver.normal * side * 1e-4 * scale;
+            let lift = receiver.normal * side * 1e-3 * scale;
             for (object, triangles) in &casters {
                 if *object == receiver.object {
                     continue;
@@ -216,9 +216,10 @@ impl ProjectedPass {
                 depth_write_enabled: Some(false),
                 depth_compare: Some(wgpu::CompareFunction::LessEqual),
                 stencil: Default::default(),
-                // The polygons lie on their receivers: pulled slightly towards the eye so that
-                // they win the depth test against the very surface they cover.
-                bias: wgpu::DepthBiasState { constant: -8, slope_scale: -2.0, clamp: 0.0 },
+                // No depth bias: the polygons are lifted off their receivers in world space
+                // instead. A bias in depth would let polygons hidden just behind another surface
+                // (a floor's shadow behind a wall standing on it) bleed through at its edge.
+                bias: Default::default(),
             }),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {

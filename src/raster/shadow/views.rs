@@ -37,6 +37,9 @@ pub struct LightView {
     pub perspective: bool,
     /// World size of one map texel: at unit distance from the light for perspective views.
     pub texel_size: f32,
+    /// near/far of a perspective view (0 for orthographic ones), to turn its depth back into
+    /// distance: `z/far = r / (1 − depth·(1 − r))`.
+    pub depth_ratio: f32,
 }
 
 /// The views of every shadowed light, and where each light's layers start.
@@ -85,10 +88,13 @@ fn box_corners((lo, hi): (Vec3, Vec3)) -> [Vec3; 8] {
 }
 
 /// Near and far distances from `position` that hold the whole scene, for perspective views.
+/// Perspective depth spends its precision near the near plane (a depth step is `Δz ≈ ε·z²/near`),
+/// so near is kept at 1/500 of far: anything closer to the light than that is clipped from its
+/// map and casts no shadow.
 fn depth_range(position: Vec3, bounds: (Vec3, Vec3)) -> (f32, f32) {
     let radius = ((bounds.1 - bounds.0).length() / 2.0).max(1e-3);
     let far = box_corners(bounds).iter().map(|c| c.distance(position)).fold(0.0, f32::max).max(radius * 1e-2);
-    (far * 1e-4, far * 1.01)
+    (far * 2e-3, far * 1.01)
 }
 
 /// The part of the view frustum that a directional light's map must cover.
@@ -141,10 +147,10 @@ fn directional_view(scene: &Scene, settings: &ShadowSettings, direction: Vec3) -
     (projection * view, texel)
 }
 
-fn perspective_view(position: Vec3, direction: Vec3, fov: f32, bounds: (Vec3, Vec3)) -> Mat4 {
+fn perspective_view(position: Vec3, direction: Vec3, fov: f32, bounds: (Vec3, Vec3)) -> (Mat4, f32) {
     let (near, far) = depth_range(position, bounds);
     let view = glam::camera::rh::view::look_to_mat4(position, direction, up_for(direction));
-    glam::camera::rh::proj::directx::perspective(fov, 1.0, near, far) * view
+    (glam::camera::rh::proj::directx::perspective(fov, 1.0, near, far) * view, near / far)
 }
 
 /// The faces of the cube around a point light: view direction and up vector of each.
@@ -180,15 +186,17 @@ pub fn shadow_layout(scene: &Scene, settings: &ShadowSettings) -> ShadowLayout {
         match light.kind {
             LightKind::Directional { direction } => {
                 let (clip_from_world, texel_size) = directional_view(scene, settings, direction);
-                layout.views.push(LightView { light: index, clip_from_world, perspective: false, texel_size });
+                layout.views.push(LightView { light: index, clip_from_world, perspective: false, texel_size, depth_ratio: 0.0 });
             }
             LightKind::Spot { position, direction, outer, .. } => {
                 let fov = (2.0 * outer + 4.0 / size).clamp(0.01, std::f32::consts::PI - 0.01);
+                let (clip_from_world, depth_ratio) = perspective_view(position, direction, fov, bounds);
                 layout.views.push(LightView {
                     light: index,
-                    clip_from_world: perspective_view(position, direction, fov, bounds),
+                    clip_from_world,
                     perspective: true,
                     texel_size: 2.0 * (fov / 2.0).tan() / size,
+                    depth_ratio,
                 });
             }
             LightKind::Point { position } => {
@@ -204,6 +212,7 @@ pub fn shadow_layout(scene: &Scene, settings: &ShadowSettings) -> ShadowLayout {
                         clip_from_world: projection * view,
                         perspective: true,
                         texel_size: 2.0 * half_width / size,
+                        depth_ratio: near / far,
                     });
                 }
             }

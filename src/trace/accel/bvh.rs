@@ -20,11 +20,9 @@
 //!
 //! **Layout.** Nodes are flattened depth first into an array of 32-byte nodes: box, one `u32`
 //! and a count. An inner node (count 0) stores the index of its left child; the right child is
-//! always the next node, since siblings are allocated as a pair, and each pair is aligned to a
-//! 64-byte cache line, so visiting a node loads both its children with one miss. A leaf stores
-//! the first of its `count` primitives in leaf order. The tree keeps its own copy of the
-//! triangles' vertices in leaf order, with each primitive's index in the spare fourth lane, so
-//! a leaf's triangles are read from consecutive memory.
+//! always the next node, since siblings are allocated as a pair. A leaf stores the first of its
+//! `count` primitives in leaf order. The tree keeps its own copy of the triangles' vertices in
+//! leaf order, so a leaf's triangles are read from consecutive memory.
 //!
 //! **Traversal.** Iterative, with a fixed stack of [`MAX_DEPTH`] entries: both children's boxes
 //! are tested, the nearer is visited first and the farther pushed with its entry distance; every
@@ -55,7 +53,7 @@ pub const MAX_DEPTH: usize = 64;
 const TRAVERSAL_COST: f32 = 1.0;
 /// Ize's `1 + 2γ₃`, `γ_n = nε/(1 − nε)` with ε = 2⁻²⁴.
 const ROBUST_EXIT: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON / 2.0) / (1.0 - 3.0 * f32::EPSILON / 2.0);
-/// Marks an analytic primitive in [`LeafPrim`]'s index.
+/// Marks an analytic primitive in [`Bvh::order`].
 const ANALYTIC: u32 = 1 << 31;
 
 /// 32 bytes: `lo = (min, first)`, `hi = (max, count)`, with the two integers stored as f32 bits
@@ -84,21 +82,6 @@ impl Node {
     fn count(&self) -> u32 {
         self.hi[3].to_bits()
     }
-}
-
-/// Two siblings in one cache line.
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(64))]
-struct NodePair([Node; 2]);
-
-/// A primitive in leaf order: a triangle's vertices `a, b, c`, with the primitive's index (and
-/// the [`ANALYTIC`] flag for non-triangles, whose vertices are unused) as the bits of `a[3]`.
-#[derive(Clone, Copy, Debug)]
-#[repr(C, align(16))]
-struct LeafPrim {
-    a: [f32; 4],
-    b: [f32; 4],
-    c: [f32; 4],
 }
 
 /// The per-ray constants of the box test.
@@ -136,10 +119,11 @@ impl NodeRay {
 
 /// A bounding volume hierarchy built with the binned SAH.
 pub struct Bvh {
-    /// Node `i` is `pairs[i / 2].0[i % 2]`; the root is node 0 and node 1 is unused, so that
-    /// every pair of siblings starts at an even index.
-    pairs: Vec<NodePair>,
-    leaf_prims: Vec<LeafPrim>,
+    nodes: Vec<Node>,
+    /// Primitive indices in leaf order; [`ANALYTIC`] marks the non-triangles.
+    order: Vec<u32>,
+    /// The triangles' vertices in leaf order (zeros in the slots of analytic primitives).
+    triangles: Vec<[Vec3A; 3]>,
     stats: AccelStats,
 }
 
@@ -247,7 +231,6 @@ impl Bvh {
         if !build.is_empty() {
             let (root_bounds, _) = bounds_of(&build);
             nodes.push(Node::new(&root_bounds, 0, 0));
-            nodes.push(Node::new(&Aabb::EMPTY, 0, 0));
             // (node, start, end, depth): the node's box is already written.
             let mut work = vec![(0usize, 0usize, build.len(), 0usize)];
             while let Some((node, first, end, level)) = work.pop() {
@@ -288,23 +271,19 @@ impl Bvh {
                 }
             }
         }
-        let leaf_prims = build
+        let order: Vec<u32> = build
             .iter()
-            .map(|p| {
-                let (index, [a, b, c]) = match &prims[p.index as usize] {
-                    Primitive::Triangle(tri) => (p.index, tri.positions),
-                    Primitive::Analytic(_) => (p.index | ANALYTIC, [glam::Vec3::ZERO; 3]),
-                };
-                LeafPrim {
-                    a: a.extend(f32::from_bits(index)).to_array(),
-                    b: b.extend(0.0).to_array(),
-                    c: c.extend(0.0).to_array(),
-                }
+            .map(|p| match prims[p.index as usize] {
+                Primitive::Triangle(_) => p.index,
+                Primitive::Analytic(_) => p.index | ANALYTIC,
             })
-            .collect::<Vec<_>>();
-        let pairs: Vec<NodePair> = nodes
-            .chunks(2)
-            .map(|pair| NodePair([pair[0], pair.get(1).copied().unwrap_or(Node::new(&Aabb::EMPTY, 0, 0))]))
+            .collect();
+        let triangles = build
+            .iter()
+            .map(|p| match &prims[p.index as usize] {
+                Primitive::Triangle(tri) => tri.positions.map(Vec3A::from),
+                Primitive::Analytic(_) => [Vec3A::ZERO; 3],
+            })
             .collect();
         let stats = AccelStats {
             name: "bvh (binned SAH)",
@@ -313,10 +292,10 @@ impl Bvh {
             leaves,
             depth,
             references: build.len(),
-            memory_bytes: pairs.len() * size_of::<NodePair>() + leaf_prims.len() * size_of::<LeafPrim>(),
+            memory_bytes: nodes.len() * size_of::<Node>() + build.len() * (4 + size_of::<[Vec3A; 3]>()),
             build_time: start.elapsed(),
         };
-        Bvh { pairs, leaf_prims, stats }
+        Bvh { nodes, order, triangles, stats }
     }
 
     /// Ordered traversal; with `ANY` it returns at the first hit found.
@@ -324,7 +303,7 @@ impl Bvh {
     fn traverse<const ANY: bool>(&self, prims: &[Primitive], ray: &Ray, t_min: f32, mut t_max: f32) -> Option<Hit> {
         let prepared = PreparedRay::new(ray)?;
         let node_ray = NodeRay::new(&prepared);
-        let root = &self.pairs.first()?.0[0];
+        let root = self.nodes.first()?;
         if node_ray.entry(root, t_min, t_max) == f32::INFINITY {
             return None;
         }
@@ -336,10 +315,10 @@ impl Bvh {
             let count = node.count();
             if count > 0 {
                 let first = node.first() as usize;
-                for leaf in &self.leaf_prims[first..first + count as usize] {
-                    let entry = leaf.a[3].to_bits();
+                for k in first..first + count as usize {
+                    let entry = self.order[k];
                     let hit = if entry & ANALYTIC == 0 {
-                        let [a, b, c] = [leaf.a, leaf.b, leaf.c].map(|v| Vec3A::from_vec4(Vec4::from_array(v)));
+                        let [a, b, c] = self.triangles[k];
                         intersect_triangle(&prepared, a, b, c, t_min, t_max)
                     } else {
                         prims[(entry & !ANALYTIC) as usize].intersect_prepared(ray, &prepared, t_min, t_max)
@@ -353,16 +332,17 @@ impl Bvh {
                     }
                 }
             } else {
-                let left = node.first();
-                let pair = &self.pairs[left as usize / 2].0;
-                let (t0, t1) = (node_ray.entry(&pair[0], t_min, t_max), node_ray.entry(&pair[1], t_min, t_max));
-                let (near, far, t_near, t_far) = if t1 < t0 { (1, 0, t1, t0) } else { (0, 1, t0, t1) };
+                let left = node.first() as usize;
+                let (near, far) = (&self.nodes[left], &self.nodes[left + 1]);
+                let (t_near, t_far) = (node_ray.entry(near, t_min, t_max), node_ray.entry(far, t_min, t_max));
+                let (near, far, t_near, t_far) =
+                    if t_far < t_near { (left + 1, left, t_far, t_near) } else { (left, left + 1, t_near, t_far) };
                 if t_near != f32::INFINITY {
                     if t_far != f32::INFINITY {
-                        stack[top] = (left + far, t_far);
+                        stack[top] = (far as u32, t_far);
                         top += 1;
                     }
-                    node = &pair[near as usize];
+                    node = &self.nodes[near];
                     continue;
                 }
             }
@@ -374,7 +354,7 @@ impl Bvh {
                 top -= 1;
                 let (index, entry) = stack[top];
                 if entry < t_max {
-                    node = &self.pairs[index as usize / 2].0[index as usize % 2];
+                    node = &self.nodes[index as usize];
                     break;
                 }
             }
