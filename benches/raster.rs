@@ -42,14 +42,14 @@ fn spot(name: &str, position: Vec3) -> Light {
 /// The median frame time of `scene` with `settings`.
 fn frame_time(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> Duration {
     let mut renderer = Renderer::new(&gpu.device, OUTPUT_FORMAT);
-    let scene_gpu = renderer.upload(gpu, scene);
+    let mut scene_gpu = renderer.upload(gpu, scene);
     let size = (scene.camera.width, scene.camera.height);
     let targets = renderer.targets(&gpu.device, size);
     let output = GpuTexture::target(&gpu.device, "bench::output", size, OUTPUT_FORMAT);
     let mut times = Vec::new();
     for frame in 0..FRAMES + 2 {
         let start = Instant::now();
-        renderer.render(gpu, scene, &scene_gpu, settings, &targets, &output.view);
+        renderer.render(gpu, scene, &mut scene_gpu, settings, &targets, &output.view);
         gpu.wait();
         if frame >= 2 {
             times.push(start.elapsed());

@@ -322,7 +322,8 @@ fn main() {
     };
     let threads = rayon::current_num_threads();
     println!(
-        "mesh: displaced sphere, {} triangles; {} primary rays ({WIDTH}×{HEIGHT}), {} shadow rays; best of {REPEATS}; {threads} threads",
+        "mesh: displaced sphere, {} triangles; {} primary rays ({WIDTH}×{HEIGHT}), {} shadow rays; \
+         best of {REPEATS}; {threads} threads",
         tris.len(),
         primary.len(),
         shadow.len()

@@ -2,9 +2,14 @@
 // for all lights, into the linear HDR target.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
+// The sampler of the chosen texture filter (TECHNIQUES.md §2), and a bilinear one for height maps.
+@group(0) @binding(1) var color_sampler: sampler;
+@group(0) @binding(2) var height_sampler: sampler;
 @group(1) @binding(0) var<uniform> material: Material;
+// sRGB, with its whole mip chain: the sampler decodes to linear before it filters.
 @group(1) @binding(1) var color_texture: texture_2d<f32>;
-@group(1) @binding(2) var color_sampler: sampler;
+// Linear grey levels f_h(u, v); the red channel is the height.
+@group(1) @binding(2) var height_texture: texture_2d<f32>;
 @group(2) @binding(0) var<uniform> object: Object;
 // Group 3: the shadow maps of this frame (pass 1's output) and how to read them.
 @group(3) @binding(0) var<uniform> shadows: Shadows;
@@ -91,18 +96,56 @@ fn visibility(light: Light, p: vec3f, facing: vec3f, pixel: vec2f) -> vec3f {
     return v;
 }
 
+// The height map's red channel at uv, bilinear on level 0.
+fn height_at(uv: vec2f) -> f32 {
+    return textureSampleLevel(height_texture, height_sampler, uv, 0.0).r;
+}
+
+// TECHNIQUES.md §3: finite differences of the height field with step Δ, perturbed tangents
+// t'u = tu + du·n, t'v = tv + dv·n, and n' = normalize(t'u × t'v) turned to n's side.
+fn bumped_normal(n: vec3f, uv: vec2f, tangents: SurfaceTangents) -> vec3f {
+    let delta = frame.bump_delta_texels / vec2f(textureDimensions(height_texture));
+    let g = bump_central_differences(
+        height_at(uv + vec2f(delta.x, 0.0)), height_at(uv - vec2f(delta.x, 0.0)),
+        height_at(uv + vec2f(0.0, delta.y)), height_at(uv - vec2f(0.0, delta.y)),
+        delta, material.bump_scale * frame.bump_scale,
+    );
+    return perturbed_normal(n, tangents.tu, tangents.tv, g.x, g.y);
+}
+
 @fragment
 fn fs_opaque(in: VertexOut) -> @location(0) vec4f {
+    // Screen-space derivatives first, in uniform control flow: the texture's level of detail and
+    // the tangents ∂p/∂u, ∂p/∂v of the surface, from the change of position and uv across pixels.
+    let duv_dx = dpdx(in.uv);
+    let duv_dy = dpdy(in.uv);
+    let tangents = tangents_from_derivatives(dpdx(in.world), dpdy(in.world), duv_dx, duv_dy);
     var color = material.color;
     if material.has_texture != 0u {
-        color *= textureSample(color_texture, color_sampler, in.uv).rgb;
+        if frame.texture_filter == TEXTURE_FILTER_LEVEL_COLOUR {
+            let size = vec2f(textureDimensions(color_texture));
+            let lod = mip_lod(duv_dx, duv_dy, size, frame.lod_bias);
+            color = mip_level_colour(clamp(lod, 0.0, f32(textureNumLevels(color_texture) - 1u)));
+        } else {
+            color *= textureSampleBias(color_texture, color_sampler, in.uv, frame.lod_bias).rgb;
+        }
     }
     let surface = Surface(
         color, material.ka, material.kd, material.ks,
         material.specular_color, material.shininess, material.emission,
     );
     let v = view_vector(in.world);
-    let n = facing_viewer(normalize(in.normal), v);
+    var shading_normal = normalize(in.normal);
+    if frame.bump_enabled != 0u && material.has_height_map != 0u && tangents.valid {
+        shading_normal = bumped_normal(shading_normal, in.uv, tangents);
+    }
+    let n = facing_viewer(shading_normal, v);
+    if frame.bump_view == BUMP_VIEW_NORMALS {
+        return vec4f(0.5 + 0.5 * n, 1.0);
+    }
+    if frame.bump_view == BUMP_VIEW_TANGENTS {
+        return vec4f(0.5 + 0.5 * normalize(tangents.tu), 1.0);
+    }
     var radiance = emitted_and_ambient(surface, frame.ambient, frame.terms);
     var checker = -1.0;
     for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {

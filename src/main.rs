@@ -208,7 +208,7 @@ fn rasterize(scene: &Scene, clock: &mut Stopwatch, timed_frames: bool) -> anyhow
     let gpu = clock.time("device", Gpu::headless)?;
     let mut renderer = clock.time("pipelines", || Renderer::new(&gpu.device, OUTPUT_FORMAT));
     let size = (scene.camera.width, scene.camera.height);
-    let (scene_gpu, targets, output) = clock.time("upload", || {
+    let (mut scene_gpu, targets, output) = clock.time("upload", || {
         let scene_gpu = renderer.upload(&gpu, scene);
         let targets = renderer.targets(&gpu.device, size);
         let output = GpuTexture::target(&gpu.device, "cli::output", size, OUTPUT_FORMAT);
@@ -219,7 +219,7 @@ fn rasterize(scene: &Scene, clock: &mut Stopwatch, timed_frames: bool) -> anyhow
     // an interactive frame costs. `--stats` reports both.
     for lap in ["first frame", "frame"] {
         clock.time(lap, || {
-            renderer.render(&gpu, scene, &scene_gpu, &scene.settings, &targets, &output.view);
+            renderer.render(&gpu, scene, &mut scene_gpu, &scene.settings, &targets, &output.view);
             gpu.wait();
         });
         if !timed_frames {

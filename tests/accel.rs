@@ -98,10 +98,11 @@ fn assert_accelerators_agree(name: &str, prims: &[Primitive], queries: &[(Ray, f
             match (got, want) {
                 (None, None) => {}
                 (Some(g), Some(w)) => {
-                    let tolerance = 1e-4 * w.t.abs().max(1.0);
+                    let tolerance = 1e-4 * w.t.abs() + 1e-6;
                     assert!(
                         (g.t - w.t).abs() <= tolerance,
-                        "{name}, {kind:?}: {r:?} in ({t0}, {t1}) hits primitive {} at t = {}, brute force primitive {} at t = {}",
+                        "{name}, {kind:?}: {r:?} in ({t0}, {t1}) hits primitive {} at t = {}, \
+                         brute force primitive {} at t = {}",
                         g.primitive,
                         g.t,
                         w.primitive,

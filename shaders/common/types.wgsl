@@ -10,6 +10,13 @@ const LIGHT_SPOT: u32 = 2u;
 const ATTENUATION_NONE: u32 = 0u;
 const ATTENUATION_INVERSE_SQUARE: u32 = 1u;
 
+// Frame.texture_filter: how colour textures are sampled (the sampler does the rest).
+const TEXTURE_FILTER_LEVEL_COLOUR: u32 = 5u;
+
+// Frame.bump_view: the bump-mapping teaching views.
+const BUMP_VIEW_NORMALS: u32 = 1u;
+const BUMP_VIEW_TANGENTS: u32 = 2u;
+
 // Bits of Frame.terms: which terms of the illumination model are drawn.
 const TERM_AMBIENT: u32 = 1u;
 const TERM_DIFFUSE: u32 = 2u;
@@ -45,6 +52,16 @@ struct Frame {
     light_count: u32,
     ambient: vec3f,
     terms: u32,
+    texture_filter: u32,
+    lod_bias: f32,
+    bump_enabled: u32,
+    // Multiplies every material's bump scale k.
+    bump_scale: f32,
+    // The finite-difference step Δ in texels of the height map.
+    bump_delta_texels: f32,
+    bump_view: u32,
+    _pad0: f32,
+    _pad1: f32,
     lights: array<Light, MAX_LIGHTS>,
 }
 
@@ -60,10 +77,11 @@ struct Material {
     // 1 when kt > 0: drawn into the transmission maps instead of the depth maps.
     transparent: u32,
     emission: vec3f,
-    _pad0: f32,
+    // k of TECHNIQUES.md §3.
+    bump_scale: f32,
     // kt·MT: what a transparent surface lets through.
     transmission: vec3f,
-    _pad1: f32,
+    has_height_map: u32,
 }
 
 // Group 2: changes per object.

@@ -16,6 +16,7 @@ pub mod scene_gpu;
 pub mod shadow;
 pub mod uniforms;
 
+use crate::gpu::mipmap::MipmapGenerator;
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::{Gpu, readback};
 use crate::scene::Scene;
@@ -36,6 +37,7 @@ pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSr
 /// The passes, built once per device and output format.
 pub struct Renderer {
     pub layouts: SceneLayouts,
+    pub mipmaps: MipmapGenerator,
     pub shadow: ShadowPass,
     projected: ProjectedPass,
     opaque: OpaquePass,
@@ -62,6 +64,7 @@ impl Renderer {
         let shadow = ShadowPass::new(device, &layouts);
         let opaque = OpaquePass::new(device, &layouts, &shadow.input_layout);
         Renderer {
+            mipmaps: MipmapGenerator::new(device),
             projected: ProjectedPass::new(device),
             present: PresentPass::new(device, output_format),
             layouts,
@@ -72,7 +75,7 @@ impl Renderer {
     }
 
     pub fn upload(&self, gpu: &Gpu, scene: &Scene) -> SceneGpu {
-        SceneGpu::upload(gpu, &self.layouts, scene)
+        SceneGpu::upload(gpu, &self.layouts, &self.mipmaps, scene)
     }
 
     pub fn targets(&self, device: &wgpu::Device, size: (u32, u32)) -> FrameTargets {
@@ -90,12 +93,15 @@ impl Renderer {
         &mut self,
         gpu: &Gpu,
         scene: &Scene,
-        scene_gpu: &SceneGpu,
+        scene_gpu: &mut SceneGpu,
         settings: &RenderSettings,
         targets: &FrameTargets,
         output: &wgpu::TextureView,
     ) {
         let (device, queue) = (&gpu.device, &gpu.queue);
+        scene_gpu.prepare_frame_group(device, &self.layouts, &settings.textures);
+        let scene_gpu = &*scene_gpu;
+        let frame_group = scene_gpu.frame_group(&settings.textures);
         let shadows = &settings.shadows;
         let layout = shadow_layout(scene, shadows);
         scene_gpu.update_frame(gpu, scene, &layout.first_layer, settings);
@@ -111,7 +117,7 @@ impl Renderer {
         let projected = shadows.enabled && shadows.method == ShadowMethod::Projected;
         if projected {
             let polygons = projected_shadows(scene, &layout);
-            self.opaque.record_prepass(&mut encoder, scene_gpu, shadow_inputs, &targets.depth.view);
+            self.opaque.record_prepass(&mut encoder, scene_gpu, frame_group, shadow_inputs, &targets.depth.view);
             let clip_from_world = scene.camera.clip_from_world();
             self.projected.record(
                 device,
@@ -128,6 +134,7 @@ impl Renderer {
         self.opaque.record(
             &mut encoder,
             scene_gpu,
+            frame_group,
             shadow_inputs,
             &OpaqueTargets { hdr: &targets.hdr.view, depth: &targets.depth.view, background: scene.background },
             projected,
@@ -168,7 +175,7 @@ impl Headless {
     }
 
     pub fn render(&mut self, gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> image::RgbaImage {
-        self.renderer.render(gpu, scene, &self.scene_gpu, settings, &self.targets, &self.output.view);
+        self.renderer.render(gpu, scene, &mut self.scene_gpu, settings, &self.targets, &self.output.view);
         let (width, height) = self.targets.size;
         let pixels = readback::read_rgba8(&gpu.device, &gpu.queue, &self.output.texture);
         image::RgbaImage::from_raw(width, height, pixels).expect("readback returns width × height RGBA8 pixels")

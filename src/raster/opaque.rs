@@ -92,6 +92,7 @@ impl OpaquePass {
         &self,
         encoder: &mut wgpu::CommandEncoder,
         scene: &SceneGpu,
+        frame_group: &wgpu::BindGroup,
         shadow_inputs: &wgpu::BindGroup,
         depth: &wgpu::TextureView,
     ) {
@@ -109,7 +110,7 @@ impl OpaquePass {
         });
         pass.push_debug_group("opaque depth prepass");
         pass.set_pipeline(&self.prepass);
-        draw_all(&mut pass, scene, shadow_inputs);
+        draw_all(&mut pass, scene, frame_group, shadow_inputs);
         pass.pop_debug_group();
     }
 
@@ -119,6 +120,7 @@ impl OpaquePass {
         &self,
         encoder: &mut wgpu::CommandEncoder,
         scene: &SceneGpu,
+        frame_group: &wgpu::BindGroup,
         shadow_inputs: &wgpu::BindGroup,
         targets: &OpaqueTargets,
         after_prepass: bool,
@@ -147,13 +149,13 @@ impl OpaquePass {
         });
         pass.push_debug_group("opaque");
         pass.set_pipeline(if after_prepass { &self.shade_after_prepass } else { &self.shade });
-        draw_all(&mut pass, scene, shadow_inputs);
+        draw_all(&mut pass, scene, frame_group, shadow_inputs);
         pass.pop_debug_group();
     }
 }
 
-fn draw_all(pass: &mut wgpu::RenderPass<'_>, scene: &SceneGpu, shadow_inputs: &wgpu::BindGroup) {
-    pass.set_bind_group(0, &scene.frame_group, &[]);
+fn draw_all(pass: &mut wgpu::RenderPass<'_>, scene: &SceneGpu, frame_group: &wgpu::BindGroup, shadow_inputs: &wgpu::BindGroup) {
+    pass.set_bind_group(0, frame_group, &[]);
     pass.set_bind_group(3, shadow_inputs, &[]);
     for drawable in &scene.drawables {
         pass.set_bind_group(1, &scene.materials[drawable.material], &[]);

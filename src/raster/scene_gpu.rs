@@ -6,7 +6,10 @@ use wgpu::util::DeviceExt;
 
 use super::uniforms::{GpuFrame, Vertex};
 use crate::gpu::Gpu;
+use crate::gpu::mipmap::{MipmapGenerator, sampler_descriptor, upload_with_mipmaps};
 use crate::gpu::texture::GpuTexture;
+use crate::settings::{TextureFilter, TextureSettings};
+use crate::texture::mipmap::Filter;
 use crate::gpu::uniform::UniformBuffer;
 use crate::scene::{Mesh, Scene};
 use crate::settings::RenderSettings;
@@ -34,31 +37,29 @@ fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGrou
 impl SceneLayouts {
     pub fn new(device: &wgpu::Device) -> SceneLayouts {
         let both = wgpu::ShaderStages::VERTEX_FRAGMENT;
+        let sampler_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        };
         let frame = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::frame_layout"),
-            entries: &[uniform_entry(0, both)],
+            entries: &[uniform_entry(0, both), sampler_entry(1), sampler_entry(2)],
         });
+        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
         let material = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::material_layout"),
-            entries: &[
-                uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
+            entries: &[uniform_entry(0, wgpu::ShaderStages::FRAGMENT), texture_entry(1), texture_entry(2)],
         });
         let object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::object_layout"),
@@ -82,13 +83,15 @@ pub struct Drawable {
 
 pub struct SceneGpu {
     pub frame: UniformBuffer<GpuFrame>,
-    pub frame_group: wgpu::BindGroup,
+    /// Group 0 for each texture filter used so far: the frame uniform and that filter's sampler.
+    frame_groups: Vec<((TextureFilter, u16), wgpu::BindGroup)>,
+    height_sampler: wgpu::Sampler,
     pub materials: Vec<wgpu::BindGroup>,
     pub drawables: Vec<Drawable>,
 }
 
 impl SceneGpu {
-    pub fn upload(gpu: &Gpu, layouts: &SceneLayouts, scene: &Scene) -> SceneGpu {
+    pub fn upload(gpu: &Gpu, layouts: &SceneLayouts, mipmaps: &MipmapGenerator, scene: &Scene) -> SceneGpu {
         let device = &gpu.device;
         if scene.lights.len() > super::uniforms::MAX_LIGHTS {
             log::warn!(
@@ -102,47 +105,32 @@ impl SceneGpu {
             "scene::frame",
             &GpuFrame::new(&scene.camera, scene.ambient, &scene.lights, &[], &scene.settings),
         );
-        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene::frame_group"),
-            layout: &layouts.frame,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: frame.binding() }],
-        });
-
+        // Every texture gets its whole mip chain, averaged in linear space (TECHNIQUES.md §2).
         let textures: Vec<GpuTexture> = scene
             .textures
             .iter()
-            .map(|t| GpuTexture::upload(device, &gpu.queue, &format!("scene::texture {}", t.path.display()), t))
+            .map(|t| upload_with_mipmaps(device, &gpu.queue, mipmaps, &format!("scene::texture {}", t.path.display()), t))
             .collect();
-        let white = GpuTexture::from_rgba8(
-            device,
-            &gpu.queue,
-            "scene::white_texture",
-            (1, 1),
-            &[255; 4],
-            wgpu::TextureFormat::Rgba8UnormSrgb,
-        );
-        // Mipmaps and the sampling modes are the textures issue's; until then, bilinear.
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("scene::color_sampler"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            ..Default::default()
-        });
+        let one_texel = |label, rgba: [u8; 4], format| {
+            GpuTexture::from_rgba8(device, &gpu.queue, label, (1, 1), &rgba, format)
+        };
+        let white = one_texel("scene::white_texture", [255; 4], wgpu::TextureFormat::Rgba8UnormSrgb);
+        let flat = one_texel("scene::flat_height", [0, 0, 0, 255], wgpu::TextureFormat::Rgba8Unorm);
+        let height_sampler = device.create_sampler(&sampler_descriptor(Filter::Bilinear, 1));
         let materials = scene
             .materials
             .iter()
             .map(|m| {
                 let uniform = UniformBuffer::new(device, &format!("scene::material {}", m.name), &m.to_gpu());
-                let view = m.texture.map_or(&white.view, |id| &textures[id.0].view);
+                let color = m.texture.map_or(&white.view, |id| &textures[id.0].view);
+                let height = m.height_map.map_or(&flat.view, |id| &textures[id.0].view);
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some(&format!("scene::material_group {}", m.name)),
                     layout: &layouts.material,
                     entries: &[
                         wgpu::BindGroupEntry { binding: 0, resource: uniform.binding() },
-                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(view) },
-                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&sampler) },
+                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(color) },
+                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(height) },
                     ],
                 })
             })
@@ -171,7 +159,39 @@ impl SceneGpu {
                 }
             })
             .collect();
-        SceneGpu { frame, frame_group, materials, drawables }
+        SceneGpu { frame, frame_groups: Vec::new(), height_sampler, materials, drawables }
+    }
+
+    /// Makes group 0 for `settings`' texture filter, the first time that filter is used.
+    pub fn prepare_frame_group(&mut self, device: &wgpu::Device, layouts: &SceneLayouts, settings: &TextureSettings) {
+        let key = frame_group_key(settings);
+        if self.frame_groups.iter().any(|(k, _)| *k == key) {
+            return;
+        }
+        let filter = match settings.filter {
+            TextureFilter::Nearest => Filter::Nearest,
+            TextureFilter::Bilinear => Filter::Bilinear,
+            TextureFilter::NearestMip => Filter::NearestMip,
+            TextureFilter::Trilinear | TextureFilter::LevelColour | TextureFilter::Anisotropic => Filter::Trilinear,
+        };
+        let sampler = device.create_sampler(&sampler_descriptor(filter, key.1));
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene::frame_group"),
+            layout: &layouts.frame,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: self.frame.binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&sampler) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.height_sampler) },
+            ],
+        });
+        self.frame_groups.push((key, group));
+    }
+
+    /// Group 0 for `settings`' texture filter; [`Self::prepare_frame_group`] made it.
+    pub fn frame_group(&self, settings: &TextureSettings) -> &wgpu::BindGroup {
+        let key = frame_group_key(settings);
+        let (_, group) = self.frame_groups.iter().find(|(k, _)| *k == key).expect("prepare_frame_group() runs first");
+        group
     }
 
     /// Rewrites the per-frame uniform: camera, lights, their shadow layers, and toggles.
@@ -183,6 +203,12 @@ impl SceneGpu {
     pub fn has_transparent(&self) -> bool {
         self.drawables.iter().any(|d| d.transparent)
     }
+}
+
+/// The filter and its anisotropy: what tells frame groups apart.
+fn frame_group_key(settings: &TextureSettings) -> (TextureFilter, u16) {
+    let anisotropy = if settings.filter == TextureFilter::Anisotropic { settings.anisotropy } else { 1 };
+    (settings.filter, anisotropy)
 }
 
 fn mesh_buffers(device: &wgpu::Device, name: &str, mesh: &Mesh) -> (wgpu::Buffer, wgpu::Buffer) {

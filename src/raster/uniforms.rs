@@ -6,7 +6,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
 use crate::scene::{Attenuation, Camera, Light, LightKind, Material, Object, Projection};
-use crate::settings::RenderSettings;
+use crate::settings::{BumpView, RenderSettings, TextureFilter};
 
 pub const MAX_LIGHTS: usize = 16;
 
@@ -60,6 +60,13 @@ pub struct GpuFrame {
     pub light_count: u32,
     pub ambient: [f32; 3],
     pub terms: u32,
+    pub texture_filter: u32,
+    pub lod_bias: f32,
+    pub bump_enabled: u32,
+    pub bump_scale: f32,
+    pub bump_delta_texels: f32,
+    pub bump_view: u32,
+    pub _pad: [f32; 2],
     pub lights: [GpuLight; MAX_LIGHTS],
 }
 
@@ -94,6 +101,24 @@ impl GpuFrame {
             light_count: lights.len().min(MAX_LIGHTS) as u32,
             ambient: ambient.to_array(),
             terms,
+            texture_filter: match settings.textures.filter {
+                TextureFilter::Nearest => 0,
+                TextureFilter::Bilinear => 1,
+                TextureFilter::NearestMip => 2,
+                TextureFilter::Trilinear => 3,
+                TextureFilter::Anisotropic => 4,
+                TextureFilter::LevelColour => 5,
+            },
+            lod_bias: settings.textures.lod_bias,
+            bump_enabled: u32::from(settings.bump.enabled),
+            bump_scale: settings.bump.scale,
+            bump_delta_texels: settings.bump.delta_texels,
+            bump_view: match settings.bump.view {
+                BumpView::Off => 0,
+                BumpView::Normals => 1,
+                BumpView::Tangents => 2,
+            },
+            _pad: [0.0; 2],
             lights: gpu_lights,
         }
     }
@@ -111,9 +136,9 @@ pub struct GpuMaterial {
     pub specular_color: [f32; 3],
     pub transparent: u32,
     pub emission: [f32; 3],
-    pub _pad0: f32,
+    pub bump_scale: f32,
     pub transmission: [f32; 3],
-    pub _pad1: f32,
+    pub has_height_map: u32,
 }
 
 impl Material {
@@ -128,9 +153,9 @@ impl Material {
             specular_color: self.specular_color.to_array(),
             transparent: u32::from(self.is_transparent()),
             emission: self.emission.to_array(),
-            _pad0: 0.0,
+            bump_scale: self.bump_scale,
             transmission: (self.transmission * self.transmission_color).to_array(),
-            _pad1: 0.0,
+            has_height_map: u32::from(self.height_map.is_some()),
         }
     }
 }

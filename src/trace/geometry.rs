@@ -31,8 +31,10 @@
 //!   with a hit when `sdf < ε = SDF_EPSILON·(size + t·|d_l|)` (relative to the object's size and
 //!   to how far the ray has gone, which is where f32 positions lose precision), then refine the
 //!   hit with up to [`SDF_POLISH_STEPS`] safeguarded Newton steps; or miss after the box's exit
-//!   or [`SDF_MAX_STEPS`] steps. A ray starting inside marches on `−sdf` to the far side. Limit: rays that graze the surface converge slowly and may run out of steps,
-//!   eroding silhouettes by a fraction of a pixel.
+//!   or [`SDF_MAX_STEPS`] steps. A ray starting inside marches on `−sdf` to the far side; one
+//!   starting on the surface (a secondary ray) marches away from it first. Limit: rays that
+//!   graze the surface converge slowly and may run out of steps, eroding silhouettes by a
+//!   fraction of a pixel.
 //!
 //! Hit records ([`SurfaceHit`]) are computed once, for the nearest hit only. Their texture
 //! coordinates follow the rasterizer's tessellation in `src/scene/mesh.rs` exactly, so textures

@@ -6,13 +6,16 @@
 //! - [`geometry`]: world-space primitives, exact intersections, hit records.
 //! - [`accel`]: BVH, uniform grid, octree and brute force, which agree on every hit.
 //! - [`whitted`]: the recursion of TECHNIQUES.md §7.
+//! - [`texture`]: mip-mapped texture lookups with ray cones, and bump mapping (§2, §3).
 //! - [`sampling`]: anti-aliasing (centre, regular, jittered, corner rays, adaptive).
 //! - [`render`]: tiles over threads, progress, cancellation, statistics, progressive refinement.
 //!
 //! Where the two renderers should differ, and why: spheres, tori and rounded boxes are exact
 //! here and tessellated in the rasterizer (silhouettes differ by up to the tessellation error);
 //! the rasterizer has no shadows, reflections or refraction until their techniques land; and
-//! only `center` sampling looks at the same points the rasterizer does.
+//! only `center` sampling looks at the same points the rasterizer does; textures pick their mip
+//! level from ray cones here and from screen derivatives there (the same level on a surface
+//! facing the camera, see `texture`).
 
 pub mod accel;
 pub mod geometry;
@@ -23,17 +26,30 @@ pub mod whitted;
 
 use glam::{Vec2, Vec3};
 
-use crate::scene::Scene;
+use crate::scene::{Camera, Projection, Scene};
 use crate::settings::{RenderSettings, TraceSettings};
+use crate::texture::RayCone;
 pub use render::{Cancelled, Progressive, RadianceImage, RenderControl, TraceStats};
+use texture::SceneTextures;
 use whitted::{RayCounts, Whitted};
 
-/// A scene prepared for tracing: primitives and an accelerator, built once.
+/// A scene prepared for tracing: primitives, an accelerator and texture mip chains, built once.
 pub struct Tracer<'s> {
     pub scene: &'s Scene,
     pub settings: TraceSettings,
     pub exposure: f32,
     pub whitted: Whitted<'s>,
+    /// The ray cone every primary ray carries (one pixel, see [`primary_cone`]).
+    pub primary_cone: RayCone,
+}
+
+/// The footprint of one pixel as a ray cone: the angle a pixel subtends for a perspective
+/// camera, a pixel's width (window width / image width) for an orthographic one.
+pub fn primary_cone(camera: &Camera) -> RayCone {
+    match camera.projection {
+        Projection::Perspective => RayCone::perspective(camera.fovy_degrees.to_radians(), camera.height),
+        Projection::Orthographic => RayCone::orthographic(camera.window().0 / camera.width.max(1) as f32),
+    }
 }
 
 impl<'s> Tracer<'s> {
@@ -51,7 +67,11 @@ impl<'s> Tracer<'s> {
                 terms: settings.terms.into(),
                 max_depth: settings.trace.max_depth,
                 shadows: settings.shadows.enabled,
+                textures: SceneTextures::new(scene),
+                texture_settings: settings.textures,
+                bump: settings.bump,
             },
+            primary_cone: primary_cone(&scene.camera),
         }
     }
 
@@ -59,7 +79,7 @@ impl<'s> Tracer<'s> {
     pub fn primary(&self, p: Vec2, counts: &mut RayCounts) -> Vec3 {
         counts.primary += 1;
         let ray = self.scene.camera.ray_through(p.x, p.y);
-        self.whitted.radiance(&ray, 0, counts)
+        self.whitted.radiance(&ray, self.primary_cone, 0, counts)
     }
 
     pub fn accelerator_stats(&self) -> accel::AccelStats {

@@ -1,18 +1,57 @@
-//! Texture lookups for the ray tracer, matching the rasterizer's sampler so the two images agree:
-//! bilinear filtering with repeat wrapping, texel centres at `(i + ½)/width`, and sRGB colour
-//! textures decoded to linear before filtering (as an `Rgba8UnormSrgb` texture is).
+//! Texture lookups and bump mapping for the ray tracer (TECHNIQUES.md §2 and §3), matching the
+//! rasterizer's sampler so the two images agree: repeat wrapping, texel centres at
+//! `(i + ½)/width`, sRGB colour textures decoded to linear before any filtering or averaging.
+//!
+//! **Preparation.** [`SceneTextures::new`] runs once per scene (in `Tracer::new`): a
+//! [`MipChain`] (linear levels down to 1×1, `crate::texture::mipmap`) for every texture some
+//! material uses as its colour texture, and a [`TextureHeight`] (level 0's red channel) for every
+//! texture used as a height map; a texture used as both gets both.
+//!
+//! **Level of detail by ray cones.** Every primary ray carries a [`RayCone`]: the angle one pixel
+//! subtends (`RayCone::perspective(fovy, height)`), or one pixel's width for an orthographic
+//! camera. Mirror and refracted rays continue the cone from the hit (`cone.continued(t)`), so a
+//! texture seen in a mirror is read at the level of its total distance; shadow rays read no
+//! texture and carry none. At a textured hit ([`hit_lod`]) the cone's width at `t`, stretched by
+//! `1/|cos θ|` (`θ` between the ray and the geometric normal: the footprint lies on the actual
+//! surface, which for a smoothed mesh is the flat triangle), gives
+//! `λ = log2 max(w·footprint/|∂p/∂u|, h·footprint/|∂p/∂v|) + lod_bias`
+//! (`crate::texture::lod::lod_from_footprint`). The seed's simpler rule, `λ = log2(d/d₀)` with
+//! `d₀` the distance at which a texel fills a pixel (`lod_from_distance`), is not used: it is
+//! exact only for a surface facing the camera and knows nothing of slant, texture stretch or
+//! bounces. The cone is always one pixel wide, whatever the anti-aliasing: supersampling averages
+//! lookups already filtered over a pixel (slightly blurrier than one ray, like a GPU with MSAA,
+//! which also picks one level per pixel).
+//!
+//! **Filters** (`settings.textures.filter`, [`filter_of`]): nearest and bilinear read level 0
+//! only (bilinear on level 0 is [`sample_bilinear`], the reference kept here); nearest-mip and
+//! trilinear read the chain at `λ`; anisotropic is trilinear here, because the GPU's anisotropic
+//! footprint is left to the implementation and has no exact CPU twin. The level-colour view puts
+//! `level_colour(λ)` (`LEVEL_PALETTE` blended like trilinear, `λ` clamped to the chain's last
+//! level) in place of the textured colour `C`: the material's colour is not multiplied in, as in
+//! the rasterizer. Untextured materials keep their colour.
+//!
+//! **Bump mapping** ([`SceneTextures::shading_normal`]): where bump mapping is on and the material
+//! has a height map, `n' = bump_normal(field, k = bump_scale·settings.scale,
+//! Δ = delta_texels/(w, h), uv, n, ∂p/∂u, ∂p/∂v)` with the hit's analytic tangents (§3's first
+//! source), by central differences on level 0 of the height map (as the GPU's
+//! `textureSampleLevel(…, 0.0)`).
 
 use glam::{Vec2, Vec3};
 
+use super::geometry::SurfaceHit;
 use crate::output::srgb_decode;
-use crate::scene::{ColorSpace, Texture};
+use crate::scene::{ColorSpace, Material, Scene, Texture, TextureId};
+use crate::settings::{BumpSettings, TextureFilter, TextureSettings};
+use crate::texture::{BumpParams, Filter, MipChain, RayCone, TextureHeight, bump_normal, lod_from_footprint};
 
-/// The linear RGB value of `texture` at `uv`, bilinearly filtered with repeat wrapping.
+/// The linear RGB value of `texture` at `uv`, bilinearly filtered with repeat wrapping: level 0
+/// of the chain read with [`Filter::Bilinear`], written out on the stored bytes (the reference
+/// that the mip chain's bilinear filter is checked against).
 pub fn sample_bilinear(texture: &Texture, uv: Vec2) -> Vec3 {
     let (w, h) = (texture.width as i64, texture.height as i64);
     let x = uv.x * w as f32 - 0.5;
     let y = uv.y * h as f32 - 0.5;
-    if !(x.is_finite() && y.is_finite()) {
+    if !(x.is_finite() && y.is_finite()) || w == 0 || h == 0 {
         return Vec3::ZERO;
     }
     let (x0, y0) = (x.floor(), y.floor());
@@ -20,8 +59,11 @@ pub fn sample_bilinear(texture: &Texture, uv: Vec2) -> Vec3 {
     let texel = |i: i64, j: i64| -> Vec3 {
         let (i, j) = (i.rem_euclid(w) as usize, j.rem_euclid(h) as usize);
         let at = 4 * (j * texture.width as usize + i);
-        let rgb =
-            Vec3::new(texture.rgba8[at] as f32, texture.rgba8[at + 1] as f32, texture.rgba8[at + 2] as f32) / 255.0;
+        let Some(bytes) = texture.rgba8.get(at..at + 3) else {
+            // Short pixel data (a malformed file) reads as black, as in `MipLevel::from_texture`.
+            return Vec3::ZERO;
+        };
+        let rgb = Vec3::new(bytes[0] as f32, bytes[1] as f32, bytes[2] as f32) / 255.0;
         match texture.color_space {
             ColorSpace::Srgb => Vec3::new(srgb_decode(rgb.x), srgb_decode(rgb.y), srgb_decode(rgb.z)),
             ColorSpace::Linear => rgb,
@@ -31,6 +73,123 @@ pub fn sample_bilinear(texture: &Texture, uv: Vec2) -> Vec3 {
     let top = texel(i, j).lerp(texel(i + 1, j), fx);
     let bottom = texel(i, j + 1).lerp(texel(i + 1, j + 1), fx);
     top.lerp(bottom, fy)
+}
+
+/// The CPU filter for a texture setting. Anisotropic filtering has no CPU twin (the GPU's
+/// footprint shape and tap count are the implementation's), so the tracer reads it as trilinear:
+/// the same level, blurrier than the GPU along the footprint's short axis.
+pub fn filter_of(filter: TextureFilter) -> Filter {
+    match filter {
+        TextureFilter::Nearest => Filter::Nearest,
+        TextureFilter::Bilinear => Filter::Bilinear,
+        TextureFilter::NearestMip => Filter::NearestMip,
+        TextureFilter::Trilinear | TextureFilter::Anisotropic => Filter::Trilinear,
+        TextureFilter::LevelColour => Filter::LevelColour,
+    }
+}
+
+/// The level of detail of a lookup in a `size`-texel texture at `hit`, reached by a ray along
+/// the unit vector `direction` that carries `cone`: the cone's footprint on the surface
+/// (stretched by `1/|cos θ|` against the geometric normal) in texels along `u` and `v`.
+pub fn hit_lod(cone: &RayCone, direction: Vec3, hit: &SurfaceHit, size: (u32, u32), bias: f32) -> f32 {
+    let footprint = cone.footprint(hit.t, direction.dot(hit.geometric_normal));
+    lod_from_footprint(footprint, hit.dpdu.length(), hit.dpdv.length(), size, bias)
+}
+
+/// The scene's textures as the tracer reads them, indexed by [`TextureId`].
+#[derive(Clone, Debug, Default)]
+pub struct SceneTextures {
+    chains: Vec<Option<MipChain>>,
+    heights: Vec<Option<TextureHeight>>,
+}
+
+impl SceneTextures {
+    /// Mip chains of the colour textures and height fields of the height maps that the scene's
+    /// materials use. A texture with no texels (which no loader produces) gets neither, and reads
+    /// as untextured.
+    pub fn new(scene: &Scene) -> SceneTextures {
+        let count = scene.textures.len();
+        let (mut chains, mut heights) = (vec![None; count], vec![None; count]);
+        let usable = |id: TextureId| scene.textures.get(id.0).filter(|t| t.width > 0 && t.height > 0);
+        for material in &scene.materials {
+            if let Some(id) = material.texture
+                && let Some(texture) = usable(id)
+                && chains[id.0].is_none()
+            {
+                chains[id.0] = Some(MipChain::build(texture));
+            }
+            if let Some(id) = material.height_map
+                && let Some(texture) = usable(id)
+                && heights[id.0].is_none()
+            {
+                heights[id.0] = Some(TextureHeight::new(texture));
+            }
+        }
+        SceneTextures { chains, heights }
+    }
+
+    /// The mip chain of colour texture `id`, if a material uses it as one.
+    pub fn chain(&self, id: TextureId) -> Option<&MipChain> {
+        self.chains.get(id.0).and_then(Option::as_ref)
+    }
+
+    /// The height field of height map `id`, if a material uses it as one.
+    pub fn height(&self, id: TextureId) -> Option<&TextureHeight> {
+        self.heights.get(id.0).and_then(Option::as_ref)
+    }
+
+    /// The level of detail the colour texture of `material` is read at, or `None` when the
+    /// material has no (usable) colour texture.
+    pub fn lod(
+        &self,
+        material: &Material,
+        hit: &SurfaceHit,
+        direction: Vec3,
+        cone: &RayCone,
+        settings: &TextureSettings,
+    ) -> Option<f32> {
+        let chain = self.chain(material.texture?)?;
+        let level0 = &chain.levels[0];
+        Some(hit_lod(cone, direction, hit, (level0.width, level0.height), settings.lod_bias))
+    }
+
+    /// `C(p)`: the material's colour times its filtered texture at the hit, or the level colour
+    /// in place of both under the level-colour view.
+    pub fn colour(
+        &self,
+        material: &Material,
+        hit: &SurfaceHit,
+        direction: Vec3,
+        cone: &RayCone,
+        settings: &TextureSettings,
+    ) -> Vec3 {
+        let Some(chain) = material.texture.and_then(|id| self.chain(id)) else {
+            return material.color;
+        };
+        let level0 = &chain.levels[0];
+        let lod = hit_lod(cone, direction, hit, (level0.width, level0.height), settings.lod_bias);
+        let filter = filter_of(settings.filter);
+        let texel = chain.sample(hit.uv, lod, filter).truncate();
+        if filter == Filter::LevelColour { texel } else { material.color * texel }
+    }
+
+    /// The shading normal at the hit, not yet turned to the viewer: bump-mapped where bump
+    /// mapping is on and the material has a height map, `hit.normal` otherwise.
+    pub fn shading_normal(&self, material: &Material, hit: &SurfaceHit, settings: &BumpSettings) -> Vec3 {
+        if !settings.enabled {
+            return hit.normal;
+        }
+        let Some(field) = material.height_map.and_then(|id| self.height(id)) else {
+            return hit.normal;
+        };
+        let size = Vec2::new(field.level.width as f32, field.level.height as f32);
+        let params = BumpParams {
+            k: material.bump_scale * settings.scale,
+            delta: Some(Vec2::splat(settings.delta_texels) / size),
+            analytic: false,
+        };
+        bump_normal(field, &params, hit.uv, hit.normal, hit.dpdu, hit.dpdv)
+    }
 }
 
 #[cfg(test)]
@@ -52,5 +211,53 @@ mod tests {
         // Repeat wrapping: u = 1.0 sits between the last texel and the first.
         assert!(sample_bilinear(&t, Vec2::new(1.0, 0.5)).abs_diff_eq(Vec3::splat(0.5), 1e-6));
         assert!(sample_bilinear(&t, Vec2::new(-0.25, 0.5)).abs_diff_eq(Vec3::ONE, 1e-6));
+    }
+
+    #[test]
+    fn chain_bilinear_on_level_0_is_the_reference() {
+        // A 5×3 pattern (odd sizes, both colour spaces) read at texel centres, edges, wrap-arounds.
+        let bytes: Vec<u8> = (0..5 * 3 * 4).map(|i| (i * 37 % 256) as u8).collect();
+        for space in [ColorSpace::Srgb, ColorSpace::Linear] {
+            let t = texture(bytes.clone(), 5, space);
+            let chain = MipChain::build(&t);
+            for uv in [Vec2::new(0.1, 0.5), Vec2::new(0.0, 0.0), Vec2::new(0.93, 0.71), Vec2::new(-1.37, 2.2)] {
+                for lod in [0.0, 3.5] {
+                    let got = chain.sample(uv, lod, Filter::Bilinear).truncate();
+                    assert!(got.abs_diff_eq(sample_bilinear(&t, uv), 1e-6), "{space:?} at {uv}: {got}");
+                }
+                let trilinear = chain.sample(uv, 0.0, Filter::Trilinear).truncate();
+                assert!(trilinear.abs_diff_eq(sample_bilinear(&t, uv), 1e-6), "trilinear at λ = 0, {uv}");
+            }
+        }
+    }
+
+    #[test]
+    fn anisotropic_reads_as_trilinear_and_level_colour_maps_through() {
+        assert_eq!(filter_of(TextureFilter::Anisotropic), Filter::Trilinear);
+        assert_eq!(filter_of(TextureFilter::LevelColour), Filter::LevelColour);
+        assert_eq!(filter_of(TextureFilter::NearestMip), Filter::NearestMip);
+    }
+
+    #[test]
+    fn frontal_hit_lod_is_log2_of_texels_per_footprint() {
+        // A 64-texel texture over 2 units, hit head-on at t = 10 by a cone of 1/100 rad:
+        // footprint 0.1 units = 3.2 texels.
+        let hit = SurfaceHit {
+            t: 10.0,
+            point: Vec3::ZERO,
+            geometric_normal: Vec3::Z,
+            normal: Vec3::Z,
+            uv: Vec2::ZERO,
+            dpdu: 2.0 * Vec3::X,
+            dpdv: -2.0 * Vec3::Y,
+            material: crate::scene::MaterialId(0),
+            object: 0,
+        };
+        let cone = RayCone { width: 0.0, spread: 0.01 };
+        let lod = hit_lod(&cone, -Vec3::Z, &hit, (64, 64), 0.0);
+        assert!((lod - 3.2f32.log2()).abs() < 1e-5, "{lod}");
+        // The bias adds, and a 60° incidence doubles the footprint.
+        let slanted = hit_lod(&cone, Vec3::new(0.0, 3f32.sqrt() / 2.0, -0.5), &hit, (64, 64), 0.25);
+        assert!((slanted - lod - 1.25).abs() < 1e-5, "{slanted}");
     }
 }

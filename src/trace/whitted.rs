@@ -21,14 +21,28 @@
 //!   the side they leave towards, along the geometric normal: `ε = 1e-4·max(1, |p|∞)`, which
 //!   scales with the scene's coordinates (a fixed ε is too small far from the origin, where
 //!   `f32` spacing grows). Rays then accept hits from `t > 0`.
+//! - **Textures and bumps** (TECHNIQUES.md §2, §3; `super::texture`). Every ray that can see a
+//!   texture carries a [`RayCone`]: the primary ray the camera's, the mirror and refracted rays
+//!   that cone continued from the hit, so a texture seen in a mirror is filtered for its whole
+//!   path length; shadow rays carry none. The bump-mapped normal `n'` replaces the shading normal
+//!   in the local model and in the mirror and refraction directions, but not in the
+//!   self-intersection offset, which follows the geometric surface the ray actually leaves.
+//!   `n'` is built on the unturned `hit.normal` and then turned to the viewer's side of the
+//!   *unperturbed* normal: one relief seen from either side (a bump from the front is a dent from
+//!   the back), and a tilted `n'` at a grazing angle is never flipped by its own tilt.
+//! - **Teaching views** (`settings.bump.view`) replace the radiance of primary hits, with no
+//!   lighting or recursion: `normals` shows `0.5 + 0.5·n` for the final shading normal (bumped,
+//!   turned to the viewer), `tangents` shows `0.5 + 0.5·normalize(∂p/∂u)`.
 
 use glam::Vec3;
 
 use super::accel::Accelerator;
 use super::geometry::{Primitive, SurfaceHit};
-use super::texture::sample_bilinear;
+use super::texture::SceneTextures;
 use crate::scene::shading::{SurfaceSample, Terms, direct, emitted_and_ambient, facing_viewer};
 use crate::scene::{Ray, Scene};
+use crate::settings::{BumpSettings, BumpView, TextureSettings};
+use crate::texture::RayCone;
 
 /// Rays traced, by kind.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -54,8 +68,8 @@ impl std::ops::AddAssign for RayCounts {
     }
 }
 
-/// The scene as the tracer sees it: primitives, an accelerator over them, and the lights and
-/// materials of the scene.
+/// The scene as the tracer sees it: primitives, an accelerator over them, the lights and
+/// materials of the scene, and its textures prepared for filtering.
 pub struct Whitted<'s> {
     pub scene: &'s Scene,
     pub primitives: Vec<Primitive>,
@@ -64,6 +78,10 @@ pub struct Whitted<'s> {
     pub max_depth: u32,
     /// Whether shadow rays are cast; without them every light is visible everywhere.
     pub shadows: bool,
+    /// Mip chains and height fields, built once per scene.
+    pub textures: SceneTextures,
+    pub texture_settings: TextureSettings,
+    pub bump: BumpSettings,
 }
 
 /// How far a new ray starts off the surface it leaves.
@@ -72,25 +90,42 @@ pub fn surface_offset(p: Vec3) -> f32 {
 }
 
 impl Whitted<'_> {
-    /// The radiance arriving at `ray.origin` from `ray.direction` (`RayTracing(o, u, n)`).
-    pub fn radiance(&self, ray: &Ray, depth: u32, counts: &mut RayCounts) -> Vec3 {
+    /// The radiance arriving at `ray.origin` from `ray.direction` (`RayTracing(o, u, n)`); `cone`
+    /// is the ray's footprint, for texture filtering.
+    pub fn radiance(&self, ray: &Ray, cone: RayCone, depth: u32, counts: &mut RayCounts) -> Vec3 {
         let Some(hit) = self.accelerator.closest(&self.primitives, ray, 0.0, f32::INFINITY) else {
             return self.scene.background;
         };
         let surface = self.primitives[hit.primitive as usize].surface(ray, hit.t);
-        self.shade(ray, &surface, depth, counts)
+        self.shade(ray, cone, &surface, depth, counts)
+    }
+
+    /// The level of detail at which the nearest hit of `ray` (carrying `cone`) reads its colour
+    /// texture, or `None` if the ray misses or the surface has no texture: the value the shader
+    /// uses, for tests and teaching.
+    pub fn texture_lod(&self, ray: &Ray, cone: RayCone) -> Option<f32> {
+        let hit = self.accelerator.closest(&self.primitives, ray, 0.0, f32::INFINITY)?;
+        let surface = self.primitives[hit.primitive as usize].surface(ray, hit.t);
+        let material = &self.scene.materials[surface.material.0];
+        self.textures.lod(material, &surface, ray.direction, &cone, &self.texture_settings)
     }
 
     /// `EvaluaMILRec`: the local model at the hit plus the mirror and transmission terms.
-    fn shade(&self, ray: &Ray, hit: &SurfaceHit, depth: u32, counts: &mut RayCounts) -> Vec3 {
+    fn shade(&self, ray: &Ray, cone: RayCone, hit: &SurfaceHit, depth: u32, counts: &mut RayCounts) -> Vec3 {
         let material = &self.scene.materials[hit.material.0];
-        let color = match material.texture {
-            Some(id) => material.color * sample_bilinear(&self.scene.textures[id.0], hit.uv),
-            None => material.color,
-        };
-        let sample = SurfaceSample::new(material, color);
         let v = -ray.direction;
-        let n = facing_viewer(hit.normal, v);
+        // Bumped on the unturned normal, then turned to the side the unperturbed normal faces.
+        let bumped = self.textures.shading_normal(material, hit, &self.bump);
+        let n = if hit.normal.dot(v) < 0.0 { -bumped } else { bumped };
+        if depth == 0 {
+            match self.bump.view {
+                BumpView::Off => {}
+                BumpView::Normals => return 0.5 + 0.5 * n,
+                BumpView::Tangents => return 0.5 + 0.5 * hit.dpdu.normalize_or_zero(),
+            }
+        }
+        let color = self.textures.colour(material, hit, ray.direction, &cone, &self.texture_settings);
+        let sample = SurfaceSample::new(material, color);
         // The geometric normal on the viewer's side: secondary rays leave along it or against it.
         let outside = facing_viewer(hit.geometric_normal, v);
         let offset = surface_offset(hit.point);
@@ -111,6 +146,7 @@ impl Whitted<'_> {
             return rad;
         }
         let reflected = 2.0 * n.dot(v) * n - v;
+        let cone = cone.continued(hit.t);
         let mut reflect_weight = material.mirror * material.mirror_color;
         if material.transmission > 0.0 {
             let weight = material.transmission * material.transmission_color;
@@ -118,7 +154,7 @@ impl Whitted<'_> {
                 Some(t) => {
                     counts.refracted += 1;
                     let origin = hit.point - offset * outside;
-                    rad += weight * self.radiance(&Ray { origin, direction: t }, depth + 1, counts);
+                    rad += weight * self.radiance(&Ray { origin, direction: t }, cone, depth + 1, counts);
                 }
                 None => reflect_weight += weight,
             }
@@ -126,7 +162,7 @@ impl Whitted<'_> {
         if reflect_weight != Vec3::ZERO {
             counts.reflected += 1;
             let origin = hit.point + offset * outside;
-            rad += reflect_weight * self.radiance(&Ray { origin, direction: reflected }, depth + 1, counts);
+            rad += reflect_weight * self.radiance(&Ray { origin, direction: reflected }, cone, depth + 1, counts);
         }
         rad
     }
