@@ -35,6 +35,35 @@ fn shadow_stage_with_projected_polygons() {
     common::assert_golden("shadows-projected", &common::raster(&scene, &settings), MAX_FLIP_MEAN);
 }
 
+/// The showcase's floor running to the horizon, in each texture filter (TECHNIQUES.md §2).
+#[test]
+fn floor_in_every_texture_filter() {
+    use mirador::settings::TextureFilter;
+    let mut scene = common::load("scenes/showcase.toml");
+    (scene.camera.width, scene.camera.height) = (320, 180);
+    // Look down the floor, away from the wall and the objects.
+    scene.camera.eye = glam::Vec3::new(2.0, 1.2, 8.0);
+    scene.camera.center = glam::Vec3::new(6.0, 0.2, -20.0);
+    for (name, filter) in [
+        ("floor-nearest", TextureFilter::Nearest),
+        ("floor-bilinear", TextureFilter::Bilinear),
+        ("floor-nearest-mip", TextureFilter::NearestMip),
+        ("floor-trilinear", TextureFilter::Trilinear),
+        ("floor-anisotropic", TextureFilter::Anisotropic),
+        ("floor-level-colour", TextureFilter::LevelColour),
+    ] {
+        let mut settings = scene.settings.clone();
+        settings.textures.filter = filter;
+        common::assert_golden(name, &common::raster(&scene, &settings), MAX_FLIP_MEAN);
+    }
+}
+
+#[test]
+fn bump_mapped_tile_and_ball() {
+    let scene = common::load("scenes/bumps.toml");
+    common::assert_golden("bumps", &common::raster(&scene, &scene.settings), MAX_FLIP_MEAN);
+}
+
 /// The threshold is meaningful: small but visible changes to the scene exceed it.
 #[test]
 fn the_threshold_catches_visible_changes() {

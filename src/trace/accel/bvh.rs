@@ -102,17 +102,30 @@ impl NodeRay {
         NodeRay { origin: ray.origin, inv_direction: ray.inv_direction, negative }
     }
 
+    /// Whether a direction component is zero (or so small that its inverse overflows): only
+    /// then can `0·∞ = NaN` arise, and only then does the box test need to pick the near plane
+    /// by the direction's sign instead of taking the smaller of the two slab distances.
+    fn needs_careful_slabs(&self) -> bool {
+        !self.inv_direction.is_finite()
+    }
+
     /// The entry distance into the node's box within `[t_min, t_max]`, or ∞ on a miss.
     #[inline(always)]
-    fn entry(&self, node: &Node, t_min: f32, t_max: f32) -> f32 {
+    fn entry<const CAREFUL: bool>(&self, node: &Node, t_min: f32, t_max: f32) -> f32 {
         let lo = Vec3A::from_vec4(Vec4::from_array(node.lo));
         let hi = Vec3A::from_vec4(Vec4::from_array(node.hi));
-        let near = (Vec3A::select(self.negative, hi, lo) - self.origin) * self.inv_direction;
-        let far = (Vec3A::select(self.negative, lo, hi) - self.origin) * self.inv_direction * ROBUST_EXIT;
+        let (near, far) = if CAREFUL {
+            let near = (Vec3A::select(self.negative, hi, lo) - self.origin) * self.inv_direction;
+            let far = (Vec3A::select(self.negative, lo, hi) - self.origin) * self.inv_direction;
+            (near, far)
+        } else {
+            let (a, b) = ((lo - self.origin) * self.inv_direction, (hi - self.origin) * self.inv_direction);
+            (a.min(b), a.max(b))
+        };
         // `max(x, t_min)` with x first: where x is NaN (0·∞, the origin on a slab plane of a
         // ray parallel to it) the lane takes t_min, i.e. that slab does not constrain the ray.
         let enter = near.max(Vec3A::splat(t_min)).max_element();
-        let exit = far.min(Vec3A::splat(t_max)).min_element();
+        let exit = (far * ROBUST_EXIT).min(Vec3A::splat(t_max)).min_element();
         if enter <= exit { enter } else { f32::INFINITY }
     }
 }
@@ -298,13 +311,20 @@ impl Bvh {
         Bvh { nodes, order, triangles, stats }
     }
 
-    /// Ordered traversal; with `ANY` it returns at the first hit found.
+    /// Iterative traversal: nearer child first for the closest hit; with `ANY` in tree order,
+    /// returning at the first hit found.
     #[inline(always)]
-    fn traverse<const ANY: bool>(&self, prims: &[Primitive], ray: &Ray, t_min: f32, mut t_max: f32) -> Option<Hit> {
-        let prepared = PreparedRay::new(ray)?;
-        let node_ray = NodeRay::new(&prepared);
+    fn traverse<const ANY: bool, const CAREFUL: bool>(
+        &self,
+        prims: &[Primitive],
+        ray: &Ray,
+        prepared: &PreparedRay,
+        node_ray: &NodeRay,
+        t_min: f32,
+        mut t_max: f32,
+    ) -> Option<Hit> {
         let root = self.nodes.first()?;
-        if node_ray.entry(root, t_min, t_max) == f32::INFINITY {
+        if node_ray.entry::<CAREFUL>(root, t_min, t_max) == f32::INFINITY {
             return None;
         }
         let mut best = None;
@@ -319,9 +339,9 @@ impl Bvh {
                     let entry = self.order[k];
                     let hit = if entry & ANALYTIC == 0 {
                         let [a, b, c] = self.triangles[k];
-                        intersect_triangle(&prepared, a, b, c, t_min, t_max)
+                        intersect_triangle(prepared, a, b, c, t_min, t_max)
                     } else {
-                        prims[(entry & !ANALYTIC) as usize].intersect_prepared(ray, &prepared, t_min, t_max)
+                        prims[(entry & !ANALYTIC) as usize].intersect_prepared(ray, prepared, t_min, t_max)
                     };
                     if let Some(t) = hit {
                         best = Some(Hit { t, primitive: entry & !ANALYTIC });
@@ -333,17 +353,30 @@ impl Bvh {
                 }
             } else {
                 let left = node.first() as usize;
-                let (near, far) = (&self.nodes[left], &self.nodes[left + 1]);
-                let (t_near, t_far) = (node_ray.entry(near, t_min, t_max), node_ray.entry(far, t_min, t_max));
-                let (near, far, t_near, t_far) =
-                    if t_far < t_near { (left + 1, left, t_far, t_near) } else { (left, left + 1, t_near, t_far) };
-                if t_near != f32::INFINITY {
-                    if t_far != f32::INFINITY {
-                        stack[top] = (far as u32, t_far);
-                        top += 1;
+                let (t_left, t_right) = (
+                    node_ray.entry::<CAREFUL>(&self.nodes[left], t_min, t_max),
+                    node_ray.entry::<CAREFUL>(&self.nodes[left + 1], t_min, t_max),
+                );
+                // Any hit ends a shadow ray, so it need not look nearest first.
+                let (near, far, t_near, t_far) = if !ANY && t_right < t_left {
+                    (left + 1, left, t_right, t_left)
+                } else {
+                    (left, left + 1, t_left, t_right)
+                };
+                match (t_near != f32::INFINITY, t_far != f32::INFINITY) {
+                    (true, far_hit) => {
+                        if far_hit {
+                            stack[top] = (far as u32, t_far);
+                            top += 1;
+                        }
+                        node = &self.nodes[near];
+                        continue;
                     }
-                    node = &self.nodes[near];
-                    continue;
+                    (false, true) => {
+                        node = &self.nodes[far];
+                        continue;
+                    }
+                    (false, false) => {}
                 }
             }
             // Next: the nearest pending node that still starts before the nearest hit.
@@ -364,11 +397,25 @@ impl Bvh {
 
 impl Accelerator for Bvh {
     fn closest(&self, prims: &[Primitive], ray: &Ray, t_min: f32, t_max: f32) -> Option<Hit> {
-        self.traverse::<false>(prims, ray, t_min, t_max)
+        let prepared = PreparedRay::new(ray)?;
+        let node_ray = NodeRay::new(&prepared);
+        if node_ray.needs_careful_slabs() {
+            self.traverse::<false, true>(prims, ray, &prepared, &node_ray, t_min, t_max)
+        } else {
+            self.traverse::<false, false>(prims, ray, &prepared, &node_ray, t_min, t_max)
+        }
     }
 
     fn occluded(&self, prims: &[Primitive], ray: &Ray, t_min: f32, t_max: f32) -> bool {
-        self.traverse::<true>(prims, ray, t_min, t_max).is_some()
+        let Some(prepared) = PreparedRay::new(ray) else {
+            return false;
+        };
+        let node_ray = NodeRay::new(&prepared);
+        if node_ray.needs_careful_slabs() {
+            self.traverse::<true, true>(prims, ray, &prepared, &node_ray, t_min, t_max).is_some()
+        } else {
+            self.traverse::<true, false>(prims, ray, &prepared, &node_ray, t_min, t_max).is_some()
+        }
     }
 
     fn stats(&self) -> AccelStats {
