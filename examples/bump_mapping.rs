@@ -49,11 +49,15 @@ fn main() -> anyhow::Result<()> {
     panels.push(Panel::new("height field f_h", mirador::raster::render_image(&gpu, &heights, &flat_heights)));
 
     for scale in [0.5, 1.0, 2.0] {
-        panels.push(Panel::new(format!("bumped, k × {scale}"), headless.render(&gpu, &scene, &with(&|s| s.bump.scale = scale))));
+        panels.push(Panel::new(
+            format!("bumped, k × {scale}"),
+            headless.render(&gpu, &scene, &with(&|s| s.bump.scale = scale)),
+        ));
     }
     panels.push(Panel::new("normals", headless.render(&gpu, &scene, &with(&|s| s.bump.view = BumpView::Normals))));
     panels.push(Panel::new("ray traced", mirador::trace::render_image(&scene, &base)));
-    mirador::output::write_png_atomically(&sheet(&panels), &out).with_context(|| format!("writing {}", out.display()))?;
+    mirador::output::write_png_atomically(&sheet(&panels), &out)
+        .with_context(|| format!("writing {}", out.display()))?;
     println!("wrote {}", out.display());
     Ok(())
 }

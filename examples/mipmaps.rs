@@ -15,11 +15,11 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
+use mirador::Scene;
 use mirador::compare::sheet::{Panel, sheet};
 use mirador::gpu::Gpu;
 use mirador::raster::Headless;
 use mirador::settings::TextureFilter;
-use mirador::Scene;
 
 const EXPLANATION: &str = "\
 The showcase's checkered floor runs to the horizon. nearest: one texel per pixel, moiré |
@@ -47,7 +47,8 @@ fn main() -> anyhow::Result<()> {
         panels.push(Panel::new(label, headless.render(&gpu, &scene, &settings)));
     }
     panels.push(Panel::new("ray traced (ray cones)", mirador::trace::render_image(&scene, &scene.settings)));
-    mirador::output::write_png_atomically(&sheet(&panels), &out).with_context(|| format!("writing {}", out.display()))?;
+    mirador::output::write_png_atomically(&sheet(&panels), &out)
+        .with_context(|| format!("writing {}", out.display()))?;
     println!("wrote {}", out.display());
     Ok(())
 }

@@ -41,35 +41,48 @@ fn main() -> anyhow::Result<()> {
         change(&mut settings);
         settings
     };
-    let mut raster = |label: &str, settings: RenderSettings| Panel::new(label, headless.render(&gpu, &scene, &settings));
+    let mut raster =
+        |label: &str, settings: RenderSettings| Panel::new(label, headless.render(&gpu, &scene, &settings));
 
     let top = vec![
         raster("no shadows", variant(&|s| s.shadows.enabled = false)),
-        raster("map 256², no PCF", variant(&|s| {
-            s.shadows.map_size = 256;
-            s.shadows.filter = ShadowFilter::None;
-        })),
-        raster("map 2048², PCF 3×3", variant(&|s| {
-            s.shadows.map_size = 2048;
-            s.shadows.filter = ShadowFilter::Pcf3x3;
-        })),
+        raster(
+            "map 256², no PCF",
+            variant(&|s| {
+                s.shadows.map_size = 256;
+                s.shadows.filter = ShadowFilter::None;
+            }),
+        ),
+        raster(
+            "map 2048², PCF 3×3",
+            variant(&|s| {
+                s.shadows.map_size = 2048;
+                s.shadows.filter = ShadowFilter::Pcf3x3;
+            }),
+        ),
         raster("projected polygons", variant(&|s| s.shadows.method = ShadowMethod::Projected)),
         Panel::new("ray traced", mirador::trace::render_image(&scene, &base)),
     ];
     let bottom = vec![
-        raster("acne: no bias", variant(&|s| {
-            s.shadows.depth_bias = 0;
-            s.shadows.slope_bias = 0.0;
-            s.shadows.normal_offset = 0.0;
-            s.shadows.filter = ShadowFilter::None;
-            s.shadows.map_size = 512;
-        })),
+        raster(
+            "acne: no bias",
+            variant(&|s| {
+                s.shadows.depth_bias = 0;
+                s.shadows.slope_bias = 0.0;
+                s.shadows.normal_offset = 0.0;
+                s.shadows.filter = ShadowFilter::None;
+                s.shadows.map_size = 512;
+            }),
+        ),
         raster("peter-panning: depth bias 2000", variant(&|s| s.shadows.depth_bias = 2000)),
         raster("the spot light's map", variant(&|s| s.shadows.view = ShadowView::Map)),
-        raster("map texels on receivers", variant(&|s| {
-            s.shadows.map_size = 256;
-            s.shadows.view = ShadowView::Texels;
-        })),
+        raster(
+            "map texels on receivers",
+            variant(&|s| {
+                s.shadows.map_size = 256;
+                s.shadows.view = ShadowView::Texels;
+            }),
+        ),
     ];
     let image = rows(&[sheet(&top), sheet(&bottom)]);
     mirador::output::write_png_atomically(&image, &out).with_context(|| format!("writing {}", out.display()))?;

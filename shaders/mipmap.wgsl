@@ -29,11 +29,9 @@ fn mip_box_taps(j: i32, n: i32) -> MipTaps {
     return MipTaps(2 * j, 3, vec3f(f32(h - j) / nf, f32(h) / nf, f32(j + 1) / nf));
 }
 
-// One triangle that covers the target: vertices at (-1,-1), (3,-1), (-1,3).
 @vertex
 fn vs_mipmap(@builtin(vertex_index) index: u32) -> @builtin(position) vec4f {
-    let uv = vec2f(f32((index << 1u) & 2u), f32(index & 2u));
-    return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
+    return fullscreen_position(index);
 }
 
 struct MipmapOut {

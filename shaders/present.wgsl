@@ -11,11 +11,9 @@ struct Present {
 @group(0) @binding(0) var hdr: texture_2d<f32>;
 @group(0) @binding(1) var<uniform> present: Present;
 
-// One triangle that covers the screen: vertices at (-1,-1), (3,-1), (-1,3).
 @vertex
 fn vs_present(@builtin(vertex_index) index: u32) -> @builtin(position) vec4f {
-    let uv = vec2f(f32((index << 1u) & 2u), f32(index & 2u));
-    return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
+    return fullscreen_position(index);
 }
 
 @fragment

@@ -44,8 +44,7 @@ struct ShownLayer {
 
 @vertex
 fn vs_shadow_map_view(@builtin(vertex_index) index: u32) -> @builtin(position) vec4f {
-    let uv = vec2f(f32((index << 1u) & 2u), f32(index & 2u));
-    return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
+    return fullscreen_position(index);
 }
 
 @fragment

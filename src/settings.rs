@@ -312,17 +312,26 @@ impl RenderSettings {
         }
         let textures = &self.textures;
         if !(1..=16).contains(&textures.anisotropy) {
-            return Err(SettingsError::Invalid(format!("textures.anisotropy must lie in 1..=16, got {}", textures.anisotropy)));
+            return Err(SettingsError::Invalid(format!(
+                "textures.anisotropy must lie in 1..=16, got {}",
+                textures.anisotropy
+            )));
         }
         if !(textures.lod_bias.is_finite() && textures.lod_bias.abs() <= 8.0) {
-            return Err(SettingsError::Invalid(format!("textures.lod_bias must lie in −8..=8, got {}", textures.lod_bias)));
+            return Err(SettingsError::Invalid(format!(
+                "textures.lod_bias must lie in −8..=8, got {}",
+                textures.lod_bias
+            )));
         }
         let bump = &self.bump;
         if !bump.scale.is_finite() {
             return Err(SettingsError::Invalid(format!("bump.scale must be finite, got {}", bump.scale)));
         }
         if !(bump.delta_texels.is_finite() && bump.delta_texels > 0.0 && bump.delta_texels <= 64.0) {
-            return Err(SettingsError::Invalid(format!("bump.delta_texels must lie in (0, 64], got {}", bump.delta_texels)));
+            return Err(SettingsError::Invalid(format!(
+                "bump.delta_texels must lie in (0, 64], got {}",
+                bump.delta_texels
+            )));
         }
         let shadows = &self.shadows;
         if !(256..=4096).contains(&shadows.map_size) {

@@ -11,6 +11,7 @@ pub const COMMON: &[(&str, &str)] = &[
 
 pub const OPAQUE: &str = include_str!("../shaders/opaque.wgsl");
 pub const PRESENT: &str = include_str!("../shaders/present.wgsl");
+pub const MIPMAP: &str = include_str!("../shaders/mipmap.wgsl");
 pub const SHADOW: &str = include_str!("../shaders/shadow.wgsl");
 pub const SHADOW_PROJECTED: &str = include_str!("../shaders/shadow_projected.wgsl");
 

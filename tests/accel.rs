@@ -184,7 +184,7 @@ fn height_field(n: u32) -> Mesh {
 /// `Mesh::sphere`, whose duplicated seam vertices differ by sin(2π) in f32.
 fn welded_sphere(slices: u32, stacks: u32) -> Mesh {
     let mut mesh = Mesh { name: "welded sphere".into(), ..Mesh::default() };
-    let mut push = |p: Vec3, mesh: &mut Mesh| {
+    let push = |p: Vec3, mesh: &mut Mesh| {
         mesh.positions.push(p);
         mesh.normals.push(p.normalize());
         mesh.uvs.push(Vec2::ZERO);

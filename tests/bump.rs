@@ -13,7 +13,6 @@ use mirador::texture::lod::lod_from_uv_derivatives;
 use mirador::texture::mipmap::level_colour;
 use mirador::texture::perturbed_normal;
 use mirador::texture::tangents::{mesh_tangents, normal_map_normal, tangents_from_edges, triangle_tangents};
-use wgpu::util::DeviceExt;
 
 /// xorshift32: reproducible inputs without a dependency.
 struct Rng(u32);
@@ -148,63 +147,8 @@ fn cases() -> Vec<ProbeCase> {
 }
 
 fn wgsl_results(cases: &[ProbeCase]) -> Vec<ProbeResult> {
-    let gpu = common::gpu();
-    let device = &gpu.device;
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("bump_probe::shader"),
-        source: wgpu::ShaderSource::Wgsl(probe_source().into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("bump_probe::pipeline"),
-        layout: None,
-        module: &module,
-        entry_point: Some("cs_bump_probe"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("bump_probe::cases"),
-        contents: bytemuck::cast_slice(cases),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let size = (std::mem::size_of::<ProbeResult>() * cases.len()) as u64;
-    let output = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("bump_probe::results"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("bump_probe::staging"),
-        size,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("bump_probe::bind_group"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
-        ],
-    });
-    let mut encoder =
-        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("bump_probe::encoder") });
-    {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("bump_probe::pass"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups(cases.len() as u32, 1, 1);
-    }
-    encoder.copy_buffer_to_buffer(&output, 0, &staging, 0, size);
-    gpu.queue.submit([encoder.finish()]);
-    staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping the probe results"));
-    gpu.wait();
-    let view = staging.slice(..).get_mapped_range().expect("mapped above");
-    bytemuck::cast_slice(&view).to_vec()
+    let bindings = common::ProbeBindings { input: 0, output: 1, extra: &[] };
+    common::run_probe("bump_probe", &probe_source(), "cs_bump_probe", cases, bindings)
 }
 
 fn v3(a: [f32; 4]) -> Vec3 {

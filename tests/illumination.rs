@@ -9,7 +9,6 @@ use glam::Vec3;
 use mirador::raster::uniforms::GpuLight;
 use mirador::scene::shading::{SurfaceSample, Terms, local_illumination};
 use mirador::scene::{Attenuation, Light, LightKind};
-use wgpu::util::DeviceExt;
 
 #[derive(Clone)]
 struct Case {
@@ -152,65 +151,11 @@ fn rust_model(c: &Case) -> Vec3 {
 }
 
 fn wgsl_model(cases: &[Case]) -> Vec<Vec3> {
-    let gpu = common::gpu();
-    let device = &gpu.device;
     let source = mirador::shaders::compose(include_str!("shaders/illumination_probe.wgsl"));
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("illumination_probe::shader"),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("illumination_probe::pipeline"),
-        layout: None,
-        module: &module,
-        entry_point: Some("cs_illumination_probe"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
     let inputs: Vec<ProbeCase> = cases.iter().map(ProbeCase::from).collect();
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("illumination_probe::cases"),
-        contents: bytemuck::cast_slice(&inputs),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let size = (16 * cases.len()) as u64;
-    let output = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("illumination_probe::results"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("illumination_probe::staging"),
-        size,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("illumination_probe::bind_group"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry { binding: 0, resource: input.as_entire_binding() },
-            wgpu::BindGroupEntry { binding: 1, resource: output.as_entire_binding() },
-        ],
-    });
-    let mut encoder =
-        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("illumination_probe::encoder") });
-    {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("illumination_probe::pass"),
-            timestamp_writes: None,
-        });
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups(cases.len() as u32, 1, 1);
-    }
-    encoder.copy_buffer_to_buffer(&output, 0, &staging, 0, size);
-    gpu.queue.submit([encoder.finish()]);
-    staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping the probe results"));
-    gpu.wait();
-    let view = staging.slice(..).get_mapped_range().expect("mapped above");
-    let values: &[[f32; 4]] = bytemuck::cast_slice(&view);
+    let bindings = common::ProbeBindings { input: 0, output: 1, extra: &[] };
+    let values: Vec<[f32; 4]> =
+        common::run_probe("illumination_probe", &source, "cs_illumination_probe", &inputs, bindings);
     values.iter().map(|v| Vec3::new(v[0], v[1], v[2])).collect()
 }
 

@@ -11,7 +11,6 @@ use mirador::gpu::mipmap::{
 use mirador::output::srgb_decode;
 use mirador::scene::{ColorSpace, Texture};
 use mirador::texture::mipmap::{Filter, LEVEL_PALETTE, MipChain, MipLevel, level_colour};
-use wgpu::util::DeviceExt;
 
 fn texture(width: u32, height: u32, rgba8: Vec<u8>, color_space: ColorSpace) -> Texture {
     assert_eq!(rgba8.len(), (4 * width * height) as usize);
@@ -304,66 +303,16 @@ fn gpu_sampler_matches_cpu_sampling() {
             cases.push([uv.x, uv.y, lod, 0.0]);
         }
     }
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("sampling_probe::shader"),
-        source: wgpu::ShaderSource::Wgsl(SAMPLING_PROBE.into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("sampling_probe::pipeline"),
-        layout: None,
-        module: &module,
-        entry_point: Some("cs_sampling_probe"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("sampling_probe::cases"),
-        contents: bytemuck::cast_slice(&cases),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let size = (16 * cases.len()) as u64;
     for filter in [Filter::Nearest, Filter::Bilinear, Filter::NearestMip, Filter::Trilinear] {
         let sampler = device.create_sampler(&sampler_descriptor(filter, 1));
-        let output = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sampling_probe::results"),
-            size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("sampling_probe::staging"),
-            size,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("sampling_probe::bind_group"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&uploaded.view) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&sampler) },
-                wgpu::BindGroupEntry { binding: 2, resource: input.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: output.as_entire_binding() },
-            ],
-        });
-        let mut encoder =
-            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sampling_probe::encoder") });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("sampling_probe::pass"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &group, &[]);
-            pass.dispatch_workgroups(cases.len() as u32, 1, 1);
-        }
-        encoder.copy_buffer_to_buffer(&output, 0, &staging, 0, size);
-        gpu.queue.submit([encoder.finish()]);
-        staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping the sampling results"));
-        gpu.wait();
-        let view = staging.slice(..).get_mapped_range().expect("mapped above");
-        let results: &[[f32; 4]] = bytemuck::cast_slice(&view);
-        for (c, r) in cases.iter().zip(results) {
+        let extra = [
+            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&uploaded.view) },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&sampler) },
+        ];
+        let bindings = common::ProbeBindings { input: 2, output: 3, extra: &extra };
+        let results: Vec<[f32; 4]> =
+            common::run_probe("sampling_probe", SAMPLING_PROBE, "cs_sampling_probe", &cases, bindings);
+        for (c, r) in cases.iter().zip(&results) {
             let cpu = chain.sample(Vec2::new(c[0], c[1]), c[2], filter);
             let got = Vec4::from_array(*r);
             // Hardware blends with a few bits of weight precision (8 on most devices).

@@ -6,6 +6,7 @@
 use std::path::Path;
 
 use glam::{Vec2, Vec3};
+use mirador::RenderSettings;
 use mirador::scene::file::parse;
 use mirador::scene::{Ray, Scene};
 use mirador::settings::{AntiAliasing, BumpView, TextureFilter};
@@ -13,7 +14,6 @@ use mirador::texture::mipmap::level_colour;
 use mirador::texture::{HeightField, LEVEL_PALETTE, MipChain, TextureHeight};
 use mirador::trace::whitted::RayCounts;
 use mirador::trace::{RadianceImage, RenderControl, Tracer};
-use mirador::RenderSettings;
 
 fn texture_path(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("assets").join("textures").join(name).display().to_string()
@@ -144,8 +144,6 @@ fn floor_text(repeats: u32) -> String {
         checker = texture_path("checker.png"),
     )
 }
-
-
 
 /// The level of detail the tracer reads the texture at through image point `(x, y)`.
 fn lod_at(tracer: &Tracer, scene: &Scene, x: f32, y: f32) -> Option<f32> {
@@ -452,6 +450,19 @@ fn normal_and_tangent_views() {
     settings.bump = mirador::settings::BumpSettings { enabled: false, view: BumpView::Normals, ..settings.bump };
     let image = render(&below, &settings);
     assert!(image.pixels.iter().all(|&p| p == Vec3::new(0.5, 0.0, 0.5)), "{:?}", &image.pixels[..3]);
+
+    // Bumped, from below: the same relief, one surface seen from its other side (a bump from
+    // above is a dent from below), so the normal is the one seen from above, negated. The camera
+    // below sees x mirrored: its pixel (127 − i, j) looks at the point pixel (i, j) sees above.
+    settings.bump.enabled = true;
+    let from_below = render(&below, &settings);
+    let from_above = bump_render(0.04, true, BumpView::Normals);
+    for j in 0..128 {
+        for i in 0..128 {
+            let (up, down) = (pixel(&from_above, i, j), pixel(&from_below, 127 - i, j));
+            assert!(down.abs_diff_eq(1.0 - up, 1e-6), "pixel ({i}, {j}): {down} from below, {up} from above");
+        }
+    }
 
     // With bumps, the view shows the very normal the shading uses: the lit image is
     // max(0, n'·l) with n' = 2·view − 1.

@@ -48,7 +48,11 @@ fn bump_central_differences(u_plus: f32, u_minus: f32, v_plus: f32, v_minus: f32
 // texture coordinates (t_u × t_v along −n) move the bumps but never invert them. n is unit;
 // t_u, t_v are ∂p/∂u, ∂p/∂v of any length. Degenerate tangents return n.
 fn perturbed_normal(n: vec3f, tu: vec3f, tv: vec3f, du: f32, dv: f32) -> vec3f {
-    let m = cross(tu + du * n, tv + dv * n);
+    // The tangents are first laid in the plane of n: a smooth-shaded mesh's interpolated n is
+    // not perpendicular to its flat facets' tangents, and t'u × t'v would bring the facets back.
+    let su = tu - dot(tu, n) * n;
+    let sv = tv - dot(tv, n) * n;
+    let m = cross(su + du * n, sv + dv * n);
     let len = length(m);
     if !(len > 0.0) || len > 3.0e38 {
         return n;

@@ -90,3 +90,10 @@ struct Object {
     // Inverse transpose of world_from_local's upper 3×3, stored as a 4×4 for alignment.
     normal_from_local: mat4x4f,
 }
+
+// One triangle covering the screen, for passes that work per pixel: vertices at (−1, −1),
+// (3, −1), (−1, 3) in clip space, for vertex_index 0, 1, 2.
+fn fullscreen_position(index: u32) -> vec4f {
+    let uv = vec2f(f32((index << 1u) & 2u), f32(index & 2u));
+    return vec4f(uv * 2.0 - 1.0, 0.0, 1.0);
+}

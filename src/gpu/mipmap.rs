@@ -37,8 +37,6 @@ use crate::scene::{ColorSpace, Texture};
 use crate::shaders;
 use crate::texture::mipmap::Filter;
 
-const SHADER: &str = include_str!("../../shaders/mipmap.wgsl");
-
 /// How many levels a full chain of a `width × height` texture has, `⌊log2 max(w, h)⌋ + 1`: the
 /// `mip_level_count` to create it with.
 pub fn mip_level_count(width: u32, height: u32) -> u32 {
@@ -76,7 +74,7 @@ pub struct MipmapGenerator {
 
 impl MipmapGenerator {
     pub fn new(device: &wgpu::Device) -> MipmapGenerator {
-        let module = shaders::module(device, "mipmap::shader", SHADER);
+        let module = shaders::module(device, "mipmap::shader", shaders::MIPMAP);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("mipmap::bind_group_layout"),
             entries: &[wgpu::BindGroupLayoutEntry {

@@ -154,7 +154,12 @@ impl OpaquePass {
     }
 }
 
-fn draw_all(pass: &mut wgpu::RenderPass<'_>, scene: &SceneGpu, frame_group: &wgpu::BindGroup, shadow_inputs: &wgpu::BindGroup) {
+fn draw_all(
+    pass: &mut wgpu::RenderPass<'_>,
+    scene: &SceneGpu,
+    frame_group: &wgpu::BindGroup,
+    shadow_inputs: &wgpu::BindGroup,
+) {
     pass.set_bind_group(0, frame_group, &[]);
     pass.set_bind_group(3, shadow_inputs, &[]);
     for drawable in &scene.drawables {

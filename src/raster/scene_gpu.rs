@@ -5,14 +5,14 @@
 use wgpu::util::DeviceExt;
 
 use super::uniforms::{GpuFrame, Vertex};
-use crate::gpu::Gpu;
 use crate::gpu::mipmap::{MipmapGenerator, sampler_descriptor, upload_with_mipmaps};
 use crate::gpu::texture::GpuTexture;
-use crate::settings::{TextureFilter, TextureSettings};
-use crate::texture::mipmap::Filter;
 use crate::gpu::uniform::UniformBuffer;
+use crate::gpu::{Gpu, layout};
 use crate::scene::{Mesh, Scene};
 use crate::settings::RenderSettings;
+use crate::settings::{TextureFilter, TextureSettings};
+use crate::texture::mipmap::Filter;
 
 /// The bind group layouts every scene pass shares.
 pub struct SceneLayouts {
@@ -21,49 +21,24 @@ pub struct SceneLayouts {
     pub object: wgpu::BindGroupLayout,
 }
 
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 impl SceneLayouts {
     pub fn new(device: &wgpu::Device) -> SceneLayouts {
         let both = wgpu::ShaderStages::VERTEX_FRAGMENT;
-        let sampler_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-            count: None,
-        };
         let frame = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::frame_layout"),
-            entries: &[uniform_entry(0, both), sampler_entry(1), sampler_entry(2)],
+            entries: &[
+                layout::uniform(0, both),
+                layout::sampler(1, wgpu::SamplerBindingType::Filtering),
+                layout::sampler(2, wgpu::SamplerBindingType::Filtering),
+            ],
         });
-        let texture_entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
         let material = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::material_layout"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::FRAGMENT), texture_entry(1), texture_entry(2)],
+            entries: &[layout::uniform(0, wgpu::ShaderStages::FRAGMENT), layout::texture_2d(1), layout::texture_2d(2)],
         });
         let object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::object_layout"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
+            entries: &[layout::uniform(0, wgpu::ShaderStages::VERTEX)],
         });
         SceneLayouts { frame, material, object }
     }
@@ -109,11 +84,12 @@ impl SceneGpu {
         let textures: Vec<GpuTexture> = scene
             .textures
             .iter()
-            .map(|t| upload_with_mipmaps(device, &gpu.queue, mipmaps, &format!("scene::texture {}", t.path.display()), t))
+            .map(|t| {
+                upload_with_mipmaps(device, &gpu.queue, mipmaps, &format!("scene::texture {}", t.path.display()), t)
+            })
             .collect();
-        let one_texel = |label, rgba: [u8; 4], format| {
-            GpuTexture::from_rgba8(device, &gpu.queue, label, (1, 1), &rgba, format)
-        };
+        let one_texel =
+            |label, rgba: [u8; 4], format| GpuTexture::from_rgba8(device, &gpu.queue, label, (1, 1), &rgba, format);
         let white = one_texel("scene::white_texture", [255; 4], wgpu::TextureFormat::Rgba8UnormSrgb);
         let flat = one_texel("scene::flat_height", [0, 0, 0, 255], wgpu::TextureFormat::Rgba8Unorm);
         let height_sampler = device.create_sampler(&sampler_descriptor(Filter::Bilinear, 1));

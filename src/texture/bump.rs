@@ -92,6 +92,10 @@ pub fn height_gradient(field: &dyn HeightField, uv: Vec2, params: &BumpParams) -
 /// the perturbed tangents are degenerate (parallel, zero, or not finite). WGSL twin:
 /// `perturbed_normal`.
 pub fn perturbed_normal(n: Vec3, tu: Vec3, tv: Vec3, du: f32, dv: f32) -> Vec3 {
+    // The tangents are first laid in the plane of n: a smooth-shaded mesh's interpolated n is
+    // not perpendicular to its flat facets' tangents, and t'u × t'v would bring the facets back.
+    // On analytic surfaces they already lie there, and nothing changes.
+    let (tu, tv) = (tu - tu.dot(n) * n, tv - tv.dot(n) * n);
     let m = (tu + du * n).cross(tv + dv * n);
     let length = m.length();
     if !(length > 0.0 && length.is_finite()) {

@@ -27,9 +27,11 @@
 //!   path length; shadow rays carry none. The bump-mapped normal `n'` replaces the shading normal
 //!   in the local model and in the mirror and refraction directions, but not in the
 //!   self-intersection offset, which follows the geometric surface the ray actually leaves.
-//!   `n'` is built on the unturned `hit.normal` and then turned to the viewer's side of the
-//!   *unperturbed* normal: one relief seen from either side (a bump from the front is a dent from
-//!   the back), and a tilted `n'` at a grazing angle is never flipped by its own tilt.
+//!   `n'` is built on the unturned `hit.normal` and then turned to the viewer
+//!   (`facing_viewer(n', v)`, as the rasterizer's fragment shader does), so a plane seen from
+//!   below shows the same relief as from above, mirrored: a bump from the front is a dent from
+//!   the back. (Where a bump tilts `n'` past the view direction, at grazing angles, the turn
+//!   flips it; both renderers do the same.)
 //! - **Teaching views** (`settings.bump.view`) replace the radiance of primary hits, with no
 //!   lighting or recursion: `normals` shows `0.5 + 0.5·n` for the final shading normal (bumped,
 //!   turned to the viewer), `tangents` shows `0.5 + 0.5·normalize(∂p/∂u)`.
@@ -114,9 +116,8 @@ impl Whitted<'_> {
     fn shade(&self, ray: &Ray, cone: RayCone, hit: &SurfaceHit, depth: u32, counts: &mut RayCounts) -> Vec3 {
         let material = &self.scene.materials[hit.material.0];
         let v = -ray.direction;
-        // Bumped on the unturned normal, then turned to the side the unperturbed normal faces.
-        let bumped = self.textures.shading_normal(material, hit, &self.bump);
-        let n = if hit.normal.dot(v) < 0.0 { -bumped } else { bumped };
+        // Bumped on the unturned normal, then turned to the viewer, exactly as the rasterizer.
+        let n = facing_viewer(self.textures.shading_normal(material, hit, &self.bump), v);
         if depth == 0 {
             match self.bump.view {
                 BumpView::Off => {}

@@ -30,6 +30,7 @@ use wgpu::util::DeviceExt;
 use super::scene_gpu::{SceneGpu, SceneLayouts};
 use super::uniforms::Vertex;
 use super::{DEPTH_FORMAT, HDR_FORMAT};
+use crate::gpu::layout;
 use crate::gpu::uniform::UniformBuffer;
 use crate::settings::{ShadowFilter, ShadowMethod, ShadowSettings, ShadowView};
 use crate::shaders;
@@ -202,38 +203,12 @@ pub struct ShadowPass {
     frusta: Frusta,
 }
 
-fn texture_entry(
-    binding: u32,
-    sample_type: wgpu::TextureSampleType,
-    dimension: wgpu::TextureViewDimension,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Texture { sample_type, view_dimension: dimension, multisampled: false },
-        count: None,
-    }
-}
-
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 impl ShadowPass {
     pub fn new(device: &wgpu::Device, scene_layouts: &SceneLayouts) -> ShadowPass {
         let module = shaders::module(device, "shadow::shader", shaders::SHADOW);
         let layer_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow::layer_layout"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
+            entries: &[layout::uniform(0, wgpu::ShaderStages::VERTEX)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow::layout"),
@@ -296,26 +271,20 @@ impl ShadowPass {
         let input_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow::input_layout"),
             entries: &[
-                uniform_entry(0, wgpu::ShaderStages::FRAGMENT),
-                texture_entry(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
-                    count: None,
-                },
-                texture_entry(
+                layout::uniform(0, wgpu::ShaderStages::FRAGMENT),
+                layout::texture(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
+                layout::sampler(2, wgpu::SamplerBindingType::Comparison),
+                layout::sampler(3, wgpu::SamplerBindingType::Comparison),
+                layout::texture(
                     4,
                     wgpu::TextureSampleType::Float { filterable: false },
                     wgpu::TextureViewDimension::D2Array,
                 ),
-                texture_entry(5, wgpu::TextureSampleType::Float { filterable: false }, wgpu::TextureViewDimension::D2),
+                layout::texture(
+                    5,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    wgpu::TextureViewDimension::D2,
+                ),
             ],
         });
         let comparison = |label, filter| {
@@ -554,8 +523,8 @@ impl MapView {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow::map_view_layout"),
             entries: &[
-                texture_entry(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
-                uniform_entry(2, wgpu::ShaderStages::FRAGMENT),
+                layout::texture(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
+                layout::uniform(2, wgpu::ShaderStages::FRAGMENT),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -640,7 +609,7 @@ impl Frusta {
     fn new(device: &wgpu::Device, module: &wgpu::ShaderModule) -> Frusta {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow::frusta_layout"),
-            entries: &[uniform_entry(3, wgpu::ShaderStages::VERTEX)],
+            entries: &[layout::uniform(3, wgpu::ShaderStages::VERTEX)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow::frusta_pipeline_layout"),

@@ -18,6 +18,7 @@ use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use super::views::ShadowLayout;
+use crate::gpu::layout;
 use crate::gpu::uniform::UniformBuffer;
 use crate::raster::DEPTH_FORMAT;
 use crate::scene::{LightKind, Scene, Shape};
@@ -176,16 +177,7 @@ impl ProjectedPass {
         let module = shaders::module(device, "shadow_projected::shader", shaders::SHADOW_PROJECTED);
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow_projected::layout"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
+            entries: &[layout::uniform(0, wgpu::ShaderStages::VERTEX)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow_projected::pipeline_layout"),

@@ -186,7 +186,13 @@ pub fn shadow_layout(scene: &Scene, settings: &ShadowSettings) -> ShadowLayout {
         match light.kind {
             LightKind::Directional { direction } => {
                 let (clip_from_world, texel_size) = directional_view(scene, settings, direction);
-                layout.views.push(LightView { light: index, clip_from_world, perspective: false, texel_size, depth_ratio: 0.0 });
+                layout.views.push(LightView {
+                    light: index,
+                    clip_from_world,
+                    perspective: false,
+                    texel_size,
+                    depth_ratio: 0.0,
+                });
             }
             LightKind::Spot { position, direction, outer, .. } => {
                 let fov = (2.0 * outer + 4.0 / size).clamp(0.01, std::f32::consts::PI - 0.01);

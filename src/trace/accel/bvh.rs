@@ -143,74 +143,149 @@ pub struct Bvh {
 /// What the build needs of a primitive: its box and where it came from.
 #[derive(Clone, Copy)]
 struct BuildPrim {
-    min: Vec3A,
-    max: Vec3A,
+    bounds: Bounds,
     index: u32,
 }
 
-impl BuildPrim {
+/// A box in SIMD registers, for the build's inner loops.
+#[derive(Clone, Copy)]
+struct Bounds {
+    min: Vec3A,
+    max: Vec3A,
+}
+
+impl Bounds {
+    const EMPTY: Bounds = Bounds { min: Vec3A::INFINITY, max: Vec3A::NEG_INFINITY };
+
+    #[inline(always)]
+    fn union(self, other: Bounds) -> Bounds {
+        Bounds { min: self.min.min(other.min), max: self.max.max(other.max) }
+    }
+
+    #[inline(always)]
+    fn including(self, p: Vec3A) -> Bounds {
+        Bounds { min: self.min.min(p), max: self.max.max(p) }
+    }
+
     #[inline(always)]
     fn centroid(&self) -> Vec3A {
         0.5 * (self.min + self.max)
     }
+
+    /// Half the surface area (the SAH only compares ratios); 0 for an empty box.
+    #[inline(always)]
+    fn half_area(&self) -> f32 {
+        let d = (self.max - self.min).max(Vec3A::ZERO);
+        d.x * d.y + d.y * d.z + d.z * d.x
+    }
+
+    fn to_aabb(self) -> Aabb {
+        Aabb::new(self.min.into(), self.max.into())
+    }
 }
 
+/// Primitives gathered in a bin, or on one side of a split: their boxes' union, their
+/// centroids' box and how many there are.
 #[derive(Clone, Copy)]
-struct Bin {
-    bounds: Aabb,
+struct Group {
+    bounds: Bounds,
+    centroids: Bounds,
     count: usize,
 }
 
-fn bounds_of(prims: &[BuildPrim]) -> (Aabb, Aabb) {
-    let (mut bounds, mut centroids) = (Aabb::EMPTY, Aabb::EMPTY);
-    for p in prims {
-        bounds = Aabb::new(bounds.min.min(p.min.into()), bounds.max.max(p.max.into()));
-        centroids = centroids.including(p.centroid().into());
+impl Group {
+    const EMPTY: Group = Group { bounds: Bounds::EMPTY, centroids: Bounds::EMPTY, count: 0 };
+
+    fn of(prims: &[BuildPrim]) -> Group {
+        prims.iter().fold(Group::EMPTY, |g, p| g.with(p))
     }
-    (bounds, centroids)
+
+    #[inline(always)]
+    fn with(self, p: &BuildPrim) -> Group {
+        Group {
+            bounds: self.bounds.union(p.bounds),
+            centroids: self.centroids.including(p.bounds.centroid()),
+            count: self.count + 1,
+        }
+    }
+
+    #[inline(always)]
+    fn union(self, other: &Group) -> Group {
+        Group {
+            bounds: self.bounds.union(other.bounds),
+            centroids: self.centroids.union(other.centroids),
+            count: self.count + other.count,
+        }
+    }
+
+    /// `A·N`, the SAH's weight of this side of a split.
+    fn cost(&self) -> f32 {
+        self.bounds.half_area() * self.count as f32
+    }
 }
 
-/// The best SAH split of `prims` along `axis` of the centroid box: `(cost, bin)` where bins
-/// `0..=bin` go left, or `None` if the centroids do not spread along the axis.
-fn best_split(prims: &[BuildPrim], centroids: &Aabb, axis: usize) -> Option<(f32, usize)> {
-    let (lo, extent) = (centroids.min[axis], centroids.max[axis] - centroids.min[axis]);
-    if !(extent > 0.0) {
+/// A chosen split: bins `0..=bin` along `axis` go left.
+struct Split {
+    axis: usize,
+    lo: f32,
+    scale: f32,
+    bin: usize,
+    /// `(A(L)·N(L) + A(R)·N(R)) / A(P)`.
+    cost: f32,
+    left: Group,
+    right: Group,
+}
+
+/// The bin of a primitive whose centroid is `c`, along `axis`.
+#[inline(always)]
+fn bin_index(c: Vec3A, axis: usize, lo: f32, scale: f32) -> usize {
+    let x = match axis {
+        0 => c.x,
+        1 => c.y,
+        _ => c.z,
+    };
+    ((x - lo) * scale).min((BINS - 1) as f32) as usize
+}
+
+/// The best SAH split of `prims` (whose union is `node`) between bins along the longest axis of
+/// their centroids' box, or `None` if the centroids coincide.
+fn best_split(prims: &[BuildPrim], node: &Group) -> Option<Split> {
+    let extent = node.centroids.max - node.centroids.min;
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    if !(extent[axis] > 0.0) {
         return None;
     }
-    let scale = BINS as f32 / extent;
-    let mut bins = [Bin { bounds: Aabb::EMPTY, count: 0 }; BINS];
+    let (lo, scale) = (node.centroids.min[axis], BINS as f32 / extent[axis]);
+    let mut bins = [Group::EMPTY; BINS];
     for p in prims {
-        let b = bin_index(p.centroid()[axis], lo, scale);
-        bins[b].count += 1;
-        bins[b].bounds = Aabb::new(bins[b].bounds.min.min(p.min.into()), bins[b].bounds.max.max(p.max.into()));
+        let b = bin_index(p.bounds.centroid(), axis, lo, scale);
+        bins[b] = bins[b].with(p);
     }
-    // right_cost[i]: A·N of bins i+1.. (the right side of the plane after bin i).
-    let mut right_cost = [0.0; BINS];
-    let (mut bounds, mut count) = (Aabb::EMPTY, 0);
-    for i in (1..BINS).rev() {
-        bounds = bounds.union(&bins[i].bounds);
-        count += bins[i].count;
-        right_cost[i - 1] = bounds.surface_area() * count as f32;
+    // right[i]: bins i+1.., the right side of the plane after bin i.
+    let mut right = [Group::EMPTY; BINS];
+    for i in (0..BINS - 1).rev() {
+        right[i] = right[i + 1].union(&bins[i + 1]);
     }
-    let (mut bounds, mut count) = (Aabb::EMPTY, 0);
-    let mut best: Option<(f32, usize)> = None;
+    let mut left = Group::EMPTY;
+    let mut best: Option<Split> = None;
+    let area = node.bounds.half_area().max(f32::MIN_POSITIVE);
     for i in 0..BINS - 1 {
-        bounds = bounds.union(&bins[i].bounds);
-        count += bins[i].count;
-        if count == 0 || count == prims.len() {
+        left = left.union(&bins[i]);
+        if left.count == 0 || right[i].count == 0 {
             continue;
         }
-        let cost = bounds.surface_area() * count as f32 + right_cost[i];
-        if best.is_none_or(|(c, _)| cost < c) {
-            best = Some((cost, i));
+        let cost = (left.cost() + right[i].cost()) / area;
+        if best.as_ref().is_none_or(|b| cost < b.cost) {
+            best = Some(Split { axis, lo, scale, bin: i, cost, left, right: right[i] });
         }
     }
     best
-}
-
-#[inline(always)]
-fn bin_index(x: f32, lo: f32, scale: f32) -> usize {
-    (((x - lo) * scale) as usize).min(BINS - 1)
 }
 
 /// Reorders `prims` so that those with `left(p)` come first; returns how many did.
@@ -235,51 +310,50 @@ impl Bvh {
             .enumerate()
             .map(|(i, p)| {
                 let b = p.bounds();
-                BuildPrim { min: b.min.into(), max: b.max.into(), index: i as u32 }
+                BuildPrim { bounds: Bounds { min: b.min.into(), max: b.max.into() }, index: i as u32 }
             })
-            .filter(|p| p.min.cmple(p.max).all())
+            .filter(|p| p.bounds.min.cmple(p.bounds.max).all())
             .collect();
-        let mut nodes: Vec<Node> = Vec::with_capacity(2 * build.len() / MAX_LEAF.max(1) + 1);
+        let mut nodes: Vec<Node> = Vec::with_capacity(2 * build.len() / MAX_LEAF + 1);
         let (mut depth, mut leaves) = (0, 0);
         if !build.is_empty() {
-            let (root_bounds, _) = bounds_of(&build);
-            nodes.push(Node::new(&root_bounds, 0, 0));
-            // (node, start, end, depth): the node's box is already written.
-            let mut work = vec![(0usize, 0usize, build.len(), 0usize)];
-            while let Some((node, first, end, level)) = work.pop() {
+            let root = Group::of(&build);
+            nodes.push(Node::new(&root.bounds.to_aabb(), 0, 0));
+            // (node, its primitives' range, depth, their group): the node's box is already written.
+            let mut work = vec![(0usize, 0usize, build.len(), 0usize, root)];
+            while let Some((node, first, end, level, group)) = work.pop() {
                 depth = depth.max(level);
                 let range = &mut build[first..end];
                 let count = range.len();
-                let (bounds, centroids) = bounds_of(range);
-                let axis = centroids.longest_axis();
-                let leaf_cost = count as f32;
-                let split = best_split(range, &centroids, axis)
-                    .map(|(cost, bin)| (TRAVERSAL_COST + cost / bounds.surface_area().max(f32::MIN_POSITIVE), bin));
-                let mid = match split {
-                    _ if level >= MAX_DEPTH - 1 || count == 1 => None,
-                    Some((cost, bin)) if cost < leaf_cost || count > MAX_LEAF => {
-                        let (lo, scale) =
-                            (centroids.min[axis], BINS as f32 / (centroids.max[axis] - centroids.min[axis]));
-                        Some(partition(range, |p| bin_index(p.centroid()[axis], lo, scale) <= bin))
+                let children = if level >= MAX_DEPTH - 1 || count == 1 {
+                    None
+                } else {
+                    match best_split(range, &group) {
+                        Some(split) if TRAVERSAL_COST + split.cost < count as f32 || count > MAX_LEAF => {
+                            let Split { axis, lo, scale, bin, .. } = split;
+                            let mid = partition(range, |p| bin_index(p.bounds.centroid(), axis, lo, scale) <= bin);
+                            Some((mid, split.left, split.right))
+                        }
+                        // All centroids coincide: halve by count to keep leaves small.
+                        None if count > MAX_LEAF => {
+                            let mid = count / 2;
+                            Some((mid, Group::of(&range[..mid]), Group::of(&range[mid..])))
+                        }
+                        _ => None,
                     }
-                    // All centroids coincide: halve by count to keep leaves small.
-                    None if count > MAX_LEAF => Some(count / 2),
-                    _ => None,
                 };
-                match mid {
-                    Some(mid) => {
+                match children {
+                    Some((mid, left_group, right_group)) => {
                         let left = nodes.len();
-                        let (lb, _) = bounds_of(&build[first..first + mid]);
-                        let (rb, _) = bounds_of(&build[first + mid..end]);
-                        nodes.push(Node::new(&lb, 0, 0));
-                        nodes.push(Node::new(&rb, 0, 0));
-                        nodes[node] = Node::new(&bounds, left as u32, 0);
-                        work.push((left + 1, first + mid, end, level + 1));
-                        work.push((left, first, first + mid, level + 1));
+                        nodes.push(Node::new(&left_group.bounds.to_aabb(), 0, 0));
+                        nodes.push(Node::new(&right_group.bounds.to_aabb(), 0, 0));
+                        nodes[node] = Node::new(&group.bounds.to_aabb(), left as u32, 0);
+                        work.push((left + 1, first + mid, end, level + 1, right_group));
+                        work.push((left, first, first + mid, level + 1, left_group));
                     }
                     None => {
                         leaves += 1;
-                        nodes[node] = Node::new(&bounds, first as u32, count as u32);
+                        nodes[node] = Node::new(&group.bounds.to_aabb(), first as u32, count as u32);
                     }
                 }
             }
