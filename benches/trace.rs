@@ -5,8 +5,10 @@
 //! ray toward a point light from every primary hit (the same rays, from Mirador's hits, for
 //! every library). Each throughput is the best of [`REPEATS`] passes, on one thread and on all
 //! of rayon's threads; builds are single-threaded for all three (obvhs without its `parallel`
-//! feature, `bvh` with `Bvh::build`). Run with `cargo bench --bench trace`; it takes about a
-//! minute on two cores.
+//! feature, `bvh` with `Bvh::build`). Single-threaded work (builds, 1T passes) is timed by the
+//! thread's CPU time where Linux reports it, so that other programs sharing the cores count
+//! less; multi-threaded passes by the wall clock. Run with `cargo bench --bench trace` (about
+//! 30 s on two cores); `cargo bench --bench trace -- obvhs` runs Mirador and the named peers only.
 //!
 //! The peers use their own idioms: obvhs its two-sided Möller–Trumbore `Triangle::intersect`
 //! with the triangles reordered into leaf order (as its examples recommend) and its
@@ -96,24 +98,22 @@ fn thread_cpu_time() -> Option<Duration> {
     Some(Duration::from_nanos(stat.split_whitespace().next()?.parse().ok()?))
 }
 
-/// The best of [`REPEATS`] passes of `run`, which returns a count to check. On one thread the
-/// pass is timed by the thread's CPU time where the system reports it, so that other programs
-/// sharing the cores do not count; on all threads by the wall clock.
-fn best_of(on_this_thread: bool, run: impl Fn() -> usize) -> (Duration, usize) {
-    let repeats: usize = std::env::var("BENCH_REPEATS").ok().and_then(|v| v.parse().ok()).unwrap_or(REPEATS);
+/// How long `run` takes: by this thread's CPU time if `on_this_thread` and the system reports
+/// it, else by the wall clock.
+fn timed<R>(on_this_thread: bool, run: impl FnOnce() -> R) -> (Duration, R) {
     let clock = || if on_this_thread { thread_cpu_time() } else { None };
-    (0..repeats)
-        .map(|_| {
-            let (start, wall) = (clock(), Instant::now());
-            let count = run();
-            let time = match (start, clock()) {
-                (Some(a), Some(b)) => b - a,
-                _ => wall.elapsed(),
-            };
-            (time, count)
-        })
-        .min_by_key(|(time, _)| *time)
-        .expect("at least one pass")
+    let (start, wall) = (clock(), Instant::now());
+    let result = run();
+    let time = match (start, clock()) {
+        (Some(a), Some(b)) => b - a,
+        _ => wall.elapsed(),
+    };
+    (time, result)
+}
+
+/// The best of [`REPEATS`] passes of `run`, which returns a count to check.
+fn best_of(on_this_thread: bool, run: impl Fn() -> usize) -> (Duration, usize) {
+    (0..REPEATS).map(|_| timed(on_this_thread, &run)).min_by_key(|(time, _)| *time).expect("at least one pass")
 }
 
 /// Rays per second through `hit` on one thread and on all threads, and how many hit.
@@ -125,10 +125,6 @@ struct Throughput {
 
 fn throughput(queries: &[Query], hit: impl Fn(&Query) -> bool + Sync) -> Throughput {
     // Warm-up: caches, page faults, rayon's threads.
-    if std::env::var("BENCH_SINGLE_ONLY").is_ok() {
-        let hits = queries.iter().filter(|q| hit(q)).count();
-        return Throughput { single: 1.0, parallel: 1.0, hits };
-    }
     let _ = queries.par_iter().take(20_000).filter(|q| hit(q)).count();
     let (single_time, hits) = best_of(true, || queries.iter().filter(|q| hit(q)).count());
     let (parallel_time, _) =
@@ -195,9 +191,7 @@ fn mirador_row(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Row {
             })
         })
         .collect();
-    let start = Instant::now();
-    let accel = Bvh::build(&prims);
-    let build = start.elapsed();
+    let (build, accel) = timed(true, || Bvh::build(&prims));
     println!("{}", accel.stats());
     let ray = |q: &Query| Ray { origin: q.origin, direction: q.direction };
     Row {
@@ -215,13 +209,9 @@ fn obvhs_rows(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Vec<Ro
     let oray = |q: &Query| ORay::new(q.origin.into(), q.direction.into(), q.t_min, q.t_max);
     let mut rows = Vec::new();
 
-    let start = Instant::now();
-    let bvh2 = obvhs::bvh2::builder::build_bvh2_from_tris(
-        &triangles,
-        obvhs::BvhBuildParams::medium_build(),
-        &mut Duration::default(),
-    );
-    let build = start.elapsed();
+    let params = obvhs::BvhBuildParams::medium_build();
+    let (build, bvh2) =
+        timed(true, || obvhs::bvh2::builder::build_bvh2_from_tris(&triangles, params, &mut Duration::default()));
     let ordered: Vec<_> = bvh2.primitive_indices.iter().map(|&i| triangles[i as usize]).collect();
     rows.push(Row {
         name: "obvhs 0.4 bvh2",
@@ -234,13 +224,8 @@ fn obvhs_rows(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Vec<Ro
     });
     drop((bvh2, ordered));
 
-    let start = Instant::now();
-    let cwbvh = obvhs::cwbvh::builder::build_cwbvh_from_tris(
-        &triangles,
-        obvhs::BvhBuildParams::medium_build(),
-        &mut Duration::default(),
-    );
-    let build = start.elapsed();
+    let (build, cwbvh) =
+        timed(true, || obvhs::cwbvh::builder::build_cwbvh_from_tris(&triangles, params, &mut Duration::default()));
     let ordered: Vec<_> = cwbvh.primitive_indices.iter().map(|&i| triangles[i as usize]).collect();
     rows.push(Row {
         name: "obvhs 0.4 cwbvh",
@@ -256,9 +241,7 @@ fn obvhs_rows(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Vec<Ro
 
 fn bvh_crate_row(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Row {
     let mut shapes: Vec<BvhShape> = tris.iter().map(|t| BvhShape { v: t.map(Vec3A::from), node: 0 }).collect();
-    let start = Instant::now();
-    let tree = bvh::bvh::Bvh::build(&mut shapes);
-    let build = start.elapsed();
+    let (build, tree) = timed(true, || bvh::bvh::Bvh::build(&mut shapes));
     let bray = |q: &Query| bvh::ray::Ray::new(q.origin.to_array().into(), q.direction.to_array().into());
     let closest = |q: &Query| {
         let ray = bray(q);

@@ -10,6 +10,8 @@
 @group(1) @binding(1) var color_texture: texture_2d<f32>;
 // Linear grey levels f_h(u, v); the red channel is the height.
 @group(1) @binding(2) var height_texture: texture_2d<f32>;
+// Tangent-space normals (glTF's normalTexture), linear.
+@group(1) @binding(3) var normal_texture: texture_2d<f32>;
 @group(2) @binding(0) var<uniform> object: Object;
 // Group 3: the shadow maps of this frame (pass 1's output) and how to read them.
 @group(3) @binding(0) var<uniform> shadows: Shadows;
@@ -26,6 +28,7 @@ struct VertexIn {
     @location(0) position: vec3f,
     @location(1) normal: vec3f,
     @location(2) uv: vec2f,
+    @location(3) tangent: vec4f,
 }
 
 struct VertexOut {
@@ -33,6 +36,8 @@ struct VertexOut {
     @location(0) world: vec3f,
     @location(1) normal: vec3f,
     @location(2) uv: vec2f,
+    // World-space tangent, and the bitangent's sign in w.
+    @location(3) tangent: vec4f,
 }
 
 @vertex
@@ -43,6 +48,7 @@ fn vs_opaque(in: VertexIn) -> VertexOut {
     out.world = world.xyz;
     out.normal = (object.normal_from_local * vec4f(in.normal, 0.0)).xyz;
     out.uv = in.uv;
+    out.tangent = vec4f((object.world_from_local * vec4f(in.tangent.xyz, 0.0)).xyz, in.tangent.w);
     return out;
 }
 
@@ -119,7 +125,7 @@ fn fs_opaque(in: VertexOut) -> @location(0) vec4f {
     // the tangents ∂p/∂u, ∂p/∂v of the surface, from the change of position and uv across pixels.
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
-    let tangents = tangents_from_derivatives(dpdx(in.world), dpdy(in.world), duv_dx, duv_dy);
+    var tangents = tangents_from_derivatives(dpdx(in.world), dpdy(in.world), duv_dx, duv_dy);
     var color = material.color;
     if material.has_texture != 0u {
         if frame.texture_filter == TEXTURE_FILTER_LEVEL_COLOUR {
@@ -136,8 +142,20 @@ fn fs_opaque(in: VertexOut) -> @location(0) vec4f {
     );
     let v = view_vector(in.world);
     var shading_normal = normalize(in.normal);
+    if frame.bump_tangents == BUMP_TANGENTS_PER_VERTEX {
+        // Interpolated per-vertex tangent t and bitangent sign·(n × t), both unit length.
+        let t = normalize(in.tangent.xyz);
+        tangents = SurfaceTangents(t, sign(in.tangent.w) * cross(shading_normal, t), length(in.tangent.xyz) > 0.0);
+    }
     if frame.bump_enabled != 0u && material.has_height_map != 0u && tangents.valid {
         shading_normal = bumped_normal(shading_normal, in.uv, tangents);
+    }
+    if frame.bump_enabled != 0u && material.has_normal_map != 0u && tangents.valid {
+        // glTF's frame: t along ∂p/∂u (in n's plane), the bitangent's sign from ∂p/∂v.
+        let t = tangents.tu - dot(tangents.tu, shading_normal) * shading_normal;
+        let handedness = select(1.0, -1.0, dot(cross(shading_normal, t), tangents.tv) < 0.0);
+        let rgb = textureSampleLevel(normal_texture, height_sampler, in.uv, 0.0).rgb;
+        shading_normal = normal_map_normal(shading_normal, vec4f(t, handedness), rgb, material.normal_scale);
     }
     let n = facing_viewer(shading_normal, v);
     if frame.bump_view == BUMP_VIEW_NORMALS {

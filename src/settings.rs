@@ -73,10 +73,25 @@ pub enum BumpView {
     Tangents,
 }
 
+/// Where the rasterizer's tangents `t_u`, `t_v` come from (TECHNIQUES.md §3 names three sources;
+/// the tracer uses the third, the analytic surface).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum TangentSource {
+    /// Constant per triangle, from how position and texture coordinates change across it
+    /// (screen-space derivatives): true-length `∂p/∂u`, `∂p/∂v`.
+    Derivatives,
+    /// Per vertex and interpolated: the file's tangents, or MikkTSpace's; unit length, so `k`
+    /// reads as relief per unit of texture coordinate rather than per unit of surface.
+    PerVertex,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BumpSettings {
+    /// Bump mapping and normal maps.
     pub enabled: bool,
+    pub tangents: TangentSource,
     /// Multiplies every material's bump scale `k` (sign allowed).
     pub scale: f32,
     /// The finite-difference step `Δ`, in texels of the height map.
@@ -86,7 +101,13 @@ pub struct BumpSettings {
 
 impl Default for BumpSettings {
     fn default() -> Self {
-        BumpSettings { enabled: true, scale: 1.0, delta_texels: 1.0, view: BumpView::Off }
+        BumpSettings {
+            enabled: true,
+            tangents: TangentSource::Derivatives,
+            scale: 1.0,
+            delta_texels: 1.0,
+            view: BumpView::Off,
+        }
     }
 }
 

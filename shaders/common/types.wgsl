@@ -17,6 +17,9 @@ const TEXTURE_FILTER_LEVEL_COLOUR: u32 = 5u;
 const BUMP_VIEW_NORMALS: u32 = 1u;
 const BUMP_VIEW_TANGENTS: u32 = 2u;
 
+// Frame.bump_tangents.
+const BUMP_TANGENTS_PER_VERTEX: u32 = 1u;
+
 // Bits of Frame.terms: which terms of the illumination model are drawn.
 const TERM_AMBIENT: u32 = 1u;
 const TERM_DIFFUSE: u32 = 2u;
@@ -60,8 +63,9 @@ struct Frame {
     // The finite-difference step Δ in texels of the height map.
     bump_delta_texels: f32,
     bump_view: u32,
+    // 0: tangents from screen derivatives; 1: the interpolated per-vertex tangents.
+    bump_tangents: u32,
     _pad0: f32,
-    _pad1: f32,
     lights: array<Light, MAX_LIGHTS>,
 }
 
@@ -82,6 +86,10 @@ struct Material {
     // kt·MT: what a transparent surface lets through.
     transmission: vec3f,
     has_height_map: u32,
+    has_normal_map: u32,
+    normal_scale: f32,
+    _pad0: f32,
+    _pad1: f32,
 }
 
 // Group 2: changes per object.

@@ -13,6 +13,7 @@ use crate::scene::{Mesh, Scene};
 use crate::settings::RenderSettings;
 use crate::settings::{TextureFilter, TextureSettings};
 use crate::texture::mipmap::Filter;
+use crate::texture::tangents::tangents_or_generate;
 
 /// The bind group layouts every scene pass shares.
 pub struct SceneLayouts {
@@ -34,7 +35,12 @@ impl SceneLayouts {
         });
         let material = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::material_layout"),
-            entries: &[layout::uniform(0, wgpu::ShaderStages::FRAGMENT), layout::texture_2d(1), layout::texture_2d(2)],
+            entries: &[
+                layout::uniform(0, wgpu::ShaderStages::FRAGMENT),
+                layout::texture_2d(1),
+                layout::texture_2d(2),
+                layout::texture_2d(3),
+            ],
         });
         let object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::object_layout"),
@@ -92,6 +98,7 @@ impl SceneGpu {
             |label, rgba: [u8; 4], format| GpuTexture::from_rgba8(device, &gpu.queue, label, (1, 1), &rgba, format);
         let white = one_texel("scene::white_texture", [255; 4], wgpu::TextureFormat::Rgba8UnormSrgb);
         let flat = one_texel("scene::flat_height", [0, 0, 0, 255], wgpu::TextureFormat::Rgba8Unorm);
+        let straight = one_texel("scene::straight_normal", [128, 128, 255, 255], wgpu::TextureFormat::Rgba8Unorm);
         let height_sampler = device.create_sampler(&sampler_descriptor(Filter::Bilinear, 1));
         let materials = scene
             .materials
@@ -100,6 +107,7 @@ impl SceneGpu {
                 let uniform = UniformBuffer::new(device, &format!("scene::material {}", m.name), &m.to_gpu());
                 let color = m.texture.map_or(&white.view, |id| &textures[id.0].view);
                 let height = m.height_map.map_or(&flat.view, |id| &textures[id.0].view);
+                let normal = m.normal_map.map_or(&straight.view, |id| &textures[id.0].view);
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some(&format!("scene::material_group {}", m.name)),
                     layout: &layouts.material,
@@ -107,6 +115,7 @@ impl SceneGpu {
                         wgpu::BindGroupEntry { binding: 0, resource: uniform.binding() },
                         wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(color) },
                         wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(height) },
+                        wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(normal) },
                     ],
                 })
             })
@@ -188,11 +197,16 @@ fn frame_group_key(settings: &TextureSettings) -> (TextureFilter, u16) {
 }
 
 fn mesh_buffers(device: &wgpu::Device, name: &str, mesh: &Mesh) -> (wgpu::Buffer, wgpu::Buffer) {
+    // The file's tangents where it has them, MikkTSpace's otherwise (TECHNIQUES.md §3's
+    // per-vertex source).
+    let existing = (!mesh.tangents.is_empty()).then_some(mesh.tangents.as_slice());
+    let tangents = tangents_or_generate(mesh, existing);
     let vertices: Vec<Vertex> = (0..mesh.positions.len())
         .map(|i| Vertex {
             position: mesh.positions[i].to_array(),
             normal: mesh.normals[i].to_array(),
             uv: mesh.uvs[i].to_array(),
+            tangent: tangents[i].to_array(),
         })
         .collect();
     let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

@@ -6,7 +6,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
 use crate::scene::{Attenuation, Camera, Light, LightKind, Material, Object, Projection};
-use crate::settings::{BumpView, RenderSettings, TextureFilter};
+use crate::settings::{BumpView, RenderSettings, TangentSource, TextureFilter};
 
 pub const MAX_LIGHTS: usize = 16;
 
@@ -66,7 +66,8 @@ pub struct GpuFrame {
     pub bump_scale: f32,
     pub bump_delta_texels: f32,
     pub bump_view: u32,
-    pub _pad: [f32; 2],
+    pub bump_tangents: u32,
+    pub _pad: f32,
     pub lights: [GpuLight; MAX_LIGHTS],
 }
 
@@ -118,7 +119,11 @@ impl GpuFrame {
                 BumpView::Normals => 1,
                 BumpView::Tangents => 2,
             },
-            _pad: [0.0; 2],
+            bump_tangents: match settings.bump.tangents {
+                TangentSource::Derivatives => 0,
+                TangentSource::PerVertex => 1,
+            },
+            _pad: 0.0,
             lights: gpu_lights,
         }
     }
@@ -139,6 +144,9 @@ pub struct GpuMaterial {
     pub bump_scale: f32,
     pub transmission: [f32; 3],
     pub has_height_map: u32,
+    pub has_normal_map: u32,
+    pub normal_scale: f32,
+    pub _pad: [f32; 2],
 }
 
 impl Material {
@@ -156,6 +164,9 @@ impl Material {
             bump_scale: self.bump_scale,
             transmission: (self.transmission * self.transmission_color).to_array(),
             has_height_map: u32::from(self.height_map.is_some()),
+            has_normal_map: u32::from(self.normal_map.is_some()),
+            normal_scale: self.normal_scale,
+            _pad: [0.0; 2],
         }
     }
 }
@@ -190,11 +201,13 @@ pub struct Vertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],
     pub uv: [f32; 2],
+    /// xyz and the bitangent's sign in w.
+    pub tangent: [f32; 4],
 }
 
 impl Vertex {
-    pub const ATTRIBUTES: [wgpu::VertexAttribute; 3] =
-        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 4] =
+        wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x4];
 
     pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
         array_stride: std::mem::size_of::<Vertex>() as u64,

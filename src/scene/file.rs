@@ -226,6 +226,8 @@ struct MaterialDesc {
     ior: Option<Positive>,
     height_map: Option<String>,
     bump_scale: Option<Finite>,
+    normal_map: Option<String>,
+    normal_scale: Option<Finite>,
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
@@ -429,6 +431,7 @@ impl<'a> Builder<'a> {
         let base = Material::default();
         let texture = d.texture.map(|p| self.texture(&p, ColorSpace::Srgb, span.clone())).transpose()?;
         let height_map = d.height_map.map(|p| self.texture(&p, ColorSpace::Linear, span.clone())).transpose()?;
+        let normal_map = d.normal_map.map(|p| self.texture(&p, ColorSpace::Linear, span.clone())).transpose()?;
         Ok(Material {
             name: name.into(),
             color: d.color.map_or(base.color, |Rgb(c)| c),
@@ -446,6 +449,8 @@ impl<'a> Builder<'a> {
             ior: d.ior.map_or(base.ior, |Positive(x)| x),
             height_map,
             bump_scale: d.bump_scale.map_or(base.bump_scale, |Finite(x)| x),
+            normal_map,
+            normal_scale: d.normal_scale.map_or(base.normal_scale, |Finite(x)| x),
         })
     }
 
@@ -626,6 +631,7 @@ fn add_gltf(scene: &mut Scene, import: GltfImport, world_from_root: Mat4, with_l
     scene.materials.extend(import.materials.into_iter().map(|mut m| {
         m.texture = m.texture.map(|TextureId(i)| TextureId(i + texture_base));
         m.height_map = m.height_map.map(|TextureId(i)| TextureId(i + texture_base));
+        m.normal_map = m.normal_map.map(|TextureId(i)| TextureId(i + texture_base));
         m
     }));
     scene.objects.extend(import.objects.into_iter().map(|o| Object {

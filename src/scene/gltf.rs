@@ -382,7 +382,7 @@ struct Importer<'d> {
     /// glTF material (`None`: the default) → index into `out.materials`.
     materials: HashMap<Option<usize>, usize>,
     /// glTF image → index into `out.textures`.
-    textures: HashMap<usize, TextureId>,
+    textures: HashMap<(usize, ColorSpace), TextureId>,
 }
 
 /// Where the depth-first walk is in each node, to tell a cycle (an error: the walk would never
@@ -532,6 +532,14 @@ impl<'d> Importer<'d> {
                 .collect(),
             None => vec![Vec2::ZERO; vertex_count],
         };
+        let tangents: Vec<Vec4> = match primitive.get(&Semantic::Tangents) {
+            Some(accessor) => self
+                .read_vectors::<4>(&accessor, &format!("TANGENT of mesh `{name}`"))?
+                .into_iter()
+                .map(Vec4::from_array)
+                .collect(),
+            None => Vec::new(),
+        };
         let vertices: Vec<u32> = match primitive.indices() {
             Some(accessor) => self.read_indices(&accessor, &format!("indices of mesh `{name}`"))?,
             None => {
@@ -554,6 +562,7 @@ impl<'d> Importer<'d> {
             // relies on.
             normals: normals.unwrap_or_else(|| vec![Vec3::Y; vertex_count]),
             uvs,
+            tangents,
             indices,
         };
         let removed = built.validate_and_repair().map_err(|e| e.to_string())?;
@@ -710,8 +719,12 @@ impl<'d> Importer<'d> {
                         info.tex_coord()
                     ));
                 }
-                Some(self.texture(info.texture().source())?)
+                Some(self.texture(info.texture().source(), ColorSpace::Srgb)?)
             }
+            None => None,
+        };
+        let normal_map = match material.normal_texture() {
+            Some(info) => Some((self.texture(info.texture().source(), ColorSpace::Linear)?, info.scale())),
             None => None,
         };
         let phong = phong_from_metallic_roughness(base, metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
@@ -734,12 +747,16 @@ impl<'d> Importer<'d> {
             ior: material.ior().filter(|&ior| ior >= 1.0).unwrap_or(default_ior),
             height_map: None,
             bump_scale: 1.0,
+            normal_map: normal_map.map(|(id, _)| id),
+            normal_scale: normal_map.map_or(1.0, |(_, scale)| scale),
         })
     }
 
-    fn texture(&mut self, image: gltf::Image<'d>) -> Result<TextureId, String> {
+    /// The image as a texture read in `space`: the same image may serve as colour (sRGB) and as
+    /// data (linear), and then becomes two textures.
+    fn texture(&mut self, image: gltf::Image<'d>, space: ColorSpace) -> Result<TextureId, String> {
         let index = image.index();
-        if let Some(&known) = self.textures.get(&index) {
+        if let Some(&known) = self.textures.get(&(index, space)) {
             return Ok(known);
         }
         // The raw JSON, because the `gltf` crate's `Image::source` unwraps fields a malformed
@@ -788,9 +805,9 @@ impl<'d> Importer<'d> {
         let (width, height) = reader().into_dimensions().map_err(|e| format!("{described}: cannot decode: {e}"))?;
         texture::check_size(width, height).map_err(|e| format!("{described}: {e}"))?;
         let decoded = reader().decode().map_err(|e| format!("{described}: cannot decode: {e}"))?;
-        self.out.textures.push(texture::from_image(&texture_path, decoded, ColorSpace::Srgb));
+        self.out.textures.push(texture::from_image(&texture_path, decoded, space));
         let id = TextureId(self.out.textures.len() - 1);
-        self.textures.insert(index, id);
+        self.textures.insert((index, space), id);
         Ok(id)
     }
 

@@ -14,7 +14,7 @@ pub struct MaterialId(pub usize);
 pub struct TextureId(pub usize);
 
 /// How a texture's stored values are to be read.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ColorSpace {
     /// Colour textures: stored sRGB-encoded, decoded to linear before any filtering.
     Srgb,
@@ -61,6 +61,10 @@ pub struct Material {
     /// Grey-level height field and its scale `k` for bump mapping (TECHNIQUES.md §3).
     pub height_map: Option<TextureId>,
     pub bump_scale: f32,
+    /// A tangent-space normal map (glTF's `normalTexture`): RGB = (n + 1)/2 in the frame
+    /// (tangent, bitangent, normal), its x and y scaled by `normal_scale`.
+    pub normal_map: Option<TextureId>,
+    pub normal_scale: f32,
 }
 
 impl Material {
@@ -89,6 +93,8 @@ impl Default for Material {
             ior: 1.0,
             height_map: None,
             bump_scale: 1.0,
+            normal_map: None,
+            normal_scale: 1.0,
         }
     }
 }

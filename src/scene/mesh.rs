@@ -5,7 +5,7 @@
 //! quads whose vertices lie on the true sphere, so its silhouette is a polygon inscribed in the
 //! true one (a raster-vs-trace difference of at most `r·(1 − cos(π/segments))`).
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 /// An indexed triangle mesh in its local coordinates.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -14,6 +14,9 @@ pub struct Mesh {
     pub positions: Vec<Vec3>,
     pub normals: Vec<Vec3>,
     pub uvs: Vec<Vec2>,
+    /// Per-vertex tangents (xyz, and w = ±1 the bitangent's sign) when the file gives them, as
+    /// glTF's TANGENT does; empty otherwise, and then made with MikkTSpace where needed.
+    pub tangents: Vec<Vec4>,
     /// Three indices per triangle, counter-clockwise seen from the front.
     pub indices: Vec<u32>,
 }
@@ -45,6 +48,14 @@ impl Mesh {
             if other != vertices {
                 return Err(MeshError::AttributeCount { mesh, positions: vertices, other, what });
             }
+        }
+        if !self.tangents.is_empty() && self.tangents.len() != vertices {
+            return Err(MeshError::AttributeCount {
+                mesh,
+                positions: vertices,
+                other: self.tangents.len(),
+                what: "tangents",
+            });
         }
         if self.indices.len() % 3 != 0 {
             return Err(MeshError::PartialTriangle { mesh, count: self.indices.len() });
@@ -316,6 +327,7 @@ mod tests {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X * 2.0],
             normals: vec![Vec3::Z; 4],
             uvs: vec![Vec2::ZERO; 4],
+            tangents: Vec::new(),
             indices: vec![0, 1, 2, 0, 1, 3],
         };
         assert_eq!(mesh.validate_and_repair(), Ok(1));

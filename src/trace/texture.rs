@@ -44,10 +44,13 @@
 //! Δ = delta_texels/(w, h), uv, n, ∂p/∂u, ∂p/∂v)` with the hit's analytic tangents (§3's first
 //! source), by central differences on level 0 of the height map (as the GPU's
 //! `textureSampleLevel(…, 0.0)`). `n' = normalize(t'_u × t'_v)` takes its direction from the
-//! tangents, not from `n`: on the exact spheres, tori and boxes here it is smooth, while the
-//! rasterizer's tangents (from `dpdx(p)`, `dpdy(p)`) are those of the flat facets of its
-//! tessellation, so its bumped normals show the facets; on triangle meshes both renderers use
-//! the per-triangle tangents and both lose the interpolated normal's smoothness.
+//! tangents, laid first in the plane of `n` (`perturbed_normal`), so the rasterizer's
+//! per-facet tangents (from `dpdx(p)`, `dpdy(p)`) give the same smooth result as the exact
+//! surfaces here.
+//!
+//! **Normal maps** (glTF's `normalTexture`): after any bump, `n' = normal_map_normal(n, (t, ±1),
+//! rgb, scale)` with `t` = ∂p/∂u laid in `n`'s plane and the bitangent's sign from ∂p/∂v, the
+//! frame MikkTSpace builds from the same texture coordinates.
 
 use glam::{Vec2, Vec3};
 
@@ -55,6 +58,7 @@ use super::geometry::SurfaceHit;
 use crate::output::srgb_decode;
 use crate::scene::{ColorSpace, Material, Scene, Texture, TextureId};
 use crate::settings::{BumpSettings, TextureFilter, TextureSettings};
+use crate::texture::tangents::normal_map_normal;
 use crate::texture::{BumpParams, Filter, MipChain, RayCone, TextureHeight, bump_normal, lod_from_footprint};
 
 /// The linear RGB value of `texture` at `uv`, bilinearly filtered with repeat wrapping: level 0
@@ -137,6 +141,12 @@ impl SceneTextures {
             {
                 heights[id.0] = Some(TextureHeight::new(texture));
             }
+            if let Some(id) = material.normal_map
+                && let Some(texture) = usable(id)
+                && chains[id.0].is_none()
+            {
+                chains[id.0] = Some(MipChain::build(texture));
+            }
         }
         SceneTextures { chains, heights }
     }
@@ -192,16 +202,25 @@ impl SceneTextures {
         if !settings.enabled {
             return hit.normal;
         }
-        let Some(field) = material.height_map.and_then(|id| self.height(id)) else {
-            return hit.normal;
-        };
-        let size = Vec2::new(field.level.width as f32, field.level.height as f32);
-        let params = BumpParams {
-            k: material.bump_scale * settings.scale,
-            delta: Some(Vec2::splat(settings.delta_texels) / size),
-            analytic: false,
-        };
-        bump_normal(field, &params, hit.uv, hit.normal, hit.dpdu, hit.dpdv)
+        let mut n = hit.normal;
+        if let Some(field) = material.height_map.and_then(|id| self.height(id)) {
+            let size = Vec2::new(field.level.width as f32, field.level.height as f32);
+            let params = BumpParams {
+                k: material.bump_scale * settings.scale,
+                delta: Some(Vec2::splat(settings.delta_texels) / size),
+                analytic: false,
+            };
+            n = bump_normal(field, &params, hit.uv, n, hit.dpdu, hit.dpdv);
+        }
+        if let Some(chain) = material.normal_map.and_then(|id| self.chain(id)) {
+            // glTF's tangent frame: t along ∂p/∂u, the bitangent's sign from ∂p/∂v's side, as
+            // MikkTSpace makes it from the same texture coordinates.
+            let t = hit.dpdu - hit.dpdu.dot(n) * n;
+            let sign = if n.cross(t).dot(hit.dpdv) < 0.0 { -1.0 } else { 1.0 };
+            let rgb = chain.sample(hit.uv, 0.0, Filter::Bilinear).truncate();
+            n = normal_map_normal(n, t.extend(sign), rgb, material.normal_scale);
+        }
+        n
     }
 }
 
