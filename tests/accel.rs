@@ -560,6 +560,7 @@ fn assert_uv_matches_tessellation(
     scene.objects.push(object(Shape::Mesh(0), world_from_local));
     let prims = scene_primitives(&scene);
     let (analytic, triangles) = prims.split_first().expect("the analytic object comes first");
+    let mesh_bvh = build(AccelKind::Bvh, triangles);
     let bounds = analytic.bounds();
     let mut rng = Pcg::new(8);
     let mut compared = 0;
@@ -573,15 +574,8 @@ fn assert_uv_matches_tessellation(
         if exact_hit.normal.dot(r.direction).abs() < 0.3 || !(v_margin..=1.0 - v_margin).contains(&exact_hit.uv.y) {
             continue;
         }
-        let Some((mesh_t, index)) = triangles
-            .iter()
-            .enumerate()
-            .filter_map(|(i, p)| p.intersect(&r, 0.0, f32::INFINITY).map(|t| (t, i)))
-            .min_by(|a, b| a.0.total_cmp(&b.0))
-        else {
-            continue;
-        };
-        let mesh_hit = triangles[index].surface(&r, mesh_t);
+        let Some(mesh) = mesh_bvh.closest(triangles, &r, 0.0, f32::INFINITY) else { continue };
+        let mesh_hit = triangles[mesh.primitive as usize].surface(&r, mesh.t);
         if (mesh_hit.point - exact_hit.point).length() > 0.01 {
             continue;
         }
