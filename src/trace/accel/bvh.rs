@@ -44,7 +44,7 @@ use std::time::Instant;
 
 use glam::{BVec3A, Vec3A, Vec4};
 
-use super::{AccelStats, Accelerator, Hit};
+use super::{AccelStats, Accelerator, Hit, offer};
 use crate::scene::Ray;
 use crate::trace::geometry::{Aabb, PreparedRay, Primitive, intersect_triangle};
 
@@ -422,12 +422,13 @@ impl Bvh {
                     } else {
                         prims[(entry & !ANALYTIC) as usize].intersect_prepared(ray, prepared, t_min, t_max)
                     };
-                    if let Some(t) = hit {
-                        best = Some(Hit { t, primitive: entry & !ANALYTIC });
+                    if let Some(t) = hit
+                        && offer(&mut best, t, entry & !ANALYTIC)
+                    {
                         if ANY {
                             return best;
                         }
-                        t_max = t;
+                        t_max = t.next_up();
                     }
                 }
             } else {

@@ -27,7 +27,7 @@ use std::time::Instant;
 
 use glam::{UVec3, Vec3};
 
-use super::{AccelStats, Accelerator, Hit, Mailbox};
+use super::{AccelStats, Accelerator, Hit, Mailbox, offer};
 use crate::scene::Ray;
 use crate::trace::geometry::{Aabb, PreparedRay, Primitive};
 
@@ -159,12 +159,13 @@ impl Grid {
                 if !mailbox.first_visit(p) {
                     continue;
                 }
-                if let Some(t) = prims[p as usize].intersect_prepared(ray, &prepared, t_min, t_max) {
-                    best = Some(Hit { t, primitive: p });
+                if let Some(t) = prims[p as usize].intersect_prepared(ray, &prepared, t_min, t_max)
+                    && offer(&mut best, t, p)
+                {
                     if ANY {
                         return best;
                     }
-                    t_max = t;
+                    t_max = t.next_up();
                 }
             }
             let axis = if t_next[0] <= t_next[1] && t_next[0] <= t_next[2] {

@@ -34,6 +34,19 @@ pub struct Hit {
     pub primitive: u32,
 }
 
+/// Offers a hit found during traversal: it becomes the best if it is nearer, or equally near with
+/// a lower primitive index. That tie-break (coplanar surfaces give exact ties) is shared by every
+/// accelerator, so all of them draw the same image. Returns whether the hit was taken; the caller
+/// then narrows its far bound to `t.next_up()`, one step past the hit, so that equally near
+/// candidates are still tested.
+pub(crate) fn offer(best: &mut Option<Hit>, t: f32, primitive: u32) -> bool {
+    let better = best.is_none_or(|b| t < b.t || (t == b.t && primitive < b.primitive));
+    if better {
+        *best = Some(Hit { t, primitive });
+    }
+    better
+}
+
 /// What an accelerator looks like once built, for logs and teaching views.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AccelStats {

@@ -23,7 +23,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 
-use super::{AccelStats, Accelerator, Hit, Mailbox};
+use super::{AccelStats, Accelerator, Hit, Mailbox, offer};
 use crate::scene::Ray;
 use crate::trace::geometry::{Aabb, PreparedRay, Primitive};
 
@@ -131,12 +131,13 @@ impl Octree {
                     if !mailbox.first_visit(p) {
                         continue;
                     }
-                    if let Some(t) = prims[p as usize].intersect_prepared(ray, &prepared, t_min, t_max) {
-                        best = Some(Hit { t, primitive: p });
+                    if let Some(t) = prims[p as usize].intersect_prepared(ray, &prepared, t_min, t_max)
+                        && offer(&mut best, t, p)
+                    {
                         if ANY {
                             return best;
                         }
-                        t_max = t;
+                        t_max = t.next_up();
                     }
                 }
                 continue;
