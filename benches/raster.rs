@@ -2,7 +2,8 @@
 //!
 //! 1. Frame time of the showcase at 1280×720 with 1, 2 and 4 shadowed lights, each against the
 //!    same lights with shadows off, measured in the same run: the ratio is the shadows' cost.
-//! 2. Pass 1 alone (one spot light's depth map) at 1024² and 4096².
+//! 2. The cost of bump mapping: the showcase and the bump scene with it off and on.
+//! 3. Pass 1 alone (one spot light's depth map) at 1024² and 4096².
 //!
 //! Times are wall-clock from submit to the queue being idle (the median of several frames after
 //! warm-up), so they include the driver's work on the CPU: on lavapipe that is all of it.
@@ -102,6 +103,22 @@ fn main() {
         let (t_off, t_on) = (frame_time(&gpu, &scene, &off), frame_time(&gpu, &scene, &on));
         println!(
             "{count:>8} {layers:>7} {:>11.1} ms {:>10.1} ms {:>6.2}×",
+            ms(t_off),
+            ms(t_on),
+            t_on.as_secs_f64() / t_off.as_secs_f64()
+        );
+    }
+
+    println!("\nbump mapping at 1280×720, median of {FRAMES} frames");
+    for name in ["showcase.toml", "bumps.toml"] {
+        let mut scene = Scene::load(&mirador::scene::builtin_path(name)).expect("a built-in scene loads");
+        (scene.camera.width, scene.camera.height) = (1280, 720);
+        let on = scene.settings.clone();
+        let mut off = on.clone();
+        off.bump.enabled = false;
+        let (t_off, t_on) = (frame_time(&gpu, &scene, &off), frame_time(&gpu, &scene, &on));
+        println!(
+            "{name:>14}: off {:>7.1} ms, on {:>7.1} ms, {:.2}×",
             ms(t_off),
             ms(t_on),
             t_on.as_secs_f64() / t_off.as_secs_f64()
