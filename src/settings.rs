@@ -46,10 +46,22 @@ pub enum TextureFilter {
     LevelColour,
 }
 
+/// How the ray tracer picks a texture's mip level at a hit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum TracerLod {
+    /// The footprint of the pixel's ray cone on the surface, stretched by the angle of incidence.
+    RayCone,
+    /// The seed's simple rule: the level grows with the logarithm of the distance travelled,
+    /// whatever the angle (orthographic cameras, whose rays do not spread, use the cone).
+    Distance,
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TextureSettings {
     pub filter: TextureFilter,
+    pub tracer_lod: TracerLod,
     /// Largest anisotropy, 1 to 16, where the device allows.
     pub anisotropy: u16,
     /// Added to the level of detail: positive is blurrier, negative sharper (and aliased).
@@ -58,7 +70,12 @@ pub struct TextureSettings {
 
 impl Default for TextureSettings {
     fn default() -> Self {
-        TextureSettings { filter: TextureFilter::Trilinear, anisotropy: 16, lod_bias: 0.0 }
+        TextureSettings {
+            filter: TextureFilter::Trilinear,
+            tracer_lod: TracerLod::RayCone,
+            anisotropy: 16,
+            lod_bias: 0.0,
+        }
     }
 }
 

@@ -1,4 +1,4 @@
-//! Normal maps (glTF's `normalTexture`): imported with their scale and the file's tangents, and
+//! Normal maps (glTF's `normalTexture`) and bump maps: imported with their scale and the file's tangents, and
 //! drawn alike by both renderers, checked against a hand computation.
 
 mod common;
@@ -85,4 +85,21 @@ fn a_tilted_normal_map_lights_the_plane_as_computed_by_hand() {
     off.bump.enabled = false;
     let unmapped = common::raster(&scene, &off).get_pixel(32, 32).0;
     assert!(unmapped[0].abs_diff(flat[0]) <= 1, "with bump mapping off the plane is flat: {unmapped:?} vs {flat:?}");
+}
+
+/// The bump scene (a cobbled tile and a cobbled ball under a low light) in both renderers: the
+/// same finite differences on tangents from screen derivatives (raster) and from the analytic
+/// surface (tracer). Measured: FLIP mean 0.0067. What differs: the ball's tessellated
+/// silhouette, and the derivative tangents' 2×2-pixel quads at the edges of cobbles.
+#[test]
+fn bump_mapped_surfaces_agree_between_the_renderers() {
+    let scene = common::load("scenes/bumps.toml");
+    let raster = common::raster(&scene, &scene.settings);
+    let traced = mirador::trace::render_image(&scene, &scene.settings);
+    let bumped = mirador::compare::difference(&traced, &raster).unwrap().flip_mean;
+    assert!(bumped < 0.01, "FLIP mean {bumped}");
+    let mut flat = scene.settings.clone();
+    flat.bump.enabled = false;
+    let against_flat = mirador::compare::difference(&traced, &common::raster(&scene, &flat)).unwrap().flip_mean;
+    assert!(against_flat > 4.0 * bumped, "the bumps matter: {against_flat} against flat, {bumped} against bumped");
 }

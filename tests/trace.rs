@@ -369,3 +369,33 @@ fn the_traced_shadow_falls_away_from_the_light() {
 fn default_settings_trace_with_the_bvh() {
     assert_eq!(RenderSettings::default().trace.accelerator, AccelKind::Bvh);
 }
+
+/// The seed's simple level rule against ray cones on the showcase floor: the cone's footprint is
+/// stretched by 1/|cos θ| where the ray meets the floor at θ from its normal, and the distance
+/// rule ignores θ, so the two levels differ by exactly log2(1/|cos θ|): a little below the
+/// camera, and by several levels towards the horizon, where the distance rule aliases.
+#[test]
+fn distance_levels_ignore_the_grazing_angle_that_ray_cones_see() {
+    use mirador::settings::TracerLod;
+    let mut scene = common::load("scenes/showcase.toml");
+    (scene.camera.width, scene.camera.height) = (320, 180);
+    let tracer_for = |rule: TracerLod| {
+        let mut settings = scene.settings.clone();
+        settings.textures.tracer_lod = rule;
+        Tracer::new(&scene, &settings)
+    };
+    let (cone, distance) = (tracer_for(TracerLod::RayCone), tracer_for(TracerLod::Distance));
+    let mut gaps = Vec::new();
+    for y in [178.5, 150.5, 120.5, 95.5] {
+        let ray = scene.camera.ray_through(300.5, y);
+        let by_cone = cone.whitted.texture_lod(&ray, cone.primary_cone).expect("the floor is textured");
+        let by_distance = distance.whitted.texture_lod(&ray, distance.primary_cone).expect("the floor is textured");
+        let stretch = -ray.direction.y.abs().log2();
+        assert!(
+            ((by_cone - by_distance) - stretch).abs() < 1e-3,
+            "row {y}: cone {by_cone}, distance {by_distance}, log2(1/cos) {stretch}"
+        );
+        gaps.push(stretch);
+    }
+    assert!(gaps.windows(2).all(|w| w[1] > w[0]) && gaps[3] > 2.0, "{gaps:?}");
+}

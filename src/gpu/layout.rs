@@ -43,3 +43,53 @@ pub fn sampler(binding: u32, kind: wgpu::SamplerBindingType) -> wgpu::BindGroupL
         count: None,
     }
 }
+
+/// A depth test of `format` with `compare`, writing depth or only reading it; no stencil, no
+/// bias (pipelines that need a bias set it on the returned state).
+pub fn depth_test(
+    format: wgpu::TextureFormat,
+    compare: wgpu::CompareFunction,
+    write: bool,
+) -> Option<wgpu::DepthStencilState> {
+    Some(wgpu::DepthStencilState {
+        format,
+        depth_write_enabled: Some(write),
+        depth_compare: Some(compare),
+        stencil: Default::default(),
+        bias: Default::default(),
+    })
+}
+
+/// The pipeline of a pass that runs its fragment shader once per pixel of its targets: one
+/// triangle covering them, no vertex buffers, no depth (the vertex entry point returns
+/// `fullscreen_position(vertex_index)` from `shaders/common/types.wgsl`).
+pub fn fullscreen_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    (vertex, fragment): (&str, &str),
+    targets: &[Option<wgpu::ColorTargetState>],
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(vertex),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fragment),
+            compilation_options: Default::default(),
+            targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}

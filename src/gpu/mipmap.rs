@@ -33,6 +33,7 @@ use std::collections::HashMap;
 use std::sync::Mutex;
 
 use super::texture::GpuTexture;
+use crate::gpu::layout;
 use crate::scene::{ColorSpace, Texture};
 use crate::shaders;
 use crate::texture::mipmap::Filter;
@@ -102,27 +103,14 @@ impl MipmapGenerator {
         pipelines
             .entry(format)
             .or_insert_with(|| {
-                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some("mipmap::pipeline"),
-                    layout: Some(&self.pipeline_layout),
-                    vertex: wgpu::VertexState {
-                        module: &self.module,
-                        entry_point: Some("vs_mipmap"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    primitive: Default::default(),
-                    depth_stencil: None,
-                    multisample: Default::default(),
-                    fragment: Some(wgpu::FragmentState {
-                        module: &self.module,
-                        entry_point: Some("fs_mipmap"),
-                        compilation_options: Default::default(),
-                        targets: &[Some(SCRATCH_FORMAT.into()), Some(format.into())],
-                    }),
-                    multiview_mask: None,
-                    cache: None,
-                })
+                layout::fullscreen_pipeline(
+                    device,
+                    "mipmap::pipeline",
+                    &self.pipeline_layout,
+                    &self.module,
+                    ("vs_mipmap", "fs_mipmap"),
+                    &[Some(SCRATCH_FORMAT.into()), Some(format.into())],
+                )
             })
             .clone()
     }

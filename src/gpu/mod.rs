@@ -7,6 +7,7 @@ pub mod readback;
 pub mod texture;
 pub mod uniform;
 
+use std::sync::Arc;
 use std::time::Instant;
 
 /// A wgpu device and the instance and adapter it came from.
@@ -33,18 +34,47 @@ impl Gpu {
     /// A device with no window, preferring Vulkan and falling back to GL, unless `WGPU_BACKEND`
     /// names the backends to try.
     pub fn headless() -> Result<Gpu, GpuError> {
+        let (gpu, ()) = Gpu::first_adapter(wgpu::InstanceDescriptor::new_without_display_handle, |_| Some(()))?;
+        Ok(gpu)
+    }
+
+    /// A device that can present to `window`, and the window's surface, preferring Vulkan and
+    /// falling back to GL as [`Gpu::headless`] does. GL needs the display at instance creation
+    /// to present, so the instance is made with it.
+    pub fn for_window<W>(window: Arc<W>) -> Result<(Gpu, wgpu::Surface<'static>), GpuError>
+    where
+        W: wgpu::rwh::HasWindowHandle + wgpu::rwh::HasDisplayHandle + std::fmt::Debug + Send + Sync + 'static,
+    {
+        let descriptor = || wgpu::InstanceDescriptor::new_with_display_handle(Box::new(window.clone()));
+        Gpu::first_adapter(descriptor, |instance| match instance.create_surface(window.clone()) {
+            Ok(surface) => Some(surface),
+            Err(e) => {
+                log::info!("no surface for the window: {e}");
+                None
+            }
+        })
+    }
+
+    /// Tries the backends in order; for each, `attach` may make something the adapter must be
+    /// compatible with (a window's surface), and the first adapter found wins.
+    fn first_adapter<T: SurfaceLike>(
+        descriptor: impl Fn() -> wgpu::InstanceDescriptor,
+        attach: impl Fn(&wgpu::Instance) -> Option<T>,
+    ) -> Result<(Gpu, T), GpuError> {
         let order = match wgpu::Backends::from_env() {
             Some(chosen) => vec![chosen],
             None => vec![wgpu::Backends::VULKAN, wgpu::Backends::GL],
         };
         let mut tried = Vec::new();
         for backends in order {
-            let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle().with_env();
-            descriptor.backends = backends;
-            let instance = wgpu::Instance::new(descriptor);
+            let mut d = descriptor().with_env();
+            d.backends = backends;
+            let instance = wgpu::Instance::new(d);
             tried.push(format!("{backends:?}"));
-            match pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default())) {
-                Ok(adapter) => return Gpu::with_adapter(instance, adapter),
+            let Some(attached) = attach(&instance) else { continue };
+            let options = wgpu::RequestAdapterOptions { compatible_surface: attached.surface(), ..Default::default() };
+            match pollster::block_on(instance.request_adapter(&options)) {
+                Ok(adapter) => return Ok((Gpu::with_adapter(instance, adapter)?, attached)),
                 Err(e) => log::info!("no {backends:?} adapter: {e}"),
             }
         }
@@ -74,6 +104,23 @@ impl Gpu {
     /// Blocks until the queue has finished everything submitted so far.
     pub fn wait(&self) {
         self.device.poll(wgpu::PollType::wait_indefinitely()).expect("polling the device for completion");
+    }
+}
+
+/// What an adapter must be able to draw to: a window's surface, or nothing.
+trait SurfaceLike {
+    fn surface(&self) -> Option<&wgpu::Surface<'static>>;
+}
+
+impl SurfaceLike for () {
+    fn surface(&self) -> Option<&wgpu::Surface<'static>> {
+        None
+    }
+}
+
+impl SurfaceLike for wgpu::Surface<'static> {
+    fn surface(&self) -> Option<&wgpu::Surface<'static>> {
+        Some(self)
     }
 }
 

@@ -10,6 +10,7 @@
 use super::scene_gpu::{SceneGpu, SceneLayouts};
 use super::uniforms::Vertex;
 use super::{DEPTH_FORMAT, HDR_FORMAT};
+use crate::gpu::layout;
 use crate::shaders;
 
 pub struct OpaquePass {
@@ -29,13 +30,7 @@ pub struct OpaqueTargets<'a> {
 }
 
 fn depth_state(compare: wgpu::CompareFunction, write: bool) -> Option<wgpu::DepthStencilState> {
-    Some(wgpu::DepthStencilState {
-        format: DEPTH_FORMAT,
-        depth_write_enabled: Some(write),
-        depth_compare: Some(compare),
-        stencil: Default::default(),
-        bias: Default::default(),
-    })
+    layout::depth_test(DEPTH_FORMAT, compare, write)
 }
 
 impl OpaquePass {

@@ -34,27 +34,14 @@ impl PresentPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("present::pipeline"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_present"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_present"),
-                compilation_options: Default::default(),
-                targets: &[Some(output_format.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = layout::fullscreen_pipeline(
+            device,
+            "present::pipeline",
+            &pipeline_layout,
+            &module,
+            ("vs_present", "fs_present"),
+            &[Some(output_format.into())],
+        );
         let uniform = UniformBuffer::new(device, "present::uniform", &GpuPresent { exposure: 1.0, _pad: [0.0; 3] });
         PresentPass { pipeline, layout, uniform }
     }

@@ -57,9 +57,11 @@ use glam::{Vec2, Vec3};
 use super::geometry::SurfaceHit;
 use crate::output::srgb_decode;
 use crate::scene::{ColorSpace, Material, Scene, Texture, TextureId};
-use crate::settings::{BumpSettings, TextureFilter, TextureSettings};
+use crate::settings::{BumpSettings, TextureFilter, TextureSettings, TracerLod};
 use crate::texture::tangents::normal_map_normal;
-use crate::texture::{BumpParams, Filter, MipChain, RayCone, TextureHeight, bump_normal, lod_from_footprint};
+use crate::texture::{
+    BumpParams, Filter, MipChain, RayCone, TextureHeight, bump_normal, lod_from_distance, lod_from_footprint,
+};
 
 /// The linear RGB value of `texture` at `uv`, bilinearly filtered with repeat wrapping: level 0
 /// of the chain read with [`Filter::Bilinear`], written out on the stored bytes (the reference
@@ -111,6 +113,27 @@ pub fn filter_of(filter: TextureFilter) -> Filter {
 pub fn hit_lod(cone: &RayCone, direction: Vec3, hit: &SurfaceHit, size: (u32, u32), bias: f32) -> f32 {
     let footprint = cone.footprint(hit.t, direction.dot(hit.geometric_normal));
     lod_from_footprint(footprint, hit.dpdu.length(), hit.dpdv.length(), size, bias)
+}
+
+/// The level by the seed's simple rule, `log2(distance / texel_distance)`: the distance is the
+/// whole path the cone has travelled (its width over its spread), and `texel_distance` the one at
+/// which a level-0 texel, seen head-on, covers a pixel. The angle of incidence plays no part, so
+/// a floor seen at a grazing angle keeps too fine a level (aliasing): what ray cones cure.
+pub fn distance_lod(cone: &RayCone, hit: &SurfaceHit, size: (u32, u32), bias: f32) -> Option<f32> {
+    if !(cone.spread > 0.0) {
+        return None;
+    }
+    let texel = (hit.dpdu.length() / size.0 as f32).min(hit.dpdv.length() / size.1 as f32);
+    Some(lod_from_distance(cone.width_at(hit.t) / cone.spread, texel / cone.spread, bias))
+}
+
+/// The level at a hit under `settings`' rule.
+fn level_at(cone: &RayCone, direction: Vec3, hit: &SurfaceHit, size: (u32, u32), settings: &TextureSettings) -> f32 {
+    match settings.tracer_lod {
+        TracerLod::Distance => distance_lod(cone, hit, size, settings.lod_bias),
+        TracerLod::RayCone => None,
+    }
+    .unwrap_or_else(|| hit_lod(cone, direction, hit, size, settings.lod_bias))
 }
 
 /// The scene's textures as the tracer reads them, indexed by [`TextureId`].
@@ -173,7 +196,7 @@ impl SceneTextures {
     ) -> Option<f32> {
         let chain = self.chain(material.texture?)?;
         let level0 = &chain.levels[0];
-        Some(hit_lod(cone, direction, hit, (level0.width, level0.height), settings.lod_bias))
+        Some(level_at(cone, direction, hit, (level0.width, level0.height), settings))
     }
 
     /// `C(p)`: the material's colour times its filtered texture at the hit, or the level colour
@@ -190,7 +213,7 @@ impl SceneTextures {
             return material.color;
         };
         let level0 = &chain.levels[0];
-        let lod = hit_lod(cone, direction, hit, (level0.width, level0.height), settings.lod_bias);
+        let lod = level_at(cone, direction, hit, (level0.width, level0.height), settings);
         let filter = filter_of(settings.filter);
         let texel = chain.sample(hit.uv, lod, filter).truncate();
         if filter == Filter::LevelColour { texel } else { material.color * texel }

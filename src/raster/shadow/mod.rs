@@ -232,13 +232,7 @@ impl ShadowPass {
             layout: Some(&pipeline_layout),
             vertex: vertex_state(&module),
             primitive: Default::default(),
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
+            depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::LessEqual, false),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,
@@ -359,12 +353,11 @@ impl ShadowPass {
             vertex: vertex_state(&self.module),
             // Both faces: open surfaces (planes, quads of a model) must cast too.
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: wgpu::DepthBiasState { constant: bias.constant, slope_scale: bias.slope, clamp: 0.0 },
+            depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less, true).map(|state| {
+                wgpu::DepthStencilState {
+                    bias: wgpu::DepthBiasState { constant: bias.constant, slope_scale: bias.slope, clamp: 0.0 },
+                    ..state
+                }
             }),
             multisample: Default::default(),
             fragment: None,
@@ -532,27 +525,14 @@ impl MapView {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("shadow::map_view_pipeline"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module,
-                entry_point: Some("vs_shadow_map_view"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module,
-                entry_point: Some("fs_shadow_map_view"),
-                compilation_options: Default::default(),
-                targets: &[Some(HDR_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = layout::fullscreen_pipeline(
+            device,
+            "shadow::map_view_pipeline",
+            &pipeline_layout,
+            module,
+            ("vs_shadow_map_view", "fs_shadow_map_view"),
+            &[Some(HDR_FORMAT.into())],
+        );
         let uniform = UniformBuffer::new(device, "shadow::map_view_uniform", &GpuShownLayer::zeroed());
         MapView { pipeline, layout, uniform }
     }
@@ -630,13 +610,7 @@ impl Frusta {
                 })],
             },
             primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::LineList, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
+            depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::LessEqual, false),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module,

@@ -203,16 +203,10 @@ impl ProjectedPass {
                 })],
             },
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                // No depth bias: the polygons are lifted off their receivers in world space
-                // instead. A bias in depth would let polygons hidden just behind another surface
-                // (a floor's shadow behind a wall standing on it) bleed through at its edge.
-                bias: Default::default(),
-            }),
+            // No depth bias: the polygons are lifted off their receivers in world space instead. A
+            // bias in depth would let polygons hidden just behind another surface (a floor's
+            // shadow behind a wall standing on it) bleed through at its edge.
+            depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::LessEqual, false),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &module,
