@@ -8,6 +8,10 @@
 //! - [`output`]: the output transform both renderers share.
 //! - [`compare`]: image metrics for golden images and raster-vs-trace comparisons.
 
+// Checks like `!(x > 0.0)` are written that way on purpose: unlike `x <= 0.0` they also reject
+// NaN, which user input can carry.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod compare;
 pub mod gpu;
 pub mod output;

@@ -139,17 +139,7 @@ impl Renderer {
             &OpaqueTargets { hdr: &targets.hdr.view, depth: &targets.depth.view, background: scene.background },
             projected,
         );
-        self.shadow.record_views(
-            device,
-            queue,
-            &mut encoder,
-            shadows,
-            &layout,
-            scene.camera.clip_from_world(),
-            &targets.hdr.view,
-            &targets.depth.view,
-            targets.size,
-        );
+        self.shadow.record_views(gpu, &mut encoder, shadows, &layout, scene.camera.clip_from_world(), targets);
         self.present.record(queue, &mut encoder, &targets.present_input, output, settings.exposure);
         queue.submit([encoder.finish()]);
     }

@@ -57,7 +57,7 @@ impl Mesh {
                 what: "tangents",
             });
         }
-        if self.indices.len() % 3 != 0 {
+        if !self.indices.len().is_multiple_of(3) {
             return Err(MeshError::PartialTriangle { mesh, count: self.indices.len() });
         }
         if let Some((at, &index)) = self.indices.iter().enumerate().find(|&(_, &i)| i as usize >= vertices) {

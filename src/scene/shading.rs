@@ -15,6 +15,7 @@
 //! - A light behind the surface (n·l ≤ 0) adds no diffuse or specular term. The notes' own shadow
 //!   test gives the same for closed objects; for open ones (a quad seen from its back) it stops
 //!   a highlight leaking through.
+//!
 //! The normal is turned to face the viewer first, so thin surfaces are lit on both sides.
 
 use glam::Vec3;

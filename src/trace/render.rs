@@ -91,7 +91,7 @@ impl Tracer<'_> {
             .collect();
         let bar = progress_bar(control.progress, tiles.len() as u64, "tracing");
         let cancelled = |c: &RenderControl| c.cancel.is_some_and(|flag| flag.load(Ordering::Relaxed));
-        let rendered: Vec<Option<(u32, u32, Vec<Vec3>, RayCounts)>> = tiles
+        let rendered: Vec<Option<TracedTile>> = tiles
             .par_iter()
             .map(|&(x0, y0)| {
                 if cancelled(control) {
@@ -170,6 +170,9 @@ impl Tracer<'_> {
         Ok(CornerGrid { width, values })
     }
 }
+
+/// A finished tile: its top-left pixel, its pixels row by row, and the rays it took.
+type TracedTile = (u32, u32, Vec<Vec3>, RayCounts);
 
 /// Radiance at pixel corners: `(width + 1) × (height + 1)` values.
 struct CornerGrid {

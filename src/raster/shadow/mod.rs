@@ -27,11 +27,12 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
+use super::FrameTargets;
 use super::scene_gpu::{SceneGpu, SceneLayouts};
 use super::uniforms::Vertex;
 use super::{DEPTH_FORMAT, HDR_FORMAT};
-use crate::gpu::layout;
 use crate::gpu::uniform::UniformBuffer;
+use crate::gpu::{Gpu, layout};
 use crate::settings::{ShadowFilter, ShadowMethod, ShadowSettings, ShadowView};
 use crate::shaders;
 use views::{MAX_LAYERS, ShadowLayout};
@@ -445,16 +446,15 @@ impl ShadowPass {
     /// The teaching views drawn over the shaded HDR image: the map itself, or the frusta.
     pub fn record_views(
         &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
         settings: &ShadowSettings,
         layout: &ShadowLayout,
         camera_clip_from_world: glam::Mat4,
-        hdr: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
-        size: (u32, u32),
+        frame: &FrameTargets,
     ) {
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let (hdr, depth, size) = (&frame.hdr.view, &frame.depth.view, frame.size);
         let Some(targets) = self.targets.as_ref() else { return };
         if settings.view == ShadowView::Map && !layout.views.is_empty() {
             let layer = settings.view_layer.min(layout.views.len() as u32 - 1);
