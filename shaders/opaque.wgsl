@@ -102,20 +102,62 @@ fn visibility(light: Light, p: vec3f, facing: vec3f, pixel: vec2f) -> vec3f {
     return v;
 }
 
-// The height map's red channel at uv, bilinear on level 0.
+// f_h(u, v): the height map's red channel (bilinear on level 0), or a procedural field.
 fn height_at(uv: vec2f) -> f32 {
-    return textureSampleLevel(height_texture, height_sampler, uv, 0.0).r;
+    switch material.height_kind {
+        case HEIGHT_SINE: {
+            return sine_height(uv, material.height_frequency, material.height_amplitude);
+        }
+        case HEIGHT_NOISE: {
+            return value_noise(uv, material.noise_seed, material.noise_cells, material.noise_octaves, material.height_amplitude).x;
+        }
+        default: {
+            return textureSampleLevel(height_texture, height_sampler, uv, 0.0).r;
+        }
+    }
 }
 
-// TECHNIQUES.md §3: finite differences of the height field with step Δ, perturbed tangents
-// t'u = tu + du·n, t'v = tv + dv·n, and n' = normalize(t'u × t'v) turned to n's side.
-fn bumped_normal(n: vec3f, uv: vec2f, tangents: SurfaceTangents) -> vec3f {
-    let delta = frame.bump_delta_texels / vec2f(textureDimensions(height_texture));
-    let g = bump_central_differences(
+// The finite-difference step Δ: bump_delta_texels texels of the height map, or of a procedural
+// field's own step (a 64th of a sine's shortest period, a 16th of the finest noise cell), as
+// src/texture/height.rs's default_delta.
+fn height_delta() -> vec2f {
+    switch material.height_kind {
+        case HEIGHT_SINE: {
+            return frame.bump_delta_texels / (64.0 * max(abs(material.height_frequency), vec2f(1.0)));
+        }
+        case HEIGHT_NOISE: {
+            let finest = max(material.noise_cells, 1u) << min(max(material.noise_octaves, 1u) - 1u, 20u);
+            return vec2f(frame.bump_delta_texels / (16.0 * f32(finest)));
+        }
+        default: {
+            return frame.bump_delta_texels / vec2f(textureDimensions(height_texture));
+        }
+    }
+}
+
+// The slopes (du, dv) = k·∇f_h: central differences (TECHNIQUES.md §3), or for procedural fields
+// their closed-form gradient when asked.
+fn height_slopes(uv: vec2f, k: f32) -> vec2f {
+    if frame.bump_analytic != 0u {
+        if material.height_kind == HEIGHT_SINE {
+            return k * sine_height_gradient(uv, material.height_frequency, material.height_amplitude);
+        }
+        if material.height_kind == HEIGHT_NOISE {
+            return k * value_noise(uv, material.noise_seed, material.noise_cells, material.noise_octaves, material.height_amplitude).yz;
+        }
+    }
+    let delta = height_delta();
+    return bump_central_differences(
         height_at(uv + vec2f(delta.x, 0.0)), height_at(uv - vec2f(delta.x, 0.0)),
         height_at(uv + vec2f(0.0, delta.y)), height_at(uv - vec2f(0.0, delta.y)),
-        delta, material.bump_scale * frame.bump_scale,
+        delta, k,
     );
+}
+
+// TECHNIQUES.md §3: perturbed tangents t'u = tu + du·n, t'v = tv + dv·n, and
+// n' = normalize(t'u × t'v) turned to n's side.
+fn bumped_normal(n: vec3f, uv: vec2f, tangents: SurfaceTangents) -> vec3f {
+    let g = height_slopes(uv, material.bump_scale * frame.bump_scale);
     return perturbed_normal(n, tangents.tu, tangents.tv, g.x, g.y);
 }
 

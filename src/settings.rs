@@ -111,8 +111,11 @@ pub struct BumpSettings {
     pub tangents: TangentSource,
     /// Multiplies every material's bump scale `k` (sign allowed).
     pub scale: f32,
-    /// The finite-difference step `Δ`, in texels of the height map.
+    /// The finite-difference step `Δ`, in texels of the height map (for procedural fields, in
+    /// units of the field's own step: a 64th of a sine's period, a 16th of a noise cell).
     pub delta_texels: f32,
+    /// For procedural height fields, the closed-form derivatives instead of finite differences.
+    pub analytic: bool,
     pub view: BumpView,
 }
 
@@ -123,6 +126,7 @@ impl Default for BumpSettings {
             tangents: TangentSource::Derivatives,
             scale: 1.0,
             delta_texels: 1.0,
+            analytic: false,
             view: BumpView::Off,
         }
     }

@@ -105,3 +105,55 @@ fn normal_map_normal(n: vec3f, tangent: vec4f, sample_rgb: vec3f, scale: f32) ->
     let m = normalize(m_raw);
     return normalize(m.x * t + m.y * b + m.z * n);
 }
+
+// Seeded, tileable value noise with quintic interpolation (src/texture/height.rs's ValueNoise):
+// the field and its gradient, as (value, ∂/∂u, ∂/∂v).
+fn noise_hash(x_in: u32) -> u32 {
+    var x = x_in;
+    x ^= x >> 16u;
+    x *= 0x7feb352du;
+    x ^= x >> 15u;
+    x *= 0x846ca68bu;
+    return x ^ (x >> 16u);
+}
+
+fn noise_lattice(seed: u32, i: u32, j: u32, octave: u32) -> f32 {
+    let h = noise_hash(i + noise_hash(j + noise_hash(octave + noise_hash(seed))));
+    return f32(h >> 8u) / 8388608.0 - 1.0;
+}
+
+fn quintic(t: f32) -> f32 {
+    return t * t * t * (t * (t * 6.0 - 15.0) + 10.0);
+}
+
+fn quintic_derivative(t: f32) -> f32 {
+    return 30.0 * t * t * (t * (t - 2.0) + 1.0);
+}
+
+fn value_noise(uv: vec2f, seed: u32, cells: u32, octaves: u32, amplitude_in: f32) -> vec3f {
+    var result = vec3f(0.0);
+    var amplitude = amplitude_in;
+    for (var octave = 0u; octave < max(octaves, 1u); octave++) {
+        let n = max(cells, 1u) << min(octave, 20u);
+        let p = uv * f32(n);
+        let cell = floor(p);
+        let f = p - cell;
+        let ni = i32(n);
+        let i0 = u32(((i32(cell.x) % ni) + ni) % ni);
+        let j0 = u32(((i32(cell.y) % ni) + ni) % ni);
+        let i1 = (i0 + 1u) % n;
+        let j1 = (j0 + 1u) % n;
+        let a = noise_lattice(seed, i0, j0, octave);
+        let b = noise_lattice(seed, i1, j0, octave);
+        let c = noise_lattice(seed, i0, j1, octave);
+        let d = noise_lattice(seed, i1, j1, octave);
+        let s = vec2f(quintic(f.x), quintic(f.y));
+        let cross = a - b - c + d;
+        result.x += amplitude * (a + (b - a) * s.x + (c - a) * s.y + cross * s.x * s.y);
+        let scale = amplitude * f32(n);
+        result.y += scale * ((b - a) + cross * s.y) * quintic_derivative(f.x);
+        result.z += scale * ((c - a) + cross * s.x) * quintic_derivative(f.y);
+        amplitude *= 0.5;
+    }
+    return result;
+}

@@ -65,7 +65,8 @@ struct Frame {
     bump_view: u32,
     // 0: tangents from screen derivatives; 1: the interpolated per-vertex tangents.
     bump_tangents: u32,
-    _pad0: f32,
+    // 1: procedural height fields use their closed-form derivatives, not finite differences.
+    bump_analytic: u32,
     lights: array<Light, MAX_LIGHTS>,
 }
 
@@ -88,9 +89,21 @@ struct Material {
     has_height_map: u32,
     has_normal_map: u32,
     normal_scale: f32,
+    // HEIGHT_* below: where the bump heights come from.
+    height_kind: u32,
+    height_amplitude: f32,
+    height_frequency: vec2f,
+    noise_seed: u32,
+    noise_cells: u32,
+    noise_octaves: u32,
     _pad0: f32,
     _pad1: f32,
+    _pad2: f32,
 }
+
+const HEIGHT_TEXTURE: u32 = 1u;
+const HEIGHT_SINE: u32 = 2u;
+const HEIGHT_NOISE: u32 = 3u;
 
 // Group 2: changes per object.
 struct Object {

@@ -5,7 +5,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
-use crate::scene::{Attenuation, Camera, Light, LightKind, Material, Object, Projection};
+use crate::scene::{Attenuation, Camera, Light, LightKind, Material, Object, ProceduralHeight, Projection};
 use crate::settings::{BumpView, RenderSettings, TangentSource, TextureFilter};
 
 pub const MAX_LIGHTS: usize = 16;
@@ -67,7 +67,7 @@ pub struct GpuFrame {
     pub bump_delta_texels: f32,
     pub bump_view: u32,
     pub bump_tangents: u32,
-    pub _pad: f32,
+    pub bump_analytic: u32,
     pub lights: [GpuLight; MAX_LIGHTS],
 }
 
@@ -123,7 +123,7 @@ impl GpuFrame {
                 TangentSource::Derivatives => 0,
                 TangentSource::PerVertex => 1,
             },
-            _pad: 0.0,
+            bump_analytic: u32::from(settings.bump.analytic),
             lights: gpu_lights,
         }
     }
@@ -146,7 +146,14 @@ pub struct GpuMaterial {
     pub has_height_map: u32,
     pub has_normal_map: u32,
     pub normal_scale: f32,
-    pub _pad: [f32; 2],
+    /// 1: the height map, 2: a sine field, 3: value noise (0: none).
+    pub height_kind: u32,
+    pub height_amplitude: f32,
+    pub height_frequency: [f32; 2],
+    pub noise_seed: u32,
+    pub noise_cells: u32,
+    pub noise_octaves: u32,
+    pub _pad: [f32; 3],
 }
 
 impl Material {
@@ -163,10 +170,35 @@ impl Material {
             emission: self.emission.to_array(),
             bump_scale: self.bump_scale,
             transmission: (self.transmission * self.transmission_color).to_array(),
-            has_height_map: u32::from(self.height_map.is_some()),
+            has_height_map: u32::from(self.height_map.is_some() || self.height_field.is_some()),
             has_normal_map: u32::from(self.normal_map.is_some()),
             normal_scale: self.normal_scale,
-            _pad: [0.0; 2],
+            height_kind: match self.height_field {
+                Some(ProceduralHeight::Sine { .. }) => 2,
+                Some(ProceduralHeight::Noise { .. }) => 3,
+                None => u32::from(self.height_map.is_some()),
+            },
+            height_amplitude: match self.height_field {
+                Some(ProceduralHeight::Sine { amplitude, .. } | ProceduralHeight::Noise { amplitude, .. }) => amplitude,
+                None => 0.0,
+            },
+            height_frequency: match self.height_field {
+                Some(ProceduralHeight::Sine { frequency, .. }) => frequency.to_array(),
+                _ => [0.0; 2],
+            },
+            noise_seed: match self.height_field {
+                Some(ProceduralHeight::Noise { seed, .. }) => seed,
+                _ => 0,
+            },
+            noise_cells: match self.height_field {
+                Some(ProceduralHeight::Noise { cells, .. }) => cells,
+                _ => 0,
+            },
+            noise_octaves: match self.height_field {
+                Some(ProceduralHeight::Noise { octaves, .. }) => octaves,
+                _ => 0,
+            },
+            _pad: [0.0; 3],
         }
     }
 }

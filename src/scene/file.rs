@@ -18,7 +18,7 @@ use toml::Spanned;
 use super::camera::{Camera, Projection};
 use super::gltf::{GltfCamera, GltfImport, GltfProjection};
 use super::light::{Attenuation, Light, LightKind};
-use super::material::{ColorSpace, Material, MaterialId, TextureId};
+use super::material::{ColorSpace, Material, MaterialId, ProceduralHeight, TextureId};
 use super::{Object, Scene, SceneError, Shape, texture};
 use crate::settings::RenderSettings;
 
@@ -225,9 +225,31 @@ struct MaterialDesc {
     transmission_color: Option<Rgb>,
     ior: Option<Positive>,
     height_map: Option<String>,
+    height_field: Option<Spanned<HeightFieldDesc>>,
     bump_scale: Option<Finite>,
     normal_map: Option<String>,
     normal_scale: Option<Finite>,
+}
+
+/// `height_field = { type = "sine", frequency = [8, 4], amplitude = 0.02 }` or
+/// `{ type = "noise", seed = 7, cells = 4, octaves = 3, amplitude = 0.02 }`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct HeightFieldDesc {
+    #[serde(rename = "type")]
+    kind: HeightFieldType,
+    frequency: Option<PositiveV2>,
+    amplitude: Option<Finite>,
+    seed: Option<u32>,
+    cells: Option<u32>,
+    octaves: Option<u32>,
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
+#[serde(rename_all = "snake_case")]
+enum HeightFieldType {
+    Sine,
+    Noise,
 }
 
 #[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
@@ -432,6 +454,16 @@ impl<'a> Builder<'a> {
         let texture = d.texture.map(|p| self.texture(&p, ColorSpace::Srgb, span.clone())).transpose()?;
         let height_map = d.height_map.map(|p| self.texture(&p, ColorSpace::Linear, span.clone())).transpose()?;
         let normal_map = d.normal_map.map(|p| self.texture(&p, ColorSpace::Linear, span.clone())).transpose()?;
+        let height_field = match d.height_field {
+            Some(field) => {
+                let span = field.span();
+                if height_map.is_some() {
+                    return Err(self.error("give a material either a `height_map` or a `height_field`, not both", span));
+                }
+                Some(self.height_field(field.into_inner(), span)?)
+            }
+            None => None,
+        };
         Ok(Material {
             name: name.into(),
             color: d.color.map_or(base.color, |Rgb(c)| c),
@@ -448,10 +480,39 @@ impl<'a> Builder<'a> {
             transmission_color: d.transmission_color.map_or(base.transmission_color, |Rgb(c)| c),
             ior: d.ior.map_or(base.ior, |Positive(x)| x),
             height_map,
+            height_field,
             bump_scale: d.bump_scale.map_or(base.bump_scale, |Finite(x)| x),
             normal_map,
             normal_scale: d.normal_scale.map_or(base.normal_scale, |Finite(x)| x),
         })
+    }
+
+    fn height_field(&self, d: HeightFieldDesc, span: Range<usize>) -> Result<ProceduralHeight, SceneError> {
+        let fail = |message: String| self.error(message, span.clone());
+        let amplitude = d.amplitude.map_or(0.05, |Finite(a)| a);
+        match d.kind {
+            HeightFieldType::Sine => {
+                if d.seed.is_some() || d.cells.is_some() || d.octaves.is_some() {
+                    return Err(fail("`seed`, `cells` and `octaves` apply to a noise field, not a sine".into()));
+                }
+                Ok(ProceduralHeight::Sine {
+                    frequency: d.frequency.map_or(Vec2::splat(8.0), |PositiveV2(f)| f),
+                    amplitude,
+                })
+            }
+            HeightFieldType::Noise => {
+                if d.frequency.is_some() {
+                    return Err(fail("`frequency` applies to a sine field; a noise field has `cells`".into()));
+                }
+                let (cells, octaves) = (d.cells.unwrap_or(4), d.octaves.unwrap_or(3));
+                if !(1..=1024).contains(&cells) || !(1..=8).contains(&octaves) {
+                    return Err(fail(format!(
+                        "a noise field needs 1 ≤ cells ≤ 1024 and 1 ≤ octaves ≤ 8, got {cells} and {octaves}"
+                    )));
+                }
+                Ok(ProceduralHeight::Noise { seed: d.seed.unwrap_or(0), cells, octaves, amplitude })
+            }
+        }
     }
 
     fn texture(&mut self, relative: &str, space: ColorSpace, span: Range<usize>) -> Result<TextureId, SceneError> {

@@ -746,6 +746,7 @@ impl<'d> Importer<'d> {
             transmission_color: base,
             ior: material.ior().filter(|&ior| ior >= 1.0).unwrap_or(default_ior),
             height_map: None,
+            height_field: None,
             bump_scale: 1.0,
             normal_map: normal_map.map(|(id, _)| id),
             normal_scale: normal_map.map_or(1.0, |(_, scale)| scale),

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// Index into [`crate::scene::Scene::materials`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -30,6 +30,17 @@ pub struct Texture {
     pub height: u32,
     pub rgba8: Vec<u8>,
     pub color_space: ColorSpace,
+}
+
+/// A height field given by a formula rather than an image (TECHNIQUES.md §3), with closed-form
+/// derivatives so finite differences can be compared with them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ProceduralHeight {
+    /// `a·sin(2π·f_u·u)·sin(2π·f_v·v)`.
+    Sine { frequency: Vec2, amplitude: f32 },
+    /// Seeded, tileable value noise with quintic interpolation and `octaves` octaves of `cells`,
+    /// `2·cells`, … lattice cells per unit of texture coordinate.
+    Noise { seed: u32, cells: u32, octaves: u32, amplitude: f32 },
 }
 
 /// One material of the model
@@ -60,6 +71,8 @@ pub struct Material {
     pub ior: f32,
     /// Grey-level height field and its scale `k` for bump mapping (TECHNIQUES.md §3).
     pub height_map: Option<TextureId>,
+    /// Or a procedural height field (a material has one or the other).
+    pub height_field: Option<ProceduralHeight>,
     pub bump_scale: f32,
     /// A tangent-space normal map (glTF's `normalTexture`): RGB = (n + 1)/2 in the frame
     /// (tangent, bitangent, normal), its x and y scaled by `normal_scale`.
@@ -92,6 +105,7 @@ impl Default for Material {
             transmission_color: Vec3::ONE,
             ior: 1.0,
             height_map: None,
+            height_field: None,
             bump_scale: 1.0,
             normal_map: None,
             normal_scale: 1.0,

@@ -56,11 +56,12 @@ use glam::{Vec2, Vec3};
 
 use super::geometry::SurfaceHit;
 use crate::output::srgb_decode;
-use crate::scene::{ColorSpace, Material, Scene, Texture, TextureId};
+use crate::scene::{ColorSpace, Material, ProceduralHeight, Scene, Texture, TextureId};
 use crate::settings::{BumpSettings, TextureFilter, TextureSettings, TracerLod};
 use crate::texture::tangents::normal_map_normal;
 use crate::texture::{
-    BumpParams, Filter, MipChain, RayCone, TextureHeight, bump_normal, lod_from_distance, lod_from_footprint,
+    BumpParams, Filter, HeightField, MipChain, RayCone, SineField, TextureHeight, ValueNoise, bump_normal,
+    lod_from_distance, lod_from_footprint,
 };
 
 /// The linear RGB value of `texture` at `uv`, bilinearly filtered with repeat wrapping: level 0
@@ -226,12 +227,24 @@ impl SceneTextures {
             return hit.normal;
         }
         let mut n = hit.normal;
-        if let Some(field) = material.height_map.and_then(|id| self.height(id)) {
-            let size = Vec2::new(field.level.width as f32, field.level.height as f32);
+        let sine;
+        let noise;
+        let field: Option<&dyn HeightField> = match material.height_field {
+            Some(ProceduralHeight::Sine { frequency, amplitude }) => {
+                sine = SineField { amplitude, frequency };
+                Some(&sine)
+            }
+            Some(ProceduralHeight::Noise { seed, cells, octaves, amplitude }) => {
+                noise = ValueNoise { seed, cells, octaves, amplitude };
+                Some(&noise)
+            }
+            None => material.height_map.and_then(|id| self.height(id)).map(|h| h as &dyn HeightField),
+        };
+        if let Some(field) = field {
             let params = BumpParams {
                 k: material.bump_scale * settings.scale,
-                delta: Some(Vec2::splat(settings.delta_texels) / size),
-                analytic: false,
+                delta: Some(settings.delta_texels * field.default_delta()),
+                analytic: settings.analytic,
             };
             n = bump_normal(field, &params, hit.uv, n, hit.dpdu, hit.dpdv);
         }
