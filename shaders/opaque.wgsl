@@ -2,9 +2,8 @@
 // for all lights, into the linear HDR target.
 
 @group(0) @binding(0) var<uniform> frame: Frame;
-// The sampler of the chosen texture filter (TECHNIQUES.md §2), and a bilinear one for height maps.
-@group(0) @binding(1) var color_sampler: sampler;
-@group(0) @binding(2) var height_sampler: sampler;
+// Bilinear, for height and normal maps (read on level 0).
+@group(0) @binding(1) var height_sampler: sampler;
 @group(1) @binding(0) var<uniform> material: Material;
 // sRGB, with its whole mip chain: the sampler decodes to linear before it filters.
 @group(1) @binding(1) var color_texture: texture_2d<f32>;
@@ -12,6 +11,8 @@
 @group(1) @binding(2) var height_texture: texture_2d<f32>;
 // Tangent-space normals (glTF's normalTexture), linear.
 @group(1) @binding(3) var normal_texture: texture_2d<f32>;
+// The chosen texture filter (TECHNIQUES.md §2) with the material's wrap modes.
+@group(1) @binding(4) var color_sampler: sampler;
 @group(2) @binding(0) var<uniform> object: Object;
 // Group 3: the shadow maps of this frame (pass 1's output) and how to read them.
 @group(3) @binding(0) var<uniform> shadows: Shadows;

@@ -99,9 +99,9 @@ impl Renderer {
         output: &wgpu::TextureView,
     ) {
         let (device, queue) = (&gpu.device, &gpu.queue);
-        scene_gpu.prepare_frame_group(device, &self.layouts, &settings.textures);
+        scene_gpu.prepare_materials(device, &self.layouts, &settings.textures);
         let scene_gpu = &*scene_gpu;
-        let frame_group = scene_gpu.frame_group(&settings.textures);
+        let frame_group = scene_gpu.frame_group();
         let shadows = &settings.shadows;
         let layout = shadow_layout(scene, shadows);
         scene_gpu.update_frame(gpu, scene, &layout.first_layer, settings);

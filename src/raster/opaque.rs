@@ -158,7 +158,7 @@ fn draw_all(
     pass.set_bind_group(0, frame_group, &[]);
     pass.set_bind_group(3, shadow_inputs, &[]);
     for drawable in &scene.drawables {
-        pass.set_bind_group(1, &scene.materials[drawable.material], &[]);
+        pass.set_bind_group(1, &scene.materials()[drawable.material], &[]);
         pass.set_bind_group(2, &drawable.object, &[]);
         pass.set_vertex_buffer(0, drawable.vertices.slice(..));
         pass.set_index_buffer(drawable.indices.slice(..), wgpu::IndexFormat::Uint32);

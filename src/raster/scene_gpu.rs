@@ -4,12 +4,12 @@
 
 use wgpu::util::DeviceExt;
 
-use super::uniforms::{GpuFrame, Vertex};
+use super::uniforms::{GpuFrame, GpuMaterial, Vertex};
 use crate::gpu::mipmap::{MipmapGenerator, sampler_descriptor, upload_with_mipmaps};
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::uniform::UniformBuffer;
 use crate::gpu::{Gpu, layout};
-use crate::scene::{Mesh, Scene};
+use crate::scene::{Mesh, Scene, Wrap};
 use crate::settings::RenderSettings;
 use crate::settings::{TextureFilter, TextureSettings};
 use crate::texture::mipmap::Filter;
@@ -27,11 +27,7 @@ impl SceneLayouts {
         let both = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let frame = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::frame_layout"),
-            entries: &[
-                layout::uniform(0, both),
-                layout::sampler(1, wgpu::SamplerBindingType::Filtering),
-                layout::sampler(2, wgpu::SamplerBindingType::Filtering),
-            ],
+            entries: &[layout::uniform(0, both), layout::sampler(1, wgpu::SamplerBindingType::Filtering)],
         });
         let material = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::material_layout"),
@@ -40,6 +36,7 @@ impl SceneLayouts {
                 layout::texture_2d(1),
                 layout::texture_2d(2),
                 layout::texture_2d(3),
+                layout::sampler(4, wgpu::SamplerBindingType::Filtering),
             ],
         });
         let object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -64,11 +61,28 @@ pub struct Drawable {
 
 pub struct SceneGpu {
     pub frame: UniformBuffer<GpuFrame>,
-    /// Group 0 for each texture filter used so far: the frame uniform and that filter's sampler.
-    frame_groups: Vec<((TextureFilter, u16), wgpu::BindGroup)>,
-    height_sampler: wgpu::Sampler,
-    pub materials: Vec<wgpu::BindGroup>,
+    /// Group 0: the frame uniform and the height maps' bilinear sampler.
+    frame_group: wgpu::BindGroup,
+    /// What each material binds, kept to make its group 1 for each texture filter.
+    material_inputs: Vec<MaterialInputs>,
+    /// Group 1 of every material, for each texture filter used so far: a material's sampler
+    /// carries both the filter (a setting) and the wrap modes (the material's).
+    material_groups: Vec<(FilterKey, Vec<wgpu::BindGroup>)>,
+    /// Which entry of `material_groups` this frame uses.
+    active: usize,
     pub drawables: Vec<Drawable>,
+}
+
+/// The filter and its anisotropy: what tells sets of material groups apart.
+type FilterKey = (TextureFilter, u16);
+
+struct MaterialInputs {
+    name: String,
+    uniform: UniformBuffer<GpuMaterial>,
+    color: wgpu::TextureView,
+    height: wgpu::TextureView,
+    normal: wgpu::TextureView,
+    wrap: [Wrap; 2],
 }
 
 impl SceneGpu {
@@ -100,24 +114,24 @@ impl SceneGpu {
         let flat = one_texel("scene::flat_height", [0, 0, 0, 255], wgpu::TextureFormat::Rgba8Unorm);
         let straight = one_texel("scene::straight_normal", [128, 128, 255, 255], wgpu::TextureFormat::Rgba8Unorm);
         let height_sampler = device.create_sampler(&sampler_descriptor(Filter::Bilinear, 1));
-        let materials = scene
+        let frame_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene::frame_group"),
+            layout: &layouts.frame,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: frame.binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&height_sampler) },
+            ],
+        });
+        let material_inputs = scene
             .materials
             .iter()
-            .map(|m| {
-                let uniform = UniformBuffer::new(device, &format!("scene::material {}", m.name), &m.to_gpu());
-                let color = m.texture.map_or(&white.view, |id| &textures[id.0].view);
-                let height = m.height_map.map_or(&flat.view, |id| &textures[id.0].view);
-                let normal = m.normal_map.map_or(&straight.view, |id| &textures[id.0].view);
-                device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some(&format!("scene::material_group {}", m.name)),
-                    layout: &layouts.material,
-                    entries: &[
-                        wgpu::BindGroupEntry { binding: 0, resource: uniform.binding() },
-                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(color) },
-                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(height) },
-                        wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(normal) },
-                    ],
-                })
+            .map(|m| MaterialInputs {
+                name: m.name.clone(),
+                uniform: UniformBuffer::new(device, &format!("scene::material {}", m.name), &m.to_gpu()),
+                color: m.texture.map_or(&white.view, |id| &textures[id.0].view).clone(),
+                height: m.height_map.map_or(&flat.view, |id| &textures[id.0].view).clone(),
+                normal: m.normal_map.map_or(&straight.view, |id| &textures[id.0].view).clone(),
+                wrap: m.wrap,
             })
             .collect();
 
@@ -144,13 +158,15 @@ impl SceneGpu {
                 }
             })
             .collect();
-        SceneGpu { frame, frame_groups: Vec::new(), height_sampler, materials, drawables }
+        SceneGpu { frame, frame_group, material_inputs, material_groups: Vec::new(), active: 0, drawables }
     }
 
-    /// Makes group 0 for `settings`' texture filter, the first time that filter is used.
-    pub fn prepare_frame_group(&mut self, device: &wgpu::Device, layouts: &SceneLayouts, settings: &TextureSettings) {
-        let key = frame_group_key(settings);
-        if self.frame_groups.iter().any(|(k, _)| *k == key) {
+    /// Makes every material's group 1 for `settings`' texture filter, the first time that filter
+    /// is used, and makes it the one [`Self::materials`] hands out.
+    pub fn prepare_materials(&mut self, device: &wgpu::Device, layouts: &SceneLayouts, settings: &TextureSettings) {
+        let key = filter_key(settings);
+        if let Some(index) = self.material_groups.iter().position(|(k, _)| *k == key) {
+            self.active = index;
             return;
         }
         let filter = match settings.filter {
@@ -159,24 +175,50 @@ impl SceneGpu {
             TextureFilter::NearestMip => Filter::NearestMip,
             TextureFilter::Trilinear | TextureFilter::LevelColour | TextureFilter::Anisotropic => Filter::Trilinear,
         };
-        let sampler = device.create_sampler(&sampler_descriptor(filter, key.1));
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("scene::frame_group"),
-            layout: &layouts.frame,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: self.frame.binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&sampler) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&self.height_sampler) },
-            ],
-        });
-        self.frame_groups.push((key, group));
+        let mut samplers: Vec<([Wrap; 2], wgpu::Sampler)> = Vec::new();
+        let groups = self
+            .material_inputs
+            .iter()
+            .map(|m| {
+                let sampler = match samplers.iter().find(|(w, _)| *w == m.wrap) {
+                    Some((_, sampler)) => sampler.clone(),
+                    None => {
+                        let [u, v] = m.wrap.map(address_mode);
+                        let descriptor = wgpu::SamplerDescriptor {
+                            address_mode_u: u,
+                            address_mode_v: v,
+                            ..sampler_descriptor(filter, key.1)
+                        };
+                        let sampler = device.create_sampler(&descriptor);
+                        samplers.push((m.wrap, sampler.clone()));
+                        sampler
+                    }
+                };
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(&format!("scene::material_group {}", m.name)),
+                    layout: &layouts.material,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: m.uniform.binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&m.color) },
+                        wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&m.height) },
+                        wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&m.normal) },
+                        wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(&sampler) },
+                    ],
+                })
+            })
+            .collect();
+        self.material_groups.push((key, groups));
+        self.active = self.material_groups.len() - 1;
     }
 
-    /// Group 0 for `settings`' texture filter; [`Self::prepare_frame_group`] made it.
-    pub fn frame_group(&self, settings: &TextureSettings) -> &wgpu::BindGroup {
-        let key = frame_group_key(settings);
-        let (_, group) = self.frame_groups.iter().find(|(k, _)| *k == key).expect("prepare_frame_group() runs first");
-        group
+    /// Group 0.
+    pub fn frame_group(&self) -> &wgpu::BindGroup {
+        &self.frame_group
+    }
+
+    /// Every material's group 1 for the texture filter [`Self::prepare_materials`] chose.
+    pub fn materials(&self) -> &[wgpu::BindGroup] {
+        &self.material_groups.get(self.active).expect("prepare_materials() runs before drawing").1
     }
 
     /// Rewrites the per-frame uniform: camera, lights, their shadow layers, and toggles.
@@ -190,8 +232,17 @@ impl SceneGpu {
     }
 }
 
-/// The filter and its anisotropy: what tells frame groups apart.
-fn frame_group_key(settings: &TextureSettings) -> (TextureFilter, u16) {
+/// The sampler address mode of a wrap mode.
+fn address_mode(wrap: Wrap) -> wgpu::AddressMode {
+    match wrap {
+        Wrap::Repeat => wgpu::AddressMode::Repeat,
+        Wrap::Clamp => wgpu::AddressMode::ClampToEdge,
+        Wrap::Mirror => wgpu::AddressMode::MirrorRepeat,
+    }
+}
+
+/// The filter and its anisotropy.
+fn filter_key(settings: &TextureSettings) -> FilterKey {
     let anisotropy = if settings.filter == TextureFilter::Anisotropic { settings.anisotropy } else { 1 };
     (settings.filter, anisotropy)
 }

@@ -18,7 +18,7 @@ use toml::Spanned;
 use super::camera::{Camera, Projection};
 use super::gltf::{GltfCamera, GltfImport, GltfProjection};
 use super::light::{Attenuation, Light, LightKind};
-use super::material::{ColorSpace, Material, MaterialId, ProceduralHeight, TextureId};
+use super::material::{ColorSpace, Material, MaterialId, ProceduralHeight, TextureId, Wrap};
 use super::{Object, Scene, SceneError, Shape, texture};
 use crate::settings::RenderSettings;
 
@@ -213,6 +213,7 @@ struct WorldDesc {
 struct MaterialDesc {
     color: Option<Rgb>,
     texture: Option<String>,
+    wrap: Option<WrapDesc>,
     ka: Option<NonNegative>,
     kd: Option<NonNegative>,
     ks: Option<NonNegative>,
@@ -229,6 +230,32 @@ struct MaterialDesc {
     bump_scale: Option<Finite>,
     normal_map: Option<String>,
     normal_scale: Option<Finite>,
+}
+
+/// `wrap = "clamp"` for both axes, or `wrap = ["repeat", "mirror"]` for u and v.
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum WrapDesc {
+    Both(WrapName),
+    PerAxis([WrapName; 2]),
+}
+
+#[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
+#[serde(rename_all = "snake_case")]
+enum WrapName {
+    Repeat,
+    Clamp,
+    Mirror,
+}
+
+impl From<WrapName> for Wrap {
+    fn from(name: WrapName) -> Wrap {
+        match name {
+            WrapName::Repeat => Wrap::Repeat,
+            WrapName::Clamp => Wrap::Clamp,
+            WrapName::Mirror => Wrap::Mirror,
+        }
+    }
 }
 
 /// `height_field = { type = "sine", frequency = [8, 4], amplitude = 0.02 }` or
@@ -468,6 +495,11 @@ impl<'a> Builder<'a> {
             name: name.into(),
             color: d.color.map_or(base.color, |Rgb(c)| c),
             texture,
+            wrap: match d.wrap {
+                Some(WrapDesc::Both(w)) => [w.into(); 2],
+                Some(WrapDesc::PerAxis([u, v])) => [u.into(), v.into()],
+                None => base.wrap,
+            },
             ka: d.ka.map_or(base.ka, |NonNegative(x)| x),
             kd: d.kd.map_or(base.kd, |NonNegative(x)| x),
             ks: d.ks.map_or(base.ks, |NonNegative(x)| x),

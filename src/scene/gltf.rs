@@ -80,7 +80,7 @@ use gltf::khr_lights_punctual::Kind;
 use gltf::mesh::{Mode, Semantic};
 use gltf::scene::Transform;
 
-use super::material::ColorSpace;
+use super::material::{ColorSpace, Wrap};
 use super::{Attenuation, Light, LightKind, Material, Mesh, SceneError, Texture, TextureId, texture};
 
 /// What one glTF file contributes to a scene, in the glTF file's own world coordinates.
@@ -723,6 +723,13 @@ impl<'d> Importer<'d> {
             }
             None => None,
         };
+        // One wrap for the whole material: the base colour texture's sampler, else the normal
+        // texture's (glTF gives each texture its own; Mirador's materials have one).
+        let sampler = pbr
+            .base_color_texture()
+            .map(|info| info.texture().sampler())
+            .or_else(|| material.normal_texture().map(|info| info.texture().sampler()));
+        let wrap = sampler.map_or([Wrap::Repeat; 2], |s| [wrap_of(s.wrap_s()), wrap_of(s.wrap_t())]);
         let normal_map = match material.normal_texture() {
             Some(info) => Some((self.texture(info.texture().source(), ColorSpace::Linear)?, info.scale())),
             None => None,
@@ -734,6 +741,7 @@ impl<'d> Importer<'d> {
             name,
             color: base,
             texture,
+            wrap,
             ka: 0.0,
             kd: phong.kd,
             ks: phong.ks,
@@ -951,6 +959,15 @@ fn phong_from_metallic_roughness(base: Vec3, metallic: f32, roughness: f32) -> P
         specular_color: Vec3::ONE.lerp(base, metallic),
         shininess,
         mirror: metallic * (1.0 - roughness) * (1.0 - roughness),
+    }
+}
+
+/// glTF's wrapping mode as Mirador's.
+fn wrap_of(mode: gltf::texture::WrappingMode) -> Wrap {
+    match mode {
+        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        gltf::texture::WrappingMode::ClampToEdge => Wrap::Clamp,
+        gltf::texture::WrappingMode::MirroredRepeat => Wrap::Mirror,
     }
 }
 

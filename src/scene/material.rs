@@ -32,6 +32,32 @@ pub struct Texture {
     pub color_space: ColorSpace,
 }
 
+/// How texture coordinates outside [0, 1] are brought back into the image, per axis (glTF's
+/// `wrapS` / `wrapT`; the GPU sampler's address modes).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Wrap {
+    #[default]
+    Repeat,
+    /// Clamp to the edge texel.
+    Clamp,
+    /// Repeat, every other copy mirrored.
+    Mirror,
+}
+
+impl Wrap {
+    /// Texel index `i` of an axis `n` texels long, brought into `0..n`.
+    pub fn index(self, i: i64, n: i64) -> i64 {
+        match self {
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::Clamp => i.clamp(0, n - 1),
+            Wrap::Mirror => {
+                let m = i.rem_euclid(2 * n);
+                if m < n { m } else { 2 * n - 1 - m }
+            }
+        }
+    }
+}
+
 /// A height field given by a formula rather than an image (TECHNIQUES.md §3), with closed-form
 /// derivatives so finite differences can be compared with them.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,6 +77,8 @@ pub struct Material {
     /// `C`: linear RGB surface colour, multiplied by `texture` where there is one.
     pub color: Vec3,
     pub texture: Option<TextureId>,
+    /// How the material's textures wrap along u and v.
+    pub wrap: [Wrap; 2],
     /// Per-light ambient coefficient (seed 000's `Directa`: `ka·C`, counted only where the light
     /// is visible).
     pub ka: f32,
@@ -93,6 +121,7 @@ impl Default for Material {
             name: "default".into(),
             color: Vec3::splat(0.8),
             texture: None,
+            wrap: [Wrap::Repeat; 2],
             ka: 0.0,
             kd: 1.0,
             ks: 0.0,

@@ -20,7 +20,7 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 
 pub use camera::{Camera, Projection, Ray};
 pub use light::{Attenuation, Light, LightKind};
-pub use material::{ColorSpace, Material, MaterialId, ProceduralHeight, Texture, TextureId};
+pub use material::{ColorSpace, Material, MaterialId, ProceduralHeight, Texture, TextureId, Wrap};
 pub use mesh::Mesh;
 
 use crate::settings::RenderSettings;

@@ -40,7 +40,7 @@ use glam::{Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 use crate::output::{srgb_decode, srgb_encode};
-use crate::scene::{ColorSpace, Texture};
+use crate::scene::{ColorSpace, Texture, Wrap};
 
 /// How a texture is read. [`MipChain::sample`] implements each on the CPU;
 /// `crate::gpu::mipmap::sampler_descriptor` gives the GPU sampler that does the same.
@@ -171,23 +171,39 @@ impl MipLevel {
 
     /// The texel at integer coordinates, wrapped (repeat) into the level.
     pub fn texel(&self, i: i64, j: i64) -> Vec4 {
-        let i = i.rem_euclid(i64::from(self.width)) as usize;
-        let j = j.rem_euclid(i64::from(self.height)) as usize;
+        self.texel_wrapped(i, j, [Wrap::Repeat; 2])
+    }
+
+    /// The texel at integer coordinates, brought into the level by `wrap` along u and v.
+    pub fn texel_wrapped(&self, i: i64, j: i64, wrap: [Wrap; 2]) -> Vec4 {
+        let i = wrap[0].index(i, i64::from(self.width)) as usize;
+        let j = wrap[1].index(j, i64::from(self.height)) as usize;
         self.texels[j * self.width as usize + i]
     }
 
     /// The texel whose square contains `uv` (repeat wrapping).
     pub fn nearest(&self, uv: Vec2) -> Vec4 {
+        self.nearest_wrapped(uv, [Wrap::Repeat; 2])
+    }
+
+    /// The texel whose square contains `uv`, wrapped by `wrap`.
+    pub fn nearest_wrapped(&self, uv: Vec2, wrap: [Wrap; 2]) -> Vec4 {
         let x = uv.x * self.width as f32;
         let y = uv.y * self.height as f32;
         if !(x.is_finite() && y.is_finite()) {
             return Vec4::ZERO;
         }
-        self.texel(x.floor() as i64, y.floor() as i64)
+        self.texel_wrapped(x.floor() as i64, y.floor() as i64, wrap)
     }
 
     /// Bilinear interpolation between the four texel centres around `uv` (repeat wrapping).
     pub fn bilinear(&self, uv: Vec2) -> Vec4 {
+        self.bilinear_wrapped(uv, [Wrap::Repeat; 2])
+    }
+
+    /// Bilinear interpolation between the four texel centres around `uv`, each wrapped by `wrap`
+    /// as the GPU's address modes do.
+    pub fn bilinear_wrapped(&self, uv: Vec2, wrap: [Wrap; 2]) -> Vec4 {
         let x = uv.x * self.width as f32 - 0.5;
         let y = uv.y * self.height as f32 - 0.5;
         if !(x.is_finite() && y.is_finite()) {
@@ -196,8 +212,9 @@ impl MipLevel {
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (i, j) = (x0 as i64, y0 as i64);
-        let top = self.texel(i, j).lerp(self.texel(i + 1, j), fx);
-        let bottom = self.texel(i, j + 1).lerp(self.texel(i + 1, j + 1), fx);
+        let texel = |i, j| self.texel_wrapped(i, j, wrap);
+        let top = texel(i, j).lerp(texel(i + 1, j), fx);
+        let bottom = texel(i, j + 1).lerp(texel(i + 1, j + 1), fx);
         top.lerp(bottom, fy)
     }
 
@@ -285,24 +302,29 @@ impl MipChain {
     /// The texture at `uv` filtered by `filter` at level of detail `lod` (ignored by
     /// [`Filter::Nearest`] and [`Filter::Bilinear`], which read level 0 only).
     pub fn sample(&self, uv: Vec2, lod: f32, filter: Filter) -> Vec4 {
+        self.sample_wrapped(uv, lod, filter, [Wrap::Repeat; 2])
+    }
+
+    /// [`MipChain::sample`] with texture coordinates wrapped by `wrap` along u and v.
+    pub fn sample_wrapped(&self, uv: Vec2, lod: f32, filter: Filter, wrap: [Wrap; 2]) -> Vec4 {
         let lod = if lod.is_nan() { 0.0 } else { lod.clamp(0.0, self.max_lod()) };
         match filter {
-            Filter::Nearest => self.levels[0].nearest(uv),
-            Filter::Bilinear => self.levels[0].bilinear(uv),
+            Filter::Nearest => self.levels[0].nearest_wrapped(uv, wrap),
+            Filter::Bilinear => self.levels[0].bilinear_wrapped(uv, wrap),
             Filter::NearestMip => {
                 // Vulkan's nearest mip: ⌈λ + ½⌉ − 1, which rounds λ = i + ½ down to level i.
                 let level = ((lod + 0.5).ceil() - 1.0).max(0.0) as usize;
-                self.levels[level].bilinear(uv)
+                self.levels[level].bilinear_wrapped(uv, wrap)
             }
             Filter::Trilinear => {
                 let lo = lod.floor();
                 let fraction = lod - lo;
                 let lo = lo as usize;
-                let near = self.levels[lo].bilinear(uv);
+                let near = self.levels[lo].bilinear_wrapped(uv, wrap);
                 if fraction == 0.0 {
                     return near;
                 }
-                near.lerp(self.levels[lo + 1].bilinear(uv), fraction)
+                near.lerp(self.levels[lo + 1].bilinear_wrapped(uv, wrap), fraction)
             }
             Filter::LevelColour => level_colour(lod).extend(1.0),
         }

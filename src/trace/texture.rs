@@ -216,7 +216,7 @@ impl SceneTextures {
         let level0 = &chain.levels[0];
         let lod = level_at(cone, direction, hit, (level0.width, level0.height), settings);
         let filter = filter_of(settings.filter);
-        let texel = chain.sample(hit.uv, lod, filter).truncate();
+        let texel = chain.sample_wrapped(hit.uv, lod, filter, material.wrap).truncate();
         if filter == Filter::LevelColour { texel } else { material.color * texel }
     }
 
@@ -253,7 +253,7 @@ impl SceneTextures {
             // MikkTSpace makes it from the same texture coordinates.
             let t = hit.dpdu - hit.dpdu.dot(n) * n;
             let sign = if n.cross(t).dot(hit.dpdv) < 0.0 { -1.0 } else { 1.0 };
-            let rgb = chain.sample(hit.uv, 0.0, Filter::Bilinear).truncate();
+            let rgb = chain.sample_wrapped(hit.uv, 0.0, Filter::Bilinear, material.wrap).truncate();
             n = normal_map_normal(n, t.extend(sign), rgb, material.normal_scale);
         }
         n

@@ -487,7 +487,7 @@ fn vertex_state(module: &wgpu::ShaderModule) -> wgpu::VertexState<'_> {
 /// Draws the opaque (or the transparent) drawables with bind groups 1 and 2.
 fn draw(pass: &mut wgpu::RenderPass<'_>, scene: &SceneGpu, transparent: bool) {
     for drawable in scene.drawables.iter().filter(|d| d.transparent == transparent) {
-        pass.set_bind_group(1, &scene.materials[drawable.material], &[]);
+        pass.set_bind_group(1, &scene.materials()[drawable.material], &[]);
         pass.set_bind_group(2, &drawable.object, &[]);
         pass.set_vertex_buffer(0, drawable.vertices.slice(..));
         pass.set_index_buffer(drawable.indices.slice(..), wgpu::IndexFormat::Uint32);
