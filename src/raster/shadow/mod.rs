@@ -107,7 +107,6 @@ struct ShadowTargets {
     size: u32,
     layers: u32,
     with_transmission: bool,
-    depth: wgpu::Texture,
     depth_array: wgpu::TextureView,
     depth_layers: Vec<wgpu::TextureView>,
     transmission_array: wgpu::TextureView,
@@ -154,8 +153,7 @@ impl ShadowTargets {
     /// At least one layer of each, so the opaque pass can always bind them; 1×1 when unused.
     fn new(device: &wgpu::Device, size: u32, layers: u32, with_transmission: bool) -> ShadowTargets {
         let layers = layers.max(1);
-        let (depth, depth_array, depth_layers) =
-            array_texture(device, "shadow::depth_maps", size, layers, DEPTH_FORMAT);
+        let (_, depth_array, depth_layers) = array_texture(device, "shadow::depth_maps", size, layers, DEPTH_FORMAT);
         let (transmission_size, transmission_layers_count) = if with_transmission { (size, layers) } else { (1, 1) };
         let (_, transmission_array, transmission_layers) = array_texture(
             device,
@@ -168,7 +166,6 @@ impl ShadowTargets {
             size,
             layers,
             with_transmission,
-            depth,
             depth_array,
             depth_layers,
             transmission_array,
@@ -464,11 +461,6 @@ impl ShadowPass {
         if settings.show_frusta && !layout.views.is_empty() {
             self.frusta.record(device, queue, encoder, layout, camera_clip_from_world, hdr, depth);
         }
-    }
-
-    /// The shadow-map texture, for tests and teaching tools that read it back.
-    pub fn depth_maps(&self) -> Option<&wgpu::Texture> {
-        self.targets.as_ref().map(|t| &t.depth)
     }
 }
 
