@@ -4,11 +4,8 @@
 // channel i is 1 where the receiver is in the shadow of shadowed light i. The mask's blend is
 // max, so where polygons overlap the receiver is not darkened twice.
 
-struct ProjectedCamera {
-    clip_from_world: mat4x4f,
-}
-
-@group(0) @binding(0) var<uniform> camera: ProjectedCamera;
+// Group 0 of the scene pass, at the main view's slot.
+@group(0) @binding(0) var<uniform> view: View;
 
 struct ProjectedIn {
     @location(0) position: vec3f,
@@ -23,7 +20,7 @@ struct ProjectedOut {
 @vertex
 fn vs_shadow_projected(in: ProjectedIn) -> ProjectedOut {
     var out: ProjectedOut;
-    out.clip = camera.clip_from_world * vec4f(in.position, 1.0);
+    out.clip = view.clip_from_world * vec4f(in.position, 1.0);
     out.slot = in.slot;
     return out;
 }

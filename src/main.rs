@@ -11,7 +11,7 @@ use clap::{CommandFactory, Parser, Subcommand};
 use mirador::compare::sheet::{Panel, flip_legend, sheet, with_footer};
 use mirador::gpu::texture::GpuTexture;
 use mirador::gpu::{Gpu, Stopwatch, readback};
-use mirador::raster::{OUTPUT_FORMAT, Renderer};
+use mirador::raster::{OUTPUT_FORMAT, Renderer, drawn_size};
 use mirador::settings::AntiAliasing;
 use mirador::trace::accel::AccelKind;
 use mirador::trace::{RenderControl, Tracer};
@@ -203,27 +203,48 @@ fn render(args: SceneArgs, output_path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The rasterizer's image of `scene` with its settings; returns it and the adapter's name.
+/// The rasterizer's image of `scene` with its settings; returns it and the adapter's name. With
+/// `timed_frames`, also a second frame (what an interactive frame costs, with everything the
+/// first one cached) and a third with each pass submitted and timed on its own.
 fn rasterize(scene: &Scene, clock: &mut Stopwatch, timed_frames: bool) -> anyhow::Result<(image::RgbaImage, String)> {
     let gpu = clock.time("device", Gpu::headless)?;
     let mut renderer = clock.time("pipelines", || Renderer::new(&gpu.device, OUTPUT_FORMAT));
     let size = (scene.camera.width, scene.camera.height);
-    let (mut scene_gpu, targets, output) = clock.time("upload", || {
+    let (mut scene_gpu, mut targets, output) = clock.time("upload", || {
         let scene_gpu = renderer.upload(&gpu, scene);
-        let targets = renderer.targets(&gpu.device, size);
+        let targets = renderer.targets(&gpu.device, drawn_size(size, scene.settings.raster.render_scale));
         let output = GpuTexture::target(&gpu.device, "cli::output", size, OUTPUT_FORMAT);
         gpu.wait();
         (scene_gpu, targets, output)
     });
-    // The first frame also pays for the driver's lazy pipeline compilation; the second is what
-    // an interactive frame costs. `--stats` reports both.
-    for lap in ["first frame", "frame"] {
-        clock.time(lap, || {
-            renderer.render(&gpu, scene, &mut scene_gpu, &scene.settings, &targets, &output.view);
-            gpu.wait();
-        });
-        if !timed_frames {
-            break;
+    // The first frame also pays for the driver's lazy pipeline compilation and fills the caches
+    // (shadow maps, tessellations); the second is what an interactive frame costs.
+    let mut frame = |renderer: &mut Renderer| {
+        let report = renderer.render(&gpu, scene, &mut scene_gpu, &scene.settings, &mut targets, &output.view);
+        gpu.wait();
+        report
+    };
+    let first = clock.time("first frame", || frame(&mut renderer));
+    if timed_frames {
+        let second = clock.time("frame", || frame(&mut renderer));
+        renderer.profile = true;
+        renderer.invalidate_shadows();
+        let profiled = frame(&mut renderer);
+        println!(
+            "raster: {} triangles per view in {} meshes, {} shader variants, drawn at {}×{}",
+            first.triangles,
+            scene_gpu.geometry.mesh_count(),
+            renderer.shader_variants(),
+            first.drawn_size.0,
+            first.drawn_size.1
+        );
+        println!(
+            "shadow layers drawn: {} in the first frame, {} in the second (kept across frames)",
+            first.shadow_layers_drawn, second.shadow_layers_drawn
+        );
+        println!("passes (each submitted and waited for on its own, shadow maps redrawn):");
+        for (name, time) in &profiled.passes {
+            println!("{name:>20}: {:9.3} ms", time.as_secs_f64() * 1e3);
         }
     }
     let pixels = clock.time("readback", || readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture));
@@ -305,11 +326,9 @@ fn compare(
 }
 
 fn print_scene(scene: &Scene) {
-    let triangles: usize = scene.objects.iter().map(|o| scene.tessellate(o).triangle_count()).sum();
     println!(
-        "scene: {} objects ({} raster triangles), {} lights, {}×{} pixels",
+        "scene: {} objects, {} lights, {}×{} pixels",
         scene.objects.len(),
-        triangles,
         scene.lights.len(),
         scene.camera.width,
         scene.camera.height

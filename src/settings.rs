@@ -5,7 +5,6 @@
 use serde::{Deserialize, Serialize};
 
 use crate::scene::shading::Terms;
-use crate::trace::accel::AccelKind;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -23,8 +22,34 @@ pub struct RenderSettings {
     /// Cast shadows: shadow maps or projected polygons in the rasterizer, shadow rays in the
     /// tracer (TECHNIQUES.md §4).
     pub shadows: ShadowSettings,
+    /// How the rasterizer spends its time: prepass, tessellation, render scale.
+    pub raster: RasterSettings,
     /// The ray tracer's own settings.
     pub trace: TraceSettings,
+}
+
+/// The rasterizer's speed settings. None of them changes what the techniques compute; each trades
+/// time for a documented, measured difference (docs/performance.md).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RasterSettings {
+    /// Draw the depth of every pixel first, then run the illumination model only on the visible
+    /// surface (once per pixel, not once per fragment drawn).
+    pub depth_prepass: bool,
+    /// Tessellate curved shapes by their size on screen (within a quarter pixel of the true
+    /// outline), up to `sphere_segments`; off: every curved shape gets `sphere_segments`.
+    pub adaptive_tessellation: bool,
+    /// Draw at this fraction of the output's size and upscale in the present pass (0.1 to 1).
+    pub render_scale: f32,
+    /// Each surface in its material's colour, no lighting: the floor of what the GPU can do with
+    /// this geometry, for benchmarks.
+    pub flat_colour: bool,
+}
+
+impl Default for RasterSettings {
+    fn default() -> Self {
+        RasterSettings { depth_prepass: true, adaptive_tessellation: true, render_scale: 1.0, flat_colour: false }
+    }
 }
 
 /// How colour textures are filtered.
@@ -159,6 +184,17 @@ pub enum ShadowFilter {
     Poisson,
 }
 
+/// What a directional light's shadow map covers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum ShadowFit {
+    /// The part of the view frustum within `distance` of the eye: finer texels where the camera
+    /// looks, redrawn when the camera moves.
+    View,
+    /// The whole scene: coarser texels, but independent of the camera, so kept while it moves.
+    Scene,
+}
+
 /// What the teaching view shows instead of, or over, the shaded image.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "snake_case")]
@@ -188,6 +224,10 @@ pub struct ShadowSettings {
     /// How far from the eye a directional light's map reaches, in scene units (0: four times the
     /// distance from the eye to the view centre, at most the far plane).
     pub distance: f32,
+    /// What a directional light's map covers.
+    pub fit: ShadowFit,
+    /// Keep each map layer across frames until its light, the casters or the bias change.
+    pub cache: bool,
     /// Transparent occluders (kt > 0) cast coloured, partial shadows.
     pub transmission: bool,
     pub view: ShadowView,
@@ -208,6 +248,8 @@ impl Default for ShadowSettings {
             slope_bias: 1.5,
             normal_offset: 1.0,
             distance: 0.0,
+            fit: ShadowFit::View,
+            cache: true,
             transmission: true,
             view: ShadowView::Off,
             view_layer: 0,
@@ -232,6 +274,21 @@ pub enum AntiAliasing {
     /// Whitted's adaptive subdivision: corner rays, and a square split in four while its corners
     /// differ by more than `adaptive_threshold`, down to `adaptive_max_level`.
     Adaptive,
+}
+
+/// Which acceleration structure the ray tracer builds (`--accel bvh|grid|octree|none`). It lives
+/// here, not in `trace`, so the layers stay one-way: scene ← settings ← renderers.
+#[derive(clap::ValueEnum, Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum AccelKind {
+    /// Bounding volume hierarchy, binned SAH.
+    #[default]
+    Bvh,
+    /// Uniform grid walked by 3D-DDA.
+    Grid,
+    Octree,
+    /// Brute force: every primitive for every ray.
+    None,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -295,6 +352,7 @@ impl Default for RenderSettings {
             textures: TextureSettings::default(),
             bump: BumpSettings::default(),
             shadows: ShadowSettings::default(),
+            raster: RasterSettings::default(),
             trace: TraceSettings::default(),
         }
     }
@@ -374,6 +432,10 @@ impl RenderSettings {
                 "bump.delta_texels must lie in (0, 64], got {}",
                 bump.delta_texels
             )));
+        }
+        let scale = self.raster.render_scale;
+        if !(scale.is_finite() && (0.1..=1.0).contains(&scale)) {
+            return Err(SettingsError::Invalid(format!("raster.render_scale must lie in 0.1..=1, got {scale}")));
         }
         let shadows = &self.shadows;
         if !(256..=4096).contains(&shadows.map_size) {

@@ -9,11 +9,22 @@ pub const COMMON: &[(&str, &str)] = &[
     ("common/shadow.wgsl", include_str!("../shaders/common/shadow.wgsl")),
 ];
 
-pub const OPAQUE: &str = include_str!("../shaders/opaque.wgsl");
+pub const SCENE: &str = include_str!("../shaders/scene.wgsl");
 pub const PRESENT: &str = include_str!("../shaders/present.wgsl");
 pub const MIPMAP: &str = include_str!("../shaders/mipmap.wgsl");
 pub const SHADOW: &str = include_str!("../shaders/shadow.wgsl");
 pub const SHADOW_PROJECTED: &str = include_str!("../shaders/shadow_projected.wgsl");
+pub const OVERLAYS: &str = include_str!("../shaders/overlays.wgsl");
+
+/// Every pass's own file, by name, for tests that validate them all.
+pub const PASSES: &[(&str, &str)] = &[
+    ("scene", SCENE),
+    ("present", PRESENT),
+    ("mipmap", MIPMAP),
+    ("shadow", SHADOW),
+    ("shadow_projected", SHADOW_PROJECTED),
+    ("overlays", OVERLAYS),
+];
 
 /// The full source of a pass: the common files, then the pass's own.
 pub fn compose(pass: &str) -> String {

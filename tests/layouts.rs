@@ -1,49 +1,214 @@
-//! Every `#[repr(C)]` GPU struct has the size naga computes for its WGSL twin, so padding is
-//! checked here instead of being kept in step by hand in two places.
+//! Twins that cannot drift: every `#[repr(C)]` GPU struct has the size and the field offsets naga
+//! computes for its WGSL twin, every code shared by Rust and WGSL (light kinds, terms, filter
+//! modes, shadow methods, view modes, height sources, array limits) has the same value on both
+//! sides, and every pipeline constant the scene pass sets is an `override` of its shader. So
+//! padding and codes are checked here instead of being kept in step by hand in two places.
 
-use mirador::raster::uniforms::{GpuFrame, GpuLight, GpuMaterial, GpuObject, GpuPresent};
+use std::mem::{offset_of, size_of};
+
+use mirador::raster::scene_pass::{self, CONSTANT_NAMES, SHADOW_FILTER_NAMES, shadow_filter_code};
+use mirador::raster::shadow::views::MAX_LAYERS;
+use mirador::raster::shadow::{GpuShadowLayer, GpuShadows};
+use mirador::raster::uniforms::{self, GpuFrame, GpuInstance, GpuLight, GpuMaterial, GpuPresent, GpuView};
 use mirador::shaders;
 
-/// The byte size of each named struct in a WGSL source, as naga lays it out.
-fn struct_sizes(source: &str) -> Vec<(String, u32)> {
-    let module = naga::front::wgsl::parse_str(source).unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)));
+fn parse(source: &str) -> naga::Module {
+    naga::front::wgsl::parse_str(source).unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)))
+}
+
+/// Each named struct's size and its members' (name, offset), as naga lays them out.
+fn structs(module: &naga::Module) -> Vec<(String, u32, Vec<(String, u32)>)> {
     module
         .types
         .iter()
         .filter_map(|(_, ty)| match &ty.inner {
-            naga::TypeInner::Struct { span, .. } => Some((ty.name.clone()?, *span)),
+            naga::TypeInner::Struct { span, members } => Some((
+                ty.name.clone()?,
+                *span,
+                members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect(),
+            )),
             _ => None,
         })
         .collect()
 }
 
-fn wgsl_size(sizes: &[(String, u32)], name: &str) -> usize {
-    sizes.iter().find(|(n, _)| n == name).unwrap_or_else(|| panic!("no struct {name} in the WGSL")).1 as usize
+/// The value of a named `const` of scalar type.
+fn constant(module: &naga::Module, name: &str) -> f64 {
+    let (_, c) = module
+        .constants
+        .iter()
+        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no const {name} in the WGSL"));
+    match module.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::U32(v)) => f64::from(v),
+        naga::Expression::Literal(naga::Literal::I32(v)) => f64::from(v),
+        naga::Expression::Literal(naga::Literal::F32(v)) => f64::from(v),
+        ref other => panic!("const {name} is not a scalar literal: {other:?}"),
+    }
+}
+
+/// Compares a WGSL struct with its Rust twin: the size, and the offset of every field that is not
+/// padding (the Rust twin's fields are listed with their offsets by `fields!`).
+fn check_struct(all: &[(String, u32, Vec<(String, u32)>)], name: &str, size: usize, rust: &[(&str, usize)]) {
+    let (_, span, members) =
+        all.iter().find(|(n, _, _)| n == name).unwrap_or_else(|| panic!("no struct {name} in the WGSL"));
+    assert_eq!(*span as usize, size, "size of WGSL {name} vs its Rust twin");
+    let wgsl: Vec<(&str, usize)> =
+        members.iter().filter(|(m, _)| !m.starts_with("_pad")).map(|(m, o)| (m.as_str(), *o as usize)).collect();
+    let rust: Vec<(&str, usize)> = rust.iter().copied().filter(|(m, _)| !m.starts_with("_pad")).collect();
+    assert_eq!(wgsl, rust, "fields and offsets of WGSL {name} vs its Rust twin");
+}
+
+/// `(field name, offset)` for each listed field of a Rust struct.
+macro_rules! fields {
+    ($ty:ty { $($field:ident),* $(,)? }) => {
+        [$((stringify!($field), offset_of!($ty, $field))),*]
+    };
 }
 
 #[test]
-fn gpu_structs_match_their_wgsl_twins() {
-    let scene = struct_sizes(&shaders::compose(shaders::OPAQUE));
-    let checks = [
-        ("Light", std::mem::size_of::<GpuLight>()),
-        ("Frame", std::mem::size_of::<GpuFrame>()),
-        ("Material", std::mem::size_of::<GpuMaterial>()),
-        ("Object", std::mem::size_of::<GpuObject>()),
+fn gpu_structs_match_their_wgsl_twins_field_by_field() {
+    let scene = structs(&parse(&shaders::compose(shaders::SCENE)));
+    check_struct(
+        &scene,
+        "Light",
+        size_of::<GpuLight>(),
+        &fields!(GpuLight {
+            position,
+            kind,
+            direction,
+            attenuation,
+            radiance,
+            cos_inner,
+            cos_outer,
+            shadow_layer,
+            shadow_slot
+        }),
+    );
+    check_struct(
+        &scene,
+        "Frame",
+        size_of::<GpuFrame>(),
+        &fields!(GpuFrame { ambient, light_count, terms, lod_bias, bump_scale, bump_delta_texels, lights }),
+    );
+    check_struct(
+        &scene,
+        "View",
+        size_of::<GpuView>(),
+        &fields!(GpuView { clip_from_world, eye, orthographic, view_axis, mirrored, clip_plane }),
+    );
+    check_struct(
+        &scene,
+        "Material",
+        size_of::<GpuMaterial>(),
+        &fields!(GpuMaterial {
+            color,
+            ka,
+            kd,
+            ks,
+            shininess,
+            transparent,
+            specular_color,
+            bump_scale,
+            emission,
+            normal_scale,
+            transmission,
+            height_amplitude,
+            height_frequency,
+            noise_seed,
+            noise_cells,
+            noise_octaves,
+        }),
+    );
+    check_struct(
+        &scene,
+        "ShadowLayer",
+        size_of::<GpuShadowLayer>(),
+        &fields!(GpuShadowLayer { clip_from_world, texel_size, perspective }),
+    );
+    check_struct(&scene, "Shadows", size_of::<GpuShadows>(), &fields!(GpuShadows { layers, map_size, normal_offset }));
+    let present = structs(&parse(&shaders::compose(shaders::PRESENT)));
+    check_struct(&present, "Present", size_of::<GpuPresent>(), &fields!(GpuPresent { exposure, scale }));
+}
+
+#[test]
+fn instance_attributes_match_the_wgsl_locations() {
+    let module = parse(&shaders::compose(shaders::SCENE));
+    let (_, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some("Instance"))
+        .expect("an Instance struct in the WGSL");
+    let naga::TypeInner::Struct { members, .. } = &ty.inner else { panic!("Instance is a struct") };
+    let wgsl: Vec<u32> = members
+        .iter()
+        .map(|m| match m.binding {
+            Some(naga::Binding::Location { location, .. }) => location,
+            ref other => panic!("Instance member without a location: {other:?}"),
+        })
+        .collect();
+    let rust: Vec<u32> = GpuInstance::ATTRIBUTES.iter().map(|a| a.shader_location).collect();
+    assert_eq!(wgsl, rust);
+    let offsets: Vec<u64> = GpuInstance::ATTRIBUTES.iter().map(|a| a.offset).collect();
+    assert_eq!(offsets, [0, 16, 32, 48, 64, 76, 88], "the matrix columns, then the normal matrix's");
+    assert_eq!(size_of::<GpuInstance>(), 100);
+}
+
+#[test]
+fn codes_shared_by_rust_and_wgsl_agree() {
+    let module = parse(&shaders::compose(shaders::SCENE));
+    let codes: [(&str, f64); 21] = [
+        ("MAX_LIGHTS", uniforms::MAX_LIGHTS as f64),
+        ("MAX_SHADOW_LAYERS", MAX_LAYERS as f64),
+        ("LIGHT_POINT", uniforms::LIGHT_POINT.into()),
+        ("LIGHT_DIRECTIONAL", uniforms::LIGHT_DIRECTIONAL.into()),
+        ("LIGHT_SPOT", uniforms::LIGHT_SPOT.into()),
+        ("ATTENUATION_NONE", uniforms::ATTENUATION_NONE.into()),
+        ("ATTENUATION_INVERSE_SQUARE", uniforms::ATTENUATION_INVERSE_SQUARE.into()),
+        ("TERM_AMBIENT", uniforms::TERM_AMBIENT.into()),
+        ("TERM_DIFFUSE", uniforms::TERM_DIFFUSE.into()),
+        ("TERM_SPECULAR", uniforms::TERM_SPECULAR.into()),
+        ("TERM_EMISSION", uniforms::TERM_EMISSION.into()),
+        ("SHADOWS_OFF", scene_pass::SHADOWS_OFF.into()),
+        ("SHADOWS_MAP", scene_pass::SHADOWS_MAP.into()),
+        ("SHADOWS_PROJECTED", scene_pass::SHADOWS_PROJECTED.into()),
+        ("BUMP_VIEW_NORMALS", scene_pass::BUMP_VIEW_NORMALS.into()),
+        ("BUMP_VIEW_TANGENTS", scene_pass::BUMP_VIEW_TANGENTS.into()),
+        ("HEIGHT_NONE", scene_pass::HEIGHT_NONE.into()),
+        ("HEIGHT_TEXTURE", scene_pass::HEIGHT_TEXTURE.into()),
+        ("HEIGHT_SINE", scene_pass::HEIGHT_SINE.into()),
+        ("HEIGHT_NOISE", scene_pass::HEIGHT_NOISE.into()),
+        ("MIP_PALETTE_LAST", (mirador::texture::mipmap::LEVEL_PALETTE.len() - 1) as f64),
     ];
-    for (name, rust) in checks {
-        assert_eq!(wgsl_size(&scene, name), rust, "WGSL {name} vs its Rust twin");
+    for (name, rust) in codes {
+        assert_eq!(constant(&module, name), rust, "{name}: WGSL vs Rust");
     }
-    let present = struct_sizes(&shaders::compose(shaders::PRESENT));
-    assert_eq!(wgsl_size(&present, "Present"), std::mem::size_of::<GpuPresent>());
+    for (name, filter) in SHADOW_FILTER_NAMES {
+        assert_eq!(constant(&module, name), f64::from(shadow_filter_code(filter)), "{name}: WGSL vs Rust");
+    }
+}
+
+#[test]
+fn every_pipeline_constant_is_an_override_of_the_scene_shader() {
+    let module = parse(&shaders::compose(shaders::SCENE));
+    let overrides: Vec<String> = module.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect();
+    for name in CONSTANT_NAMES {
+        assert!(overrides.iter().any(|o| o == name), "{name} is set by scene_pass.rs but is no override of scene.wgsl");
+    }
+    assert_eq!(
+        overrides.len(),
+        CONSTANT_NAMES.len(),
+        "scene.wgsl has overrides scene_pass.rs never sets: {overrides:?}"
+    );
 }
 
 #[test]
 fn every_pass_shader_validates() {
-    for (name, pass) in [("opaque", shaders::OPAQUE), ("present", shaders::PRESENT)] {
+    for (name, pass) in shaders::PASSES {
         let source = shaders::compose(pass);
         let module =
             naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
-        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
+        naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
             .validate(&module)
             .unwrap_or_else(|e| panic!("{name}: {e:?}"));
     }

@@ -22,14 +22,11 @@ struct ShadowLayer {
 
 struct Shadows {
     layers: array<ShadowLayer, MAX_SHADOW_LAYERS>,
-    enabled: u32,
-    method: u32,
-    filter_mode: u32,
     map_size: u32,
+    // The lookup point is pushed along the normal by this many map texels.
     normal_offset: f32,
-    transmission: u32,
-    view: u32,
-    view_layer: u32,
+    _pad0: f32,
+    _pad1: f32,
 }
 
 // Sixteen points of a Poisson disc in the unit circle.
@@ -67,8 +64,13 @@ fn shadow_coordinates(clip_from_world: mat4x4f, p: vec3f) -> vec4f {
     return vec4f(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y, ndc.z, 1.0);
 }
 
-// The fraction of hardware comparisons that find p lit: 1 lit, 0 in shadow. Each comparison is
-// "stored depth ≥ p's depth" (the sampler's compare function is greater-equal on the reference).
+// The fraction of the filter's comparisons that find p lit: 1 lit, 0 in shadow. Each comparison
+// is "p's depth ≤ stored depth". PCF filters compare first and average after: the hardware's 2×2
+// filter weighs the four texels around the lookup bilinearly, and a (2r+1)² grid of such taps
+// one texel apart adds up to one separable kernel over 2r+2 texels a side, with 1-D weights
+// (1 − f, 1, …, 1, f)/(2r+1). That kernel is evaluated here with plain texel loads, which a
+// software GPU runs several times faster than comparison samplers; the Poisson disc, whose taps
+// fall between texels, keeps the hardware's comparison sampler.
 fn shadow_filtered(
     map: texture_depth_2d_array,
     linear: sampler_comparison,
@@ -79,33 +81,67 @@ fn shadow_filtered(
     filter_mode: u32,
     map_size: u32,
 ) -> f32 {
-    let texel = 1.0 / f32(map_size);
+    let size = f32(map_size);
     switch filter_mode {
         case SHADOW_FILTER_NONE: {
-            return textureSampleCompareLevel(map, nearest, uv, layer, depth);
-        }
-        case SHADOW_FILTER_HARDWARE: {
-            return textureSampleCompareLevel(map, linear, uv, layer, depth);
+            let texel = clamp(vec2i(floor(uv * size)), vec2i(0), vec2i(i32(map_size) - 1));
+            return select(0.0, 1.0, depth <= textureLoad(map, texel, layer, 0));
         }
         case SHADOW_FILTER_POISSON: {
+            let texel = 1.0 / size;
             var lit = 0.0;
             for (var k = 0u; k < 16u; k++) {
                 lit += textureSampleCompareLevel(map, linear, uv + 2.5 * texel * POISSON_DISC[k], layer, depth);
             }
             return lit / 16.0;
         }
+        case SHADOW_FILTER_HARDWARE: {
+            return shadow_tent(map, uv, depth, layer, map_size, 0);
+        }
+        case SHADOW_FILTER_PCF3: {
+            return shadow_tent(map, uv, depth, layer, map_size, 1);
+        }
         default: {
-            let reach = select(1, 2, filter_mode == SHADOW_FILTER_PCF5);
-            var lit = 0.0;
-            for (var j = -reach; j <= reach; j++) {
-                for (var i = -reach; i <= reach; i++) {
-                    lit += textureSampleCompareLevel(map, linear, uv + texel * vec2f(f32(i), f32(j)), layer, depth);
-                }
-            }
-            let side = f32(2 * reach + 1);
-            return lit / (side * side);
+            return shadow_tent(map, uv, depth, layer, map_size, 2);
         }
     }
+}
+
+// (2r+1)² bilinear comparison taps one texel apart around uv, as one separable kernel over
+// (2r+2)² texels; texels outside the map repeat its edge (clamp to edge).
+fn shadow_tent(map: texture_depth_2d_array, uv: vec2f, depth: f32, layer: u32, map_size: u32, r: i32) -> f32 {
+    let p = uv * f32(map_size) - 0.5;
+    let base = floor(p);
+    let f = p - base;
+    let first = vec2i(base) - vec2i(r);
+    let last = i32(map_size) - 1;
+    let n = 2 * r + 2;
+    var lit = 0.0;
+    for (var j = 0; j < n; j++) {
+        let wy = select(select(1.0, f.y, j == n - 1), 1.0 - f.y, j == 0);
+        var row = 0.0;
+        for (var i = 0; i < n; i++) {
+            let wx = select(select(1.0, f.x, i == n - 1), 1.0 - f.x, i == 0);
+            let texel = clamp(first + vec2i(i, j), vec2i(0), vec2i(last));
+            row += wx * select(0.0, 1.0, depth <= textureLoad(map, texel, layer, 0));
+        }
+        lit += wy * row;
+    }
+    let side = f32(2 * r + 1);
+    return lit / (side * side);
+}
+
+// Where p is looked up in a light view: map coordinates and depth, w = 1; w = 0 when p lies outside
+// the view, where nothing was drawn into the map and so nothing occludes. `facing` is the normal
+// on the light's side: p is pushed along it by `normal_offset` map texels first (an acne cure).
+fn shadow_lookup_point(view: ShadowLayer, light_position: vec3f, p: vec3f, facing: vec3f, normal_offset: f32) -> vec4f {
+    // The texel's world size where p is: fixed for orthographic views, growing with distance
+    // from the light for perspective ones.
+    let texel = select(view.texel_size, view.texel_size * distance(p, light_position), view.perspective != 0u);
+    let coordinates = shadow_coordinates(view.clip_from_world, p + facing * normal_offset * texel);
+    let inside = coordinates.w > 0.0 && all(coordinates.xy >= vec2f(0.0)) && all(coordinates.xy <= vec2f(1.0))
+        && coordinates.z <= 1.0;
+    return select(vec4f(0.0), coordinates, inside);
 }
 
 // The map texel that p's lookup lands in, for the texel-checker teaching view.

@@ -1,5 +1,5 @@
 // Uniform layouts shared by every pass. The Rust twins live in src/raster/uniforms.rs; a test
-// (tests/layouts.rs) checks that each struct here has the size of its Rust twin.
+// (tests/layouts.rs) checks that each struct here has the size and field offsets of its Rust twin.
 
 const MAX_LIGHTS: u32 = 16u;
 
@@ -9,16 +9,6 @@ const LIGHT_SPOT: u32 = 2u;
 
 const ATTENUATION_NONE: u32 = 0u;
 const ATTENUATION_INVERSE_SQUARE: u32 = 1u;
-
-// Frame.texture_filter: how colour textures are sampled (the sampler does the rest).
-const TEXTURE_FILTER_LEVEL_COLOUR: u32 = 5u;
-
-// Frame.bump_view: the bump-mapping teaching views.
-const BUMP_VIEW_NORMALS: u32 = 1u;
-const BUMP_VIEW_TANGENTS: u32 = 2u;
-
-// Frame.bump_tangents.
-const BUMP_TANGENTS_PER_VERTEX: u32 = 1u;
 
 // Bits of Frame.terms: which terms of the illumination model are drawn.
 const TERM_AMBIENT: u32 = 1u;
@@ -44,53 +34,53 @@ struct Light {
     _pad0: f32,
 }
 
-// Group 0: changes once per frame.
-struct Frame {
+// Group 0, binding 0: one camera as one pass sees it (the main camera, a light's view for pass 1
+// of the shadow maps, later mirrored cameras and cube faces). Each view has its own slot in one
+// buffer, chosen by a dynamic offset, so a frame can draw from many cameras.
+struct View {
     clip_from_world: mat4x4f,
     eye: vec3f,
     // 1 for an orthographic camera: then every view ray runs along -view_axis.
     orthographic: u32,
     // ze of the eye frame: from the scene towards the eye.
     view_axis: vec3f,
-    light_count: u32,
+    // 1 when the view is mirrored (its triangles' winding flips).
+    mirrored: u32,
+    // Points p with dot(clip_plane.xyz, p) + clip_plane.w < 0 are not drawn; all zero: no plane.
+    clip_plane: vec4f,
+}
+
+// Group 0, binding 1: what every view of the frame shares: lights and numeric settings. The
+// toggles that switch code on and off are pipeline constants instead (shaders/scene.wgsl).
+struct Frame {
     ambient: vec3f,
+    light_count: u32,
     terms: u32,
-    texture_filter: u32,
     lod_bias: f32,
-    bump_enabled: u32,
     // Multiplies every material's bump scale k.
     bump_scale: f32,
     // The finite-difference step Δ in texels of the height map.
     bump_delta_texels: f32,
-    bump_view: u32,
-    // 0: tangents from screen derivatives; 1: the interpolated per-vertex tangents.
-    bump_tangents: u32,
-    // 1: procedural height fields use their closed-form derivatives, not finite differences.
-    bump_analytic: u32,
     lights: array<Light, MAX_LIGHTS>,
 }
 
-// Group 1: changes per material.
+// Group 1: changes per material. Which textures and height field a material has are pipeline
+// constants of its variant (shaders/scene.wgsl), not fields here.
 struct Material {
     color: vec3f,
-    has_texture: u32,
     ka: f32,
     kd: f32,
     ks: f32,
     shininess: f32,
-    specular_color: vec3f,
     // 1 when kt > 0: drawn into the transmission maps instead of the depth maps.
     transparent: u32,
-    emission: vec3f,
+    specular_color: vec3f,
     // k of TECHNIQUES.md §3.
     bump_scale: f32,
+    emission: vec3f,
+    normal_scale: f32,
     // kt·MT: what a transparent surface lets through.
     transmission: vec3f,
-    has_height_map: u32,
-    has_normal_map: u32,
-    normal_scale: f32,
-    // HEIGHT_* below: where the bump heights come from.
-    height_kind: u32,
     height_amplitude: f32,
     height_frequency: vec2f,
     noise_seed: u32,
@@ -101,15 +91,25 @@ struct Material {
     _pad2: f32,
 }
 
-const HEIGHT_TEXTURE: u32 = 1u;
-const HEIGHT_SINE: u32 = 2u;
-const HEIGHT_NOISE: u32 = 3u;
+// Per object, as instance attributes (vertex buffer 1): objects that share a mesh are drawn in one
+// instanced call.
+struct Instance {
+    @location(4) world_from_local_0: vec4f,
+    @location(5) world_from_local_1: vec4f,
+    @location(6) world_from_local_2: vec4f,
+    @location(7) world_from_local_3: vec4f,
+    // Inverse transpose of world_from_local's upper 3×3, by columns.
+    @location(8) normal_from_local_0: vec3f,
+    @location(9) normal_from_local_1: vec3f,
+    @location(10) normal_from_local_2: vec3f,
+}
 
-// Group 2: changes per object.
-struct Object {
-    world_from_local: mat4x4f,
-    // Inverse transpose of world_from_local's upper 3×3, stored as a 4×4 for alignment.
-    normal_from_local: mat4x4f,
+fn instance_world_from_local(i: Instance) -> mat4x4f {
+    return mat4x4f(i.world_from_local_0, i.world_from_local_1, i.world_from_local_2, i.world_from_local_3);
+}
+
+fn instance_normal_from_local(i: Instance) -> mat3x3f {
+    return mat3x3f(i.normal_from_local_0, i.normal_from_local_1, i.normal_from_local_2);
 }
 
 // One triangle covering the screen, for passes that work per pixel: vertices at (−1, −1),

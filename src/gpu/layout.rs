@@ -15,6 +15,19 @@ pub fn uniform(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupL
     }
 }
 
+/// A uniform buffer seen by `visibility`, whose offset is chosen when its bind group is set (one
+/// slot of a buffer of many).
+pub fn dynamic_uniform(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: true,
+            min_binding_size: None,
+        },
+        ..uniform(binding, visibility)
+    }
+}
+
 /// A texture read by the fragment stage.
 pub fn texture(
     binding: u32,

@@ -1,32 +1,44 @@
 //! The z-buffer renderer. Each technique is one pass (one file here, one WGSL file of the same
-//! name in `shaders/`); [`Renderer::render`] records them in order, top to bottom:
+//! name in `shaders/`); [`Renderer::render`] records them in order, top to bottom, and each pass
+//! returns what it made for the next to read:
 //!
 //! ```text
-//! shadow maps (pass 1 of §4)  ─┐
-//! or projected shadow polygons ┴→ opaque (z-buffer + illumination model + pass 2 of §4)
-//!                                 → teaching views → present (output transform to sRGB)
+//! views (main camera, light views) written to their slots
+//! shadow maps (pass 1 of §4, kept while lights and casters stay) ─┐
+//!                                                                 ├→ lighting inputs (group 2)
+//! depth prepass → projected shadow polygons (object precision) ───┘
+//!               → opaque (z-buffer + illumination model + pass 2 of §4)
+//!               → teaching overlays → present (output transform, upscale)
 //! ```
 //!
 //! Later techniques slot in where DESIGN.md puts them: environment captures and mirror views
-//! before `opaque`; the sky and sorted transparent surfaces after it.
+//! (more views, drawn by the same scene pass) before `opaque`; the sky and sorted transparent
+//! surfaces after it.
 
-pub mod opaque;
+pub mod geometry;
+pub mod overlays;
 pub mod present;
 pub mod scene_gpu;
+pub mod scene_pass;
 pub mod shadow;
 pub mod uniforms;
+pub mod view;
+
+use std::time::{Duration, Instant};
 
 use crate::gpu::mipmap::MipmapGenerator;
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::{Gpu, readback};
 use crate::scene::Scene;
 use crate::settings::{RenderSettings, ShadowMethod};
-use opaque::{OpaquePass, OpaqueTargets};
-use present::PresentPass;
+use overlays::Overlays;
+use present::{PresentInput, PresentPass};
 use scene_gpu::{SceneGpu, SceneLayouts};
-use shadow::ShadowPass;
-use shadow::projected::{MASK_FORMAT, ProjectedPass, projected_shadows};
-use shadow::views::shadow_layout;
+use scene_pass::{FrameKey, ScenePass, SceneTargets};
+use shadow::projected::{MASK_FORMAT, ProjectedPass};
+use shadow::views::shadow_layout_in;
+use shadow::{ShadowMaps, ShadowPass};
+use view::{View, ViewSlot};
 
 /// Linear radiance, before the output transform.
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -38,39 +50,102 @@ pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSr
 pub struct Renderer {
     pub layouts: SceneLayouts,
     pub mipmaps: MipmapGenerator,
-    pub shadow: ShadowPass,
+    shadow: ShadowPass,
     projected: ProjectedPass,
-    opaque: OpaquePass,
+    scene: ScenePass,
+    overlays: Overlays,
     present: PresentPass,
-    /// The opaque pass's shadow inputs, and the (shadow targets, frame targets) generations they
-    /// were made for.
-    shadow_inputs: Option<((u64, u64), wgpu::BindGroup)>,
+    /// The lighting inputs (group 2), and the (shadow maps, frame targets) generations they were
+    /// made for.
+    lighting: Option<((u64, u64), wgpu::BindGroup)>,
+    /// Submit and time each pass on its own (`render --stats`): slower, but it says where the
+    /// frame's time goes.
+    pub profile: bool,
 }
 
-/// The intermediate images of a frame, recreated when the output size changes.
+/// The intermediate images of a frame, recreated when the output size or the render scale
+/// changes.
 pub struct FrameTargets {
     pub size: (u32, u32),
     pub hdr: GpuTexture,
     pub depth: GpuTexture,
     /// Object-precision shadows: one channel per shadowed light.
     pub shadow_mask: GpuTexture,
-    present_input: wgpu::BindGroup,
+    present_input: PresentInput,
     generation: u64,
+}
+
+/// What a frame did, for `--stats`, the viewer's corner and the tests of the caches.
+#[derive(Clone, Debug, Default)]
+pub struct FrameReport {
+    /// Wall time of each pass, submitted and waited for on its own; empty unless
+    /// [`Renderer::profile`] is set.
+    pub passes: Vec<(&'static str, Duration)>,
+    /// Shadow-map layers drawn this frame (the others were kept).
+    pub shadow_layers_drawn: u32,
+    /// The projected shadow polygons were computed anew.
+    pub projected_recomputed: bool,
+    /// Triangles drawn per view.
+    pub triangles: u64,
+    /// The size the frame was drawn at, before the present pass upscaled it.
+    pub drawn_size: (u32, u32),
+}
+
+/// The frame's command encoder. When profiling, each pass is submitted and waited for on its
+/// own, and its wall time recorded; otherwise the whole frame is one submission.
+struct FrameEncoder<'g> {
+    gpu: &'g Gpu,
+    encoder: wgpu::CommandEncoder,
+    profile: bool,
+    mark: Instant,
+    passes: Vec<(&'static str, Duration)>,
+}
+
+impl<'g> FrameEncoder<'g> {
+    fn new(gpu: &'g Gpu, profile: bool) -> FrameEncoder<'g> {
+        FrameEncoder { gpu, encoder: Self::encoder(gpu), profile, mark: Instant::now(), passes: Vec::new() }
+    }
+
+    fn encoder(gpu: &Gpu) -> wgpu::CommandEncoder {
+        gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame::encoder") })
+    }
+
+    /// Ends the pass called `name`.
+    fn end(&mut self, name: &'static str) {
+        if self.profile {
+            let encoder = std::mem::replace(&mut self.encoder, Self::encoder(self.gpu));
+            self.gpu.queue.submit([encoder.finish()]);
+            self.gpu.wait();
+            self.passes.push((name, self.mark.elapsed()));
+            self.mark = Instant::now();
+        }
+    }
+
+    fn finish(self) -> Vec<(&'static str, Duration)> {
+        self.gpu.queue.submit([self.encoder.finish()]);
+        self.passes
+    }
+}
+
+/// The size a frame is drawn at: the output's times the render scale, at least one pixel.
+pub fn drawn_size(output: (u32, u32), render_scale: f32) -> (u32, u32) {
+    let scaled = |n: u32| ((n as f32 * render_scale).round() as u32).clamp(1, n.max(1));
+    (scaled(output.0), scaled(output.1))
 }
 
 impl Renderer {
     pub fn new(device: &wgpu::Device, output_format: wgpu::TextureFormat) -> Renderer {
         let layouts = SceneLayouts::new(device);
-        let shadow = ShadowPass::new(device, &layouts);
-        let opaque = OpaquePass::new(device, &layouts, &shadow.input_layout);
         Renderer {
             mipmaps: MipmapGenerator::new(device),
-            projected: ProjectedPass::new(device),
+            shadow: ShadowPass::new(device, &layouts),
+            projected: ProjectedPass::new(device, &layouts),
+            scene: ScenePass::new(device, &layouts),
+            overlays: Overlays::new(device, &layouts),
             present: PresentPass::new(device, output_format),
             layouts,
-            shadow,
-            opaque,
-            shadow_inputs: None,
+            lighting: None,
+            profile: false,
         }
     }
 
@@ -78,6 +153,7 @@ impl Renderer {
         SceneGpu::upload(gpu, &self.layouts, &self.mipmaps, scene)
     }
 
+    /// Targets for a frame drawn at `size` (the output's size times the render scale).
     pub fn targets(&self, device: &wgpu::Device, size: (u32, u32)) -> FrameTargets {
         static GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
         let hdr = GpuTexture::target(device, "frame::hdr", size, HDR_FORMAT);
@@ -88,61 +164,136 @@ impl Renderer {
         FrameTargets { size, hdr, depth, shadow_mask, present_input, generation }
     }
 
-    /// Records and submits one frame of `scene` into `output`, whose size must match `targets`.
+    /// The number of scene-pass shader variants compiled so far.
+    pub fn shader_variants(&self) -> usize {
+        self.scene.variant_count()
+    }
+
+    /// Forgets the kept shadow maps, so the next frame draws them all.
+    pub fn invalidate_shadows(&mut self) {
+        self.shadow.invalidate();
+    }
+
+    /// Records and submits one frame of `scene` into `output`. `targets` are remade when the
+    /// output's size times the render scale no longer matches them.
     pub fn render(
         &mut self,
         gpu: &Gpu,
         scene: &Scene,
         scene_gpu: &mut SceneGpu,
         settings: &RenderSettings,
-        targets: &FrameTargets,
+        targets: &mut FrameTargets,
         output: &wgpu::TextureView,
-    ) {
+    ) -> FrameReport {
         let (device, queue) = (&gpu.device, &gpu.queue);
-        scene_gpu.prepare_materials(device, &self.layouts, &settings.textures);
-        let scene_gpu = &*scene_gpu;
-        let frame_group = scene_gpu.frame_group();
-        let shadows = &settings.shadows;
-        let layout = shadow_layout(scene, shadows);
-        scene_gpu.update_frame(gpu, scene, &layout.first_layer, settings);
-        self.shadow.prepare(device, queue, &layout, shadows, scene_gpu.has_transparent());
-        let key = (self.shadow.generation, targets.generation);
-        if self.shadow_inputs.as_ref().is_none_or(|(k, _)| *k != key) {
-            self.shadow_inputs = Some((key, self.shadow.inputs(device, &targets.shadow_mask.view)));
+        let out = output.texture().size();
+        let size = drawn_size((out.width, out.height), settings.raster.render_scale);
+        if targets.size != size {
+            *targets = self.targets(device, size);
         }
-        let (_, shadow_inputs) = self.shadow_inputs.as_ref().expect("made just above");
 
-        let mut encoder =
-            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame::encoder") });
+        // Per-scene work, redone only when what it depends on changes.
+        scene_gpu.prepare_materials(device, &self.layouts, &settings.textures);
+        scene_gpu.geometry.prepare(
+            device,
+            queue,
+            scene,
+            &scene.camera,
+            settings.sphere_segments,
+            settings.raster.adaptive_tessellation,
+        );
+        let scene_gpu = &*scene_gpu;
+        let shadows = &settings.shadows;
+        let layout = shadow_layout_in(scene, scene_gpu.geometry.bounds, shadows);
+        scene_gpu.views.write(queue, ViewSlot::Main, &View::of_camera(&scene.camera));
+        scene_gpu.update_frame(queue, scene, &layout.first_layer, settings);
+
         let projected = shadows.enabled && shadows.method == ShadowMethod::Projected;
+        let prepass = settings.raster.depth_prepass || projected;
+        let transmission = shadows.transmission && scene_gpu.geometry.has_transparent();
+        let frame_key = FrameKey::new(settings, !layout.views.is_empty(), transmission);
+        self.scene.prepare(device, frame_key, &scene_gpu.material_keys, prepass);
+
+        let mut frame = FrameEncoder::new(gpu, self.profile);
+        let maps = if projected {
+            self.shadow.record(device, queue, &mut frame.encoder, scene_gpu, &Default::default(), shadows)
+        } else {
+            self.shadow.record(device, queue, &mut frame.encoder, scene_gpu, &layout, shadows)
+        };
+        let shadow_layers_drawn = maps.layers_drawn;
+        frame.end("shadow maps");
+        let lighting = lighting_group(&mut self.lighting, device, &self.layouts, &maps, targets);
+        if prepass {
+            self.scene.record_prepass(&mut frame.encoder, scene_gpu, lighting, ViewSlot::Main, &targets.depth.view);
+            frame.end("depth prepass");
+        }
+        let mut projected_recomputed = false;
         if projected {
-            let polygons = projected_shadows(scene, &layout);
-            self.opaque.record_prepass(&mut encoder, scene_gpu, frame_group, shadow_inputs, &targets.depth.view);
-            let clip_from_world = scene.camera.clip_from_world();
-            self.projected.record(
+            projected_recomputed = self.projected.record(
                 device,
-                queue,
-                &mut encoder,
-                &polygons,
-                clip_from_world,
+                &mut frame.encoder,
+                scene,
+                scene_gpu,
+                &layout,
                 &targets.shadow_mask.view,
                 &targets.depth.view,
             );
-        } else {
-            self.shadow.record(&mut encoder, scene_gpu, &layout);
+            frame.end("projected shadows");
         }
-        self.opaque.record(
-            &mut encoder,
+        let scene_targets =
+            SceneTargets { hdr: &targets.hdr.view, depth: &targets.depth.view, background: scene.background };
+        self.scene.record_opaque(
+            &mut frame.encoder,
             scene_gpu,
-            frame_group,
-            shadow_inputs,
-            &OpaqueTargets { hdr: &targets.hdr.view, depth: &targets.depth.view, background: scene.background },
-            projected,
+            lighting,
+            ViewSlot::Main,
+            frame_key,
+            &scene_targets,
+            prepass,
         );
-        self.shadow.record_views(gpu, &mut encoder, shadows, &layout, scene.camera.clip_from_world(), targets);
-        self.present.record(queue, &mut encoder, &targets.present_input, output, settings.exposure);
-        queue.submit([encoder.finish()]);
+        frame.end("opaque");
+        self.overlays.record(device, queue, &mut frame.encoder, shadows, scene_gpu, &layout, &maps, targets);
+        self.present.record(queue, &mut frame.encoder, &targets.present_input, output, settings.exposure);
+        frame.end("overlays + present");
+        FrameReport {
+            passes: frame.finish(),
+            shadow_layers_drawn,
+            projected_recomputed,
+            triangles: scene_gpu.geometry.triangles(),
+            drawn_size: size,
+        }
     }
+}
+
+/// Group 2 of the scene pass, built from the shadow pass's outputs and the frame's projected
+/// shadow mask; remade only when either is recreated.
+fn lighting_group<'c>(
+    cache: &'c mut Option<((u64, u64), wgpu::BindGroup)>,
+    device: &wgpu::Device,
+    layouts: &SceneLayouts,
+    maps: &ShadowMaps,
+    targets: &FrameTargets,
+) -> &'c wgpu::BindGroup {
+    let key = (maps.generation, targets.generation);
+    if cache.as_ref().is_none_or(|(k, _)| *k != key) {
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame::lighting_group"),
+            layout: &layouts.lighting,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: maps.uniform.binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(maps.depth) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(maps.linear) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(maps.nearest) },
+                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(maps.transmission) },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&targets.shadow_mask.view),
+                },
+            ],
+        });
+        *cache = Some((key, group));
+    }
+    &cache.as_ref().expect("made just above").1
 }
 
 /// A headless frame: renders `scene` at its camera's size and reads it back as sRGB RGBA8.
@@ -152,6 +303,8 @@ pub struct Headless {
     pub scene_gpu: SceneGpu,
     pub targets: FrameTargets,
     pub output: GpuTexture,
+    /// What the last frame did.
+    pub report: FrameReport,
 }
 
 impl Headless {
@@ -159,14 +312,16 @@ impl Headless {
         let renderer = Renderer::new(&gpu.device, OUTPUT_FORMAT);
         let scene_gpu = renderer.upload(gpu, scene);
         let size = (scene.camera.width, scene.camera.height);
-        let targets = renderer.targets(&gpu.device, size);
+        let targets = renderer.targets(&gpu.device, drawn_size(size, scene.settings.raster.render_scale));
         let output = GpuTexture::target(&gpu.device, "frame::output", size, OUTPUT_FORMAT);
-        Headless { renderer, scene_gpu, targets, output }
+        Headless { renderer, scene_gpu, targets, output, report: FrameReport::default() }
     }
 
     pub fn render(&mut self, gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> image::RgbaImage {
-        self.renderer.render(gpu, scene, &mut self.scene_gpu, settings, &self.targets, &self.output.view);
-        let (width, height) = self.targets.size;
+        self.report =
+            self.renderer.render(gpu, scene, &mut self.scene_gpu, settings, &mut self.targets, &self.output.view);
+        let size = self.output.texture.size();
+        let (width, height) = (size.width, size.height);
         let pixels = readback::read_rgba8(&gpu.device, &gpu.queue, &self.output.texture);
         image::RgbaImage::from_raw(width, height, pixels).expect("readback returns width × height RGBA8 pixels")
     }

@@ -1,11 +1,19 @@
 //! The present pass: the output transform of `src/output.rs` on the GPU. Reads the linear HDR
 //! target texel for texel, applies exposure and the clamp, and writes an sRGB target (a window's
-//! surface, or an offscreen texture for screenshots), whose format does the sRGB encoding.
+//! surface, or an offscreen texture for screenshots), whose format does the sRGB encoding. A frame
+//! drawn at a render scale below 1 is upscaled here (bilinear), so the viewer can trade
+//! resolution for frame rate while the camera moves.
 
 use super::uniforms::GpuPresent;
 use crate::gpu::layout;
 use crate::gpu::uniform::UniformBuffer;
 use crate::shaders;
+
+/// The HDR image the pass reads, bound, and its size.
+pub struct PresentInput {
+    group: wgpu::BindGroup,
+    size: (u32, u32),
+}
 
 pub struct PresentPass {
     pipeline: wgpu::RenderPipeline,
@@ -42,20 +50,23 @@ impl PresentPass {
             ("vs_present", "fs_present"),
             &[Some(output_format.into())],
         );
-        let uniform = UniformBuffer::new(device, "present::uniform", &GpuPresent { exposure: 1.0, _pad: [0.0; 3] });
+        let uniform =
+            UniformBuffer::new(device, "present::uniform", &GpuPresent { exposure: 1.0, _pad: 0.0, scale: [1.0; 2] });
         PresentPass { pipeline, layout, uniform }
     }
 
     /// The pass's input: made once per HDR target, when the targets are (re)created.
-    pub fn bind(&self, device: &wgpu::Device, hdr: &wgpu::TextureView) -> wgpu::BindGroup {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
+    pub fn bind(&self, device: &wgpu::Device, hdr: &wgpu::TextureView) -> PresentInput {
+        let size = hdr.texture().size();
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("present::bind_group"),
             layout: &self.layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(hdr) },
                 wgpu::BindGroupEntry { binding: 1, resource: self.uniform.binding() },
             ],
-        })
+        });
+        PresentInput { group, size: (size.width, size.height) }
     }
 
     /// Draws the HDR target bound in `input` through the output transform into `output`.
@@ -63,11 +74,13 @@ impl PresentPass {
         &self,
         queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
-        input: &wgpu::BindGroup,
+        input: &PresentInput,
         output: &wgpu::TextureView,
         exposure: f32,
     ) {
-        self.uniform.write(queue, &GpuPresent { exposure, _pad: [0.0; 3] });
+        let out = output.texture().size();
+        let scale = [input.size.0 as f32 / out.width as f32, input.size.1 as f32 / out.height as f32];
+        self.uniform.write(queue, &GpuPresent { exposure, _pad: 0.0, scale });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("present::pass"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -83,7 +96,7 @@ impl PresentPass {
         });
         pass.push_debug_group("present");
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, input, &[]);
+        pass.set_bind_group(0, &input.group, &[]);
         pass.draw(0..3, 0..1);
         pass.pop_debug_group();
     }

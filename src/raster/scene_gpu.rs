@@ -1,25 +1,30 @@
-//! The scene on the GPU: vertex and index buffers, and bind groups by how often they change
-//! (0 per frame, 1 per material, 2 per object). Built once per scene; a frame only rewrites the
-//! frame uniform.
+//! The scene on the GPU: its geometry ([`SceneGeometry`]), textures, and bind groups by how often
+//! they change: 0 per view (the view's slot, chosen by a dynamic offset) and per frame (lights,
+//! numeric settings), 1 per material, 2 the lighting inputs the renderer builds from the shadow
+//! pass's outputs. Built once per scene; a frame rewrites the uniforms and, when tessellations
+//! change, the draw list.
 
-use wgpu::util::DeviceExt;
-
-use super::uniforms::{GpuFrame, GpuMaterial, Vertex};
+use super::geometry::SceneGeometry;
+use super::scene_pass::MaterialKey;
+use super::uniforms::{GpuFrame, GpuMaterial};
+use super::view::ViewBuffer;
 use crate::gpu::mipmap::{MipmapGenerator, sampler_descriptor, upload_with_mipmaps};
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::uniform::UniformBuffer;
 use crate::gpu::{Gpu, layout};
-use crate::scene::{Mesh, Scene, Wrap};
+use crate::scene::{Scene, Wrap};
 use crate::settings::RenderSettings;
 use crate::settings::{TextureFilter, TextureSettings};
 use crate::texture::mipmap::Filter;
-use crate::texture::tangents::tangents_or_generate;
 
 /// The bind group layouts every scene pass shares.
 pub struct SceneLayouts {
+    /// Group 0: the view (dynamic offset), the frame uniform, the height maps' sampler.
     pub frame: wgpu::BindGroupLayout,
+    /// Group 1: a material's uniform, textures and colour sampler.
     pub material: wgpu::BindGroupLayout,
-    pub object: wgpu::BindGroupLayout,
+    /// Group 2: the shadow pass's outputs and how to read them.
+    pub lighting: wgpu::BindGroupLayout,
 }
 
 impl SceneLayouts {
@@ -27,7 +32,11 @@ impl SceneLayouts {
         let both = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let frame = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::frame_layout"),
-            entries: &[layout::uniform(0, both), layout::sampler(1, wgpu::SamplerBindingType::Filtering)],
+            entries: &[
+                layout::dynamic_uniform(0, both),
+                layout::uniform(1, wgpu::ShaderStages::FRAGMENT),
+                layout::sampler(2, wgpu::SamplerBindingType::Filtering),
+            ],
         });
         let material = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::material_layout"),
@@ -39,29 +48,27 @@ impl SceneLayouts {
                 layout::sampler(4, wgpu::SamplerBindingType::Filtering),
             ],
         });
-        let object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("scene::object_layout"),
-            entries: &[layout::uniform(0, wgpu::ShaderStages::VERTEX)],
+        let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
+        let lighting = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene::lighting_layout"),
+            entries: &[
+                layout::uniform(0, wgpu::ShaderStages::FRAGMENT),
+                layout::texture(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
+                layout::sampler(2, wgpu::SamplerBindingType::Comparison),
+                layout::sampler(3, wgpu::SamplerBindingType::Comparison),
+                layout::texture(4, unfilterable, wgpu::TextureViewDimension::D2Array),
+                layout::texture(5, unfilterable, wgpu::TextureViewDimension::D2),
+            ],
         });
-        SceneLayouts { frame, material, object }
+        SceneLayouts { frame, material, lighting }
     }
 }
 
-/// One drawable: an object's geometry with its material and transform bind groups.
-pub struct Drawable {
-    pub name: String,
-    pub vertices: wgpu::Buffer,
-    pub indices: wgpu::Buffer,
-    pub index_count: u32,
-    pub material: usize,
-    /// Its material lets light through (kt > 0): it tints shadows rather than casting them.
-    pub transparent: bool,
-    pub object: wgpu::BindGroup,
-}
-
 pub struct SceneGpu {
-    pub frame: UniformBuffer<GpuFrame>,
-    /// Group 0: the frame uniform and the height maps' bilinear sampler.
+    frame: UniformBuffer<GpuFrame>,
+    /// Every view of the frame, a slot each.
+    pub views: ViewBuffer,
+    /// Group 0: a view slot, the frame uniform and the height maps' bilinear sampler.
     frame_group: wgpu::BindGroup,
     /// What each material binds, kept to make its group 1 for each texture filter.
     material_inputs: Vec<MaterialInputs>,
@@ -70,7 +77,9 @@ pub struct SceneGpu {
     material_groups: Vec<(FilterKey, Vec<wgpu::BindGroup>)>,
     /// Which entry of `material_groups` this frame uses.
     active: usize,
-    pub drawables: Vec<Drawable>,
+    /// Per material: which shader variant draws it.
+    pub material_keys: Vec<MaterialKey>,
+    pub geometry: SceneGeometry,
 }
 
 /// The filter and its anisotropy: what tells sets of material groups apart.
@@ -98,8 +107,9 @@ impl SceneGpu {
         let frame = UniformBuffer::new(
             device,
             "scene::frame",
-            &GpuFrame::new(&scene.camera, scene.ambient, &scene.lights, &[], &scene.settings),
+            &GpuFrame::new(scene.ambient, &scene.lights, &[], &scene.settings),
         );
+        let views = ViewBuffer::new(device);
         // Every texture gets its whole mip chain, averaged in linear space (TECHNIQUES.md §2).
         let textures: Vec<GpuTexture> = scene
             .textures
@@ -118,8 +128,9 @@ impl SceneGpu {
             label: Some("scene::frame_group"),
             layout: &layouts.frame,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: frame.binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&height_sampler) },
+                wgpu::BindGroupEntry { binding: 0, resource: views.binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: frame.binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&height_sampler) },
             ],
         });
         let material_inputs = scene
@@ -135,30 +146,16 @@ impl SceneGpu {
             })
             .collect();
 
-        let drawables = scene
-            .objects
-            .iter()
-            .map(|object| {
-                let mesh = scene.tessellate(object);
-                let (vertices, indices) = mesh_buffers(device, &object.name, &mesh);
-                let uniform = UniformBuffer::new(device, &format!("scene::object {}", object.name), &object.to_gpu());
-                let object_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some(&format!("scene::object_group {}", object.name)),
-                    layout: &layouts.object,
-                    entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniform.binding() }],
-                });
-                Drawable {
-                    name: object.name.clone(),
-                    vertices,
-                    indices,
-                    index_count: mesh.indices.len() as u32,
-                    material: object.material.0,
-                    transparent: scene.materials[object.material.0].is_transparent(),
-                    object: object_group,
-                }
-            })
-            .collect();
-        SceneGpu { frame, frame_group, material_inputs, material_groups: Vec::new(), active: 0, drawables }
+        SceneGpu {
+            frame,
+            views,
+            frame_group,
+            material_inputs,
+            material_groups: Vec::new(),
+            active: 0,
+            material_keys: scene.materials.iter().map(MaterialKey::of).collect(),
+            geometry: SceneGeometry::new(scene),
+        }
     }
 
     /// Makes every material's group 1 for `settings`' texture filter, the first time that filter
@@ -221,14 +218,15 @@ impl SceneGpu {
         &self.material_groups.get(self.active).expect("prepare_materials() runs before drawing").1
     }
 
-    /// Rewrites the per-frame uniform: camera, lights, their shadow layers, and toggles.
-    pub fn update_frame(&self, gpu: &Gpu, scene: &Scene, shadow_layers: &[Option<u32>], settings: &RenderSettings) {
-        self.frame
-            .write(&gpu.queue, &GpuFrame::new(&scene.camera, scene.ambient, &scene.lights, shadow_layers, settings));
-    }
-
-    pub fn has_transparent(&self) -> bool {
-        self.drawables.iter().any(|d| d.transparent)
+    /// Rewrites the per-frame uniform: lights, their shadow layers, and numeric settings.
+    pub fn update_frame(
+        &self,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        shadow_layers: &[Option<u32>],
+        settings: &RenderSettings,
+    ) {
+        self.frame.write(queue, &GpuFrame::new(scene.ambient, &scene.lights, shadow_layers, settings));
     }
 }
 
@@ -245,30 +243,4 @@ fn address_mode(wrap: Wrap) -> wgpu::AddressMode {
 fn filter_key(settings: &TextureSettings) -> FilterKey {
     let anisotropy = if settings.filter == TextureFilter::Anisotropic { settings.anisotropy } else { 1 };
     (settings.filter, anisotropy)
-}
-
-fn mesh_buffers(device: &wgpu::Device, name: &str, mesh: &Mesh) -> (wgpu::Buffer, wgpu::Buffer) {
-    // The file's tangents where it has them, MikkTSpace's otherwise (TECHNIQUES.md §3's
-    // per-vertex source).
-    let existing = (!mesh.tangents.is_empty()).then_some(mesh.tangents.as_slice());
-    let tangents = tangents_or_generate(mesh, existing);
-    let vertices: Vec<Vertex> = (0..mesh.positions.len())
-        .map(|i| Vertex {
-            position: mesh.positions[i].to_array(),
-            normal: mesh.normals[i].to_array(),
-            uv: mesh.uvs[i].to_array(),
-            tangent: tangents[i].to_array(),
-        })
-        .collect();
-    let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(&format!("scene::vertices {name}")),
-        contents: bytemuck::cast_slice(&vertices),
-        usage: wgpu::BufferUsages::VERTEX,
-    });
-    let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(&format!("scene::indices {name}")),
-        contents: bytemuck::cast_slice(&mesh.indices),
-        usage: wgpu::BufferUsages::INDEX,
-    });
-    (vertex_buffer, index_buffer)
 }

@@ -3,12 +3,25 @@
 //! through naga's reflection, so the padding is checked rather than kept in step by hand.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec3};
 
-use crate::scene::{Attenuation, Camera, Light, LightKind, Material, Object, ProceduralHeight, Projection};
-use crate::settings::{BumpView, RenderSettings, TangentSource, TextureFilter};
+use crate::scene::{Attenuation, Light, LightKind, Material, ProceduralHeight};
+use crate::settings::RenderSettings;
 
 pub const MAX_LIGHTS: usize = 16;
+
+/// `Light.kind` codes (`LIGHT_*` in `shaders/common/types.wgsl`).
+pub const LIGHT_POINT: u32 = 0;
+pub const LIGHT_DIRECTIONAL: u32 = 1;
+pub const LIGHT_SPOT: u32 = 2;
+/// `Light.attenuation` codes (`ATTENUATION_*`).
+pub const ATTENUATION_NONE: u32 = 0;
+pub const ATTENUATION_INVERSE_SQUARE: u32 = 1;
+/// Bits of `Frame.terms` (`TERM_*`).
+pub const TERM_AMBIENT: u32 = 1;
+pub const TERM_DIFFUSE: u32 = 2;
+pub const TERM_SPECULAR: u32 = 4;
+pub const TERM_EMISSION: u32 = 8;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -28,17 +41,19 @@ pub struct GpuLight {
 impl Light {
     pub fn to_gpu(&self) -> GpuLight {
         let (kind, position, direction, cos_inner, cos_outer) = match self.kind {
-            LightKind::Point { position } => (0, position, Vec3::ZERO, 1.0, 1.0),
-            LightKind::Directional { direction } => (1, Vec3::ZERO, direction, 1.0, 1.0),
-            LightKind::Spot { position, direction, inner, outer } => (2, position, direction, inner.cos(), outer.cos()),
+            LightKind::Point { position } => (LIGHT_POINT, position, Vec3::ZERO, 1.0, 1.0),
+            LightKind::Directional { direction } => (LIGHT_DIRECTIONAL, Vec3::ZERO, direction, 1.0, 1.0),
+            LightKind::Spot { position, direction, inner, outer } => {
+                (LIGHT_SPOT, position, direction, inner.cos(), outer.cos())
+            }
         };
         GpuLight {
             position: position.to_array(),
             kind,
             direction: direction.to_array(),
             attenuation: match self.attenuation {
-                Attenuation::None => 0,
-                Attenuation::InverseSquare => 1,
+                Attenuation::None => ATTENUATION_NONE,
+                Attenuation::InverseSquare => ATTENUATION_INVERSE_SQUARE,
             },
             radiance: (self.color * self.intensity).to_array(),
             cos_inner,
@@ -50,37 +65,23 @@ impl Light {
     }
 }
 
+/// Group 0, binding 1: what every view of a frame shares.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuFrame {
-    pub clip_from_world: [[f32; 4]; 4],
-    pub eye: [f32; 3],
-    pub orthographic: u32,
-    pub view_axis: [f32; 3],
-    pub light_count: u32,
     pub ambient: [f32; 3],
+    pub light_count: u32,
     pub terms: u32,
-    pub texture_filter: u32,
     pub lod_bias: f32,
-    pub bump_enabled: u32,
     pub bump_scale: f32,
     pub bump_delta_texels: f32,
-    pub bump_view: u32,
-    pub bump_tangents: u32,
-    pub bump_analytic: u32,
     pub lights: [GpuLight; MAX_LIGHTS],
 }
 
 impl GpuFrame {
     /// The per-frame uniform. Lights past [`MAX_LIGHTS`] are dropped (the loader warns).
     /// `shadow_layers[i]` is light `i`'s first shadow-map layer, if it casts shadows.
-    pub fn new(
-        camera: &Camera,
-        ambient: Vec3,
-        lights: &[Light],
-        shadow_layers: &[Option<u32>],
-        settings: &RenderSettings,
-    ) -> GpuFrame {
+    pub fn new(ambient: Vec3, lights: &[Light], shadow_layers: &[Option<u32>], settings: &RenderSettings) -> GpuFrame {
         let mut gpu_lights = [GpuLight::zeroed(); MAX_LIGHTS];
         let mut slots = 0;
         for (i, (gpu, light)) in gpu_lights.iter_mut().zip(lights).enumerate() {
@@ -92,38 +93,18 @@ impl GpuFrame {
             }
         }
         let t = settings.terms;
-        let terms =
-            u32::from(t.ambient) | u32::from(t.diffuse) << 1 | u32::from(t.specular) << 2 | u32::from(t.emission) << 3;
+        let bit = |on: bool, bit: u32| if on { bit } else { 0 };
+        let terms = bit(t.ambient, TERM_AMBIENT)
+            | bit(t.diffuse, TERM_DIFFUSE)
+            | bit(t.specular, TERM_SPECULAR)
+            | bit(t.emission, TERM_EMISSION);
         GpuFrame {
-            clip_from_world: camera.clip_from_world().to_cols_array_2d(),
-            eye: camera.eye.to_array(),
-            orthographic: u32::from(camera.projection == Projection::Orthographic),
-            view_axis: camera.frame().ze.to_array(),
-            light_count: lights.len().min(MAX_LIGHTS) as u32,
             ambient: ambient.to_array(),
+            light_count: lights.len().min(MAX_LIGHTS) as u32,
             terms,
-            texture_filter: match settings.textures.filter {
-                TextureFilter::Nearest => 0,
-                TextureFilter::Bilinear => 1,
-                TextureFilter::NearestMip => 2,
-                TextureFilter::Trilinear => 3,
-                TextureFilter::Anisotropic => 4,
-                TextureFilter::LevelColour => 5,
-            },
             lod_bias: settings.textures.lod_bias,
-            bump_enabled: u32::from(settings.bump.enabled),
             bump_scale: settings.bump.scale,
             bump_delta_texels: settings.bump.delta_texels,
-            bump_view: match settings.bump.view {
-                BumpView::Off => 0,
-                BumpView::Normals => 1,
-                BumpView::Tangents => 2,
-            },
-            bump_tangents: match settings.bump.tangents {
-                TangentSource::Derivatives => 0,
-                TangentSource::PerVertex => 1,
-            },
-            bump_analytic: u32::from(settings.bump.analytic),
             lights: gpu_lights,
         }
     }
@@ -133,21 +114,16 @@ impl GpuFrame {
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuMaterial {
     pub color: [f32; 3],
-    pub has_texture: u32,
     pub ka: f32,
     pub kd: f32,
     pub ks: f32,
     pub shininess: f32,
-    pub specular_color: [f32; 3],
     pub transparent: u32,
-    pub emission: [f32; 3],
+    pub specular_color: [f32; 3],
     pub bump_scale: f32,
-    pub transmission: [f32; 3],
-    pub has_height_map: u32,
-    pub has_normal_map: u32,
+    pub emission: [f32; 3],
     pub normal_scale: f32,
-    /// 1: the height map, 2: a sine field, 3: value noise (0: none).
-    pub height_kind: u32,
+    pub transmission: [f32; 3],
     pub height_amplitude: f32,
     pub height_frequency: [f32; 2],
     pub noise_seed: u32,
@@ -158,72 +134,84 @@ pub struct GpuMaterial {
 
 impl Material {
     pub fn to_gpu(&self) -> GpuMaterial {
+        let (amplitude, frequency, seed, cells, octaves) = match self.height_field {
+            Some(ProceduralHeight::Sine { amplitude, frequency }) => (amplitude, frequency.to_array(), 0, 0, 0),
+            Some(ProceduralHeight::Noise { amplitude, seed, cells, octaves }) => {
+                (amplitude, [0.0; 2], seed, cells, octaves)
+            }
+            None => (0.0, [0.0; 2], 0, 0, 0),
+        };
         GpuMaterial {
             color: self.color.to_array(),
-            has_texture: u32::from(self.texture.is_some()),
             ka: self.ka,
             kd: self.kd,
             ks: self.ks,
             shininess: self.shininess,
-            specular_color: self.specular_color.to_array(),
             transparent: u32::from(self.is_transparent()),
-            emission: self.emission.to_array(),
+            specular_color: self.specular_color.to_array(),
             bump_scale: self.bump_scale,
-            transmission: (self.transmission * self.transmission_color).to_array(),
-            has_height_map: u32::from(self.height_map.is_some() || self.height_field.is_some()),
-            has_normal_map: u32::from(self.normal_map.is_some()),
+            emission: self.emission.to_array(),
             normal_scale: self.normal_scale,
-            height_kind: match self.height_field {
-                Some(ProceduralHeight::Sine { .. }) => 2,
-                Some(ProceduralHeight::Noise { .. }) => 3,
-                None => u32::from(self.height_map.is_some()),
-            },
-            height_amplitude: match self.height_field {
-                Some(ProceduralHeight::Sine { amplitude, .. } | ProceduralHeight::Noise { amplitude, .. }) => amplitude,
-                None => 0.0,
-            },
-            height_frequency: match self.height_field {
-                Some(ProceduralHeight::Sine { frequency, .. }) => frequency.to_array(),
-                _ => [0.0; 2],
-            },
-            noise_seed: match self.height_field {
-                Some(ProceduralHeight::Noise { seed, .. }) => seed,
-                _ => 0,
-            },
-            noise_cells: match self.height_field {
-                Some(ProceduralHeight::Noise { cells, .. }) => cells,
-                _ => 0,
-            },
-            noise_octaves: match self.height_field {
-                Some(ProceduralHeight::Noise { octaves, .. }) => octaves,
-                _ => 0,
-            },
+            transmission: (self.transmission * self.transmission_color).to_array(),
+            height_amplitude: amplitude,
+            height_frequency: frequency,
+            noise_seed: seed,
+            noise_cells: cells,
+            noise_octaves: octaves,
             _pad: [0.0; 3],
         }
     }
 }
 
+/// Per object: its transforms, as instance attributes (vertex buffer 1, `Instance` in
+/// `shaders/common/types.wgsl`).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuObject {
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct GpuInstance {
     pub world_from_local: [[f32; 4]; 4],
-    pub normal_from_local: [[f32; 4]; 4],
+    /// Inverse transpose of `world_from_local`'s upper 3×3, by columns.
+    pub normal_from_local: [[f32; 3]; 3],
 }
 
-impl Object {
-    pub fn to_gpu(&self) -> GpuObject {
-        GpuObject {
-            world_from_local: self.world_from_local.to_cols_array_2d(),
-            normal_from_local: Mat4::from_mat3(self.normal_from_local()).to_cols_array_2d(),
+impl GpuInstance {
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 7] = wgpu::vertex_attr_array![
+        4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4,
+        8 => Float32x3, 9 => Float32x3, 10 => Float32x3,
+    ];
+
+    pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<GpuInstance>() as u64,
+        step_mode: wgpu::VertexStepMode::Instance,
+        attributes: &Self::ATTRIBUTES,
+    };
+
+    pub fn new(world_from_local: Mat4) -> GpuInstance {
+        GpuInstance {
+            world_from_local: world_from_local.to_cols_array_2d(),
+            normal_from_local: Mat3::from_mat4(world_from_local).inverse().transpose().to_cols_array_2d(),
         }
     }
+}
+
+/// Group 0, binding 0: one view's camera (`View` in `shaders/common/types.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuView {
+    pub clip_from_world: [[f32; 4]; 4],
+    pub eye: [f32; 3],
+    pub orthographic: u32,
+    pub view_axis: [f32; 3],
+    pub mirrored: u32,
+    pub clip_plane: [f32; 4],
 }
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuPresent {
     pub exposure: f32,
-    pub _pad: [f32; 3],
+    pub _pad: f32,
+    /// The HDR image's size over the output's.
+    pub scale: [f32; 2],
 }
 
 /// One vertex of the interleaved vertex buffer.

@@ -59,6 +59,22 @@ pub enum Shape {
     },
 }
 
+impl Shape {
+    /// A box around a curved analytic shape in its local coordinates; `None` for flat shapes and
+    /// meshes, whose vertices are their bounds.
+    pub fn curved_bounds(&self) -> Option<(Vec3, Vec3)> {
+        match *self {
+            Shape::Sphere { center, radius } => Some((center - Vec3::splat(radius), center + Vec3::splat(radius))),
+            Shape::Torus { major, minor } => {
+                let half = Vec3::new(major + minor, minor, major + minor);
+                Some((-half, half))
+            }
+            Shape::RoundedBox { half, radius } => Some((-half - Vec3::splat(radius), half + Vec3::splat(radius))),
+            Shape::Cuboid { .. } | Shape::Plane { .. } | Shape::Mesh(_) => None,
+        }
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Object {
     pub name: String,
@@ -147,16 +163,29 @@ impl Scene {
         }
     }
 
-    /// A world-space bounding box of everything in the scene, `None` for an empty scene.
+    /// A world-space bounding box of everything in the scene, `None` for an empty scene: the box
+    /// around the rasterizer's triangles, except that a sphere's is exact (`r·‖row_i‖` of its
+    /// transform about its centre), so thousands of spheres need no tessellation.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         let mut bounds: Option<(Vec3, Vec3)> = None;
+        let mut add = |lo: Vec3, hi: Vec3| {
+            bounds = Some(match bounds {
+                None => (lo, hi),
+                Some((a, b)) => (a.min(lo), b.max(hi)),
+            });
+        };
         for object in &self.objects {
+            let m = object.world_from_local;
+            if let Shape::Sphere { center, radius } = object.shape {
+                let c = m.transform_point3(center);
+                let rows = Mat3::from_mat4(m).transpose();
+                let half = radius * Vec3::new(rows.x_axis.length(), rows.y_axis.length(), rows.z_axis.length());
+                add(c - half, c + half);
+                continue;
+            }
             for p in self.tessellate(object).positions.iter() {
-                let w = object.world_from_local.transform_point3(*p);
-                bounds = Some(match bounds {
-                    None => (w, w),
-                    Some((lo, hi)) => (lo.min(w), hi.max(w)),
-                });
+                let w = m.transform_point3(*p);
+                add(w, w);
             }
         }
         bounds

@@ -12,6 +12,9 @@
 //! receivers must be planar: here, the scene's `plane` objects. Transparent casters are skipped
 //! (their coloured shadows need the shadow-map method). A light in the receiver's plane, or a
 //! directional light parallel to it, casts nothing on it.
+//!
+//! The polygons depend on the lights and the objects, not on the camera: they are computed once
+//! and kept until a light or the scene's geometry changes.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -19,9 +22,10 @@ use wgpu::util::DeviceExt;
 
 use super::views::ShadowLayout;
 use crate::gpu::layout;
-use crate::gpu::uniform::UniformBuffer;
 use crate::raster::DEPTH_FORMAT;
-use crate::scene::{LightKind, Scene, Shape};
+use crate::raster::scene_gpu::{SceneGpu, SceneLayouts};
+use crate::raster::view::ViewSlot;
+use crate::scene::{Light, LightKind, Scene, Shape};
 use crate::shaders;
 
 /// The screen-sized mask the polygons are drawn into: one channel per shadowed light.
@@ -165,23 +169,33 @@ struct MaskVertex {
     slot: u32,
 }
 
+/// What the polygons were computed from.
+#[derive(Clone, Debug, PartialEq)]
+struct PolygonInputs {
+    lights: Vec<Light>,
+    first_layer: Vec<Option<u32>>,
+    geometry: u64,
+}
+
+/// The polygons of the last computation, as triangles ready to draw.
+struct Polygons {
+    inputs: PolygonInputs,
+    vertices: Option<wgpu::Buffer>,
+    count: u32,
+}
+
 /// Draws the shadow polygons into the mask, depth-tested against the opaque depth prepass.
 pub struct ProjectedPass {
     pipeline: wgpu::RenderPipeline,
-    camera: UniformBuffer<[[f32; 4]; 4]>,
-    group: wgpu::BindGroup,
+    polygons: Option<Polygons>,
 }
 
 impl ProjectedPass {
-    pub fn new(device: &wgpu::Device) -> ProjectedPass {
+    pub fn new(device: &wgpu::Device, scene_layouts: &SceneLayouts) -> ProjectedPass {
         let module = shaders::module(device, "shadow_projected::shader", shaders::SHADOW_PROJECTED);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("shadow_projected::layout"),
-            entries: &[layout::uniform(0, wgpu::ShaderStages::VERTEX)],
-        });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow_projected::pipeline_layout"),
-            bind_group_layouts: &[Some(&layout)],
+            bind_group_layouts: &[Some(&scene_layouts.frame)],
             immediate_size: 0,
         });
         let max = wgpu::BlendComponent {
@@ -221,36 +235,33 @@ impl ProjectedPass {
             multiview_mask: None,
             cache: None,
         });
-        let camera = UniformBuffer::new(device, "shadow_projected::camera", &glam::Mat4::IDENTITY.to_cols_array_2d());
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("shadow_projected::group"),
-            layout: &layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: camera.binding() }],
-        });
-        ProjectedPass { pipeline, camera, group }
+        ProjectedPass { pipeline, polygons: None }
     }
 
-    /// Clears `mask` and draws `polygons` into it. The mask starts cleared even when there is
-    /// nothing to draw, since the opaque pass reads it whenever this method is chosen.
-    #[allow(clippy::too_many_arguments)]
+    /// Computes the polygons if the lights or the geometry changed since the last call, clears
+    /// `mask` and draws them into it, seen from the main view. The mask starts cleared even when
+    /// there is nothing to draw, since the opaque pass reads it whenever this method is chosen.
+    /// Returns whether the polygons were computed anew.
     pub fn record(
-        &self,
+        &mut self,
         device: &wgpu::Device,
-        queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
-        polygons: &[ShadowPolygon],
-        clip_from_world: glam::Mat4,
+        scene: &Scene,
+        scene_gpu: &SceneGpu,
+        layout: &ShadowLayout,
         mask: &wgpu::TextureView,
         depth: &wgpu::TextureView,
-    ) {
-        self.camera.write(queue, &clip_from_world.to_cols_array_2d());
-        let vertices: Vec<MaskVertex> = polygons
-            .iter()
-            .flat_map(|polygon| {
-                let fan = (1..polygon.points.len() - 1).flat_map(move |k| [0, k, k + 1]);
-                fan.map(move |i| MaskVertex { position: polygon.points[i].to_array(), slot: polygon.slot })
-            })
-            .collect();
+    ) -> bool {
+        let inputs = PolygonInputs {
+            lights: scene.lights.clone(),
+            first_layer: layout.first_layer.clone(),
+            geometry: scene_gpu.geometry.version(),
+        };
+        let fresh = self.polygons.as_ref().is_none_or(|p| p.inputs != inputs);
+        if fresh {
+            self.polygons = Some(Polygons::new(device, inputs, &projected_shadows(scene, layout)));
+        }
+        let polygons = self.polygons.as_ref().expect("computed above");
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("shadow_projected::pass"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -271,20 +282,35 @@ impl ProjectedPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if vertices.is_empty() {
-            return;
+        if let Some(vertices) = &polygons.vertices {
+            pass.push_debug_group("projected shadows");
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, scene_gpu.frame_group(), &[scene_gpu.views.offset(ViewSlot::Main)]);
+            pass.set_vertex_buffer(0, vertices.slice(..));
+            pass.draw(0..polygons.count, 0..1);
+            pass.pop_debug_group();
         }
-        let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("shadow_projected::vertices"),
-            contents: bytemuck::cast_slice(&vertices),
-            usage: wgpu::BufferUsages::VERTEX,
+        fresh
+    }
+}
+
+impl Polygons {
+    fn new(device: &wgpu::Device, inputs: PolygonInputs, polygons: &[ShadowPolygon]) -> Polygons {
+        let vertices: Vec<MaskVertex> = polygons
+            .iter()
+            .flat_map(|polygon| {
+                let fan = (1..polygon.points.len() - 1).flat_map(move |k| [0, k, k + 1]);
+                fan.map(move |i| MaskVertex { position: polygon.points[i].to_array(), slot: polygon.slot })
+            })
+            .collect();
+        let buffer = (!vertices.is_empty()).then(|| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("shadow_projected::vertices"),
+                contents: bytemuck::cast_slice(&vertices),
+                usage: wgpu::BufferUsages::VERTEX,
+            })
         });
-        pass.push_debug_group("projected shadows");
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.group, &[]);
-        pass.set_vertex_buffer(0, buffer.slice(..));
-        pass.draw(0..vertices.len() as u32, 0..1);
-        pass.pop_debug_group();
+        Polygons { inputs, vertices: buffer, count: vertices.len() as u32 }
     }
 }
 

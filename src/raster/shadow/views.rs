@@ -18,7 +18,7 @@
 use glam::{Mat4, Vec3, Vec4};
 
 use crate::scene::{LightKind, Scene};
-use crate::settings::ShadowSettings;
+use crate::settings::{ShadowFit, ShadowSettings};
 
 /// At most this many lights cast shadows; the others light everything they face.
 pub const MAX_SHADOWED_LIGHTS: usize = 4;
@@ -72,8 +72,8 @@ fn up_for(direction: Vec3) -> Vec3 {
 }
 
 /// The scene's bounds, or a unit box for an empty scene.
-fn scene_bounds(scene: &Scene) -> (Vec3, Vec3) {
-    scene.bounds().unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)))
+fn or_unit_box(bounds: Option<(Vec3, Vec3)>) -> (Vec3, Vec3) {
+    bounds.unwrap_or((Vec3::splat(-1.0), Vec3::splat(1.0)))
 }
 
 /// The eight corners of an axis-aligned box.
@@ -116,8 +116,7 @@ fn view_frustum_points(scene: &Scene, settings: &ShadowSettings) -> Vec<Vec3> {
     points
 }
 
-fn directional_view(scene: &Scene, settings: &ShadowSettings, direction: Vec3) -> (Mat4, f32) {
-    let bounds = scene_bounds(scene);
+fn directional_view(scene: &Scene, bounds: (Vec3, Vec3), settings: &ShadowSettings, direction: Vec3) -> (Mat4, f32) {
     let center = (bounds.0 + bounds.1) / 2.0;
     let radius = ((bounds.1 - bounds.0).length() / 2.0).max(1e-3);
     let view = glam::camera::rh::view::look_to_mat4(center - 2.0 * radius * direction, direction, up_for(direction));
@@ -128,7 +127,10 @@ fn directional_view(scene: &Scene, settings: &ShadowSettings, direction: Vec3) -
         })
     };
     let (scene_lo, scene_hi) = in_light(&box_corners(bounds));
-    let (view_lo, view_hi) = in_light(&view_frustum_points(scene, settings));
+    let (view_lo, view_hi) = match settings.fit {
+        ShadowFit::View => in_light(&view_frustum_points(scene, settings)),
+        ShadowFit::Scene => (scene_lo, scene_hi),
+    };
     // The window: the view frustum's footprint, but never beyond the scene.
     let lo = view_lo.max(scene_lo);
     let hi = view_hi.min(scene_hi);
@@ -166,11 +168,17 @@ pub const CUBE_FACES: [(Vec3, Vec3); 6] = [
 /// The layers of every shadowed light: the first [`MAX_SHADOWED_LIGHTS`] lights with any
 /// intensity.
 pub fn shadow_layout(scene: &Scene, settings: &ShadowSettings) -> ShadowLayout {
+    shadow_layout_in(scene, scene.bounds(), settings)
+}
+
+/// [`shadow_layout`] with the scene's bounds already known (the renderer computes them once per
+/// scene).
+pub fn shadow_layout_in(scene: &Scene, bounds: Option<(Vec3, Vec3)>, settings: &ShadowSettings) -> ShadowLayout {
     let mut layout = ShadowLayout { views: Vec::new(), first_layer: vec![None; scene.lights.len()] };
     if !settings.enabled {
         return layout;
     }
-    let bounds = scene_bounds(scene);
+    let bounds = or_unit_box(bounds);
     let size = settings.map_size as f32;
     let mut shadowed = 0;
     for (index, light) in scene.lights.iter().enumerate() {
@@ -185,7 +193,7 @@ pub fn shadow_layout(scene: &Scene, settings: &ShadowSettings) -> ShadowLayout {
         layout.first_layer[index] = Some(layout.views.len() as u32);
         match light.kind {
             LightKind::Directional { direction } => {
-                let (clip_from_world, texel_size) = directional_view(scene, settings, direction);
+                let (clip_from_world, texel_size) = directional_view(scene, bounds, settings, direction);
                 layout.views.push(LightView {
                     light: index,
                     clip_from_world,

@@ -21,8 +21,6 @@ pub mod octree;
 use std::fmt;
 use std::time::{Duration, Instant};
 
-use serde::{Deserialize, Serialize};
-
 use crate::scene::Ray;
 use crate::trace::geometry::{PreparedRay, Primitive};
 
@@ -91,17 +89,7 @@ pub trait Accelerator: Send + Sync {
     fn stats(&self) -> AccelStats;
 }
 
-/// Which accelerator to build (`--accel bvh|grid|octree|none`).
-#[derive(clap::ValueEnum, Serialize, Deserialize, Clone, Copy, Debug, PartialEq, Eq, Default)]
-#[serde(rename_all = "snake_case")]
-pub enum AccelKind {
-    #[default]
-    Bvh,
-    Grid,
-    Octree,
-    /// Brute force: every primitive for every ray.
-    None,
-}
+pub use crate::settings::AccelKind;
 
 /// Builds the accelerator `kind` over `prims`; query it with the same slice.
 pub fn build(kind: AccelKind, prims: &[Primitive]) -> Box<dyn Accelerator> {

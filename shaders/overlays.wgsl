@@ -1,0 +1,52 @@
+// Teaching overlays drawn over the shaded image (src/raster/overlays.rs): one shadow-map layer as
+// grey levels, and the lights' view volumes as lines in the scene.
+
+// ---- One layer of the shadow maps, depth as grey.
+
+struct ShownLayer {
+    layer: u32,
+    width: u32,
+    height: u32,
+    // near/far of a perspective view, 0 for an orthographic one.
+    depth_ratio: f32,
+}
+
+@group(0) @binding(1) var shadow_maps: texture_depth_2d_array;
+@group(0) @binding(2) var<uniform> shown_layer: ShownLayer;
+
+@vertex
+fn vs_shadow_map_view(@builtin(vertex_index) index: u32) -> @builtin(position) vec4f {
+    return fullscreen_position(index);
+}
+
+@fragment
+fn fs_shadow_map_view(@builtin(position) pixel: vec4f) -> @location(0) vec4f {
+    // The map fills the largest centred square of the image.
+    let size = vec2f(f32(shown_layer.width), f32(shown_layer.height));
+    let side = min(size.x, size.y);
+    let uv = (pixel.xy - 0.5 * (size - side)) / side;
+    if any(uv < vec2f(0.0)) || any(uv >= vec2f(1.0)) {
+        return vec4f(0.02, 0.02, 0.03, 1.0);
+    }
+    let dims = textureDimensions(shadow_maps);
+    let depth = textureLoad(shadow_maps, vec2i(uv * vec2f(dims)), shown_layer.layer, 0);
+    // A perspective view's depth crowds towards 1; shown as distance over the far plane instead.
+    let r = shown_layer.depth_ratio;
+    let distance = select(depth, r / (1.0 - depth * (1.0 - r)), r > 0.0);
+    return vec4f(vec3f(distance), 1.0);
+}
+
+// ---- The lights' view volumes as lines in the scene.
+
+// Group 0 of the scene pass, read at the main view's slot.
+@group(0) @binding(0) var<uniform> view: View;
+
+@vertex
+fn vs_frustum(@location(0) position: vec3f) -> @builtin(position) vec4f {
+    return view.clip_from_world * vec4f(position, 1.0);
+}
+
+@fragment
+fn fs_frustum() -> @location(0) vec4f {
+    return vec4f(1.0, 0.8, 0.1, 1.0);
+}

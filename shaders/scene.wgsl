@@ -1,0 +1,270 @@
+// The scene pass: every surface of the scene drawn from one view, shaded per fragment by the
+// illumination model (shaders/common/lighting.wgsl) for all lights, each weighted by its
+// visibility from the shadow pass, into the linear HDR target. One module serves every variant
+// (depth prepass, opaque, and the techniques to come); src/raster/scene_pass.rs says which.
+//
+// Toggles that switch code on or off are pipeline constants, not uniforms: a software GPU such
+// as lavapipe runs both sides of a branch on a uniform value, so a shader that merely skips
+// switched-off work would still pay for all of it. Each variant is compiled with its code only.
+
+// The frame's toggles (src/raster/scene_pass.rs, FrameKey).
+override SHADOW_METHOD: u32 = 0u;
+override SHADOW_FILTER: u32 = 0u;
+override SHADOW_TRANSMISSION: bool = false;
+override SHADOW_TEXELS_VIEW: bool = false;
+override LEVEL_COLOUR: bool = false;
+override BUMP: bool = false;
+override BUMP_VIEW: u32 = 0u;
+override TANGENTS_PER_VERTEX: bool = false;
+override BUMP_ANALYTIC: bool = false;
+override FLAT_COLOUR: bool = false;
+// The material's inputs (MaterialKey).
+override COLOR_TEXTURE: bool = false;
+override HEIGHT_KIND: u32 = 0u;
+override NORMAL_MAP: bool = false;
+
+const SHADOWS_OFF: u32 = 0u;
+const SHADOWS_MAP: u32 = 1u;
+const SHADOWS_PROJECTED: u32 = 2u;
+
+const BUMP_VIEW_NORMALS: u32 = 1u;
+const BUMP_VIEW_TANGENTS: u32 = 2u;
+
+const HEIGHT_NONE: u32 = 0u;
+const HEIGHT_TEXTURE: u32 = 1u;
+const HEIGHT_SINE: u32 = 2u;
+const HEIGHT_NOISE: u32 = 3u;
+
+@group(0) @binding(0) var<uniform> view: View;
+@group(0) @binding(1) var<uniform> frame: Frame;
+// Bilinear, for height and normal maps (read on level 0).
+@group(0) @binding(2) var height_sampler: sampler;
+@group(1) @binding(0) var<uniform> material: Material;
+// sRGB, with its whole mip chain: the sampler decodes to linear before it filters.
+@group(1) @binding(1) var color_texture: texture_2d<f32>;
+// Linear grey levels f_h(u, v); the red channel is the height.
+@group(1) @binding(2) var height_texture: texture_2d<f32>;
+// Tangent-space normals (glTF's normalTexture), linear.
+@group(1) @binding(3) var normal_texture: texture_2d<f32>;
+// The chosen texture filter (TECHNIQUES.md §2) with the material's wrap modes.
+@group(1) @binding(4) var color_sampler: sampler;
+// Group 2: the shadow pass's outputs and how to read them.
+@group(2) @binding(0) var<uniform> shadows: Shadows;
+@group(2) @binding(1) var shadow_maps: texture_depth_2d_array;
+@group(2) @binding(2) var shadow_linear: sampler_comparison;
+@group(2) @binding(3) var shadow_nearest: sampler_comparison;
+@group(2) @binding(4) var transmission_maps: texture_2d_array<f32>;
+@group(2) @binding(5) var projected_mask: texture_2d<f32>;
+
+struct VertexIn {
+    @location(0) position: vec3f,
+    @location(1) normal: vec3f,
+    @location(2) uv: vec2f,
+    @location(3) tangent: vec4f,
+}
+
+struct VertexOut {
+    // Invariant: the shading pass after a depth prepass tests Equal against the prepass's depth,
+    // so both must compute exactly the same position.
+    @builtin(position) @invariant clip: vec4f,
+    @location(0) world: vec3f,
+    @location(1) normal: vec3f,
+    @location(2) uv: vec2f,
+    // World-space tangent, and the bitangent's sign in w.
+    @location(3) tangent: vec4f,
+}
+
+@vertex
+fn vs_scene(in: VertexIn, instance: Instance) -> VertexOut {
+    let world_from_local = instance_world_from_local(instance);
+    let world = world_from_local * vec4f(in.position, 1.0);
+    var out: VertexOut;
+    out.clip = view.clip_from_world * world;
+    out.world = world.xyz;
+    out.normal = instance_normal_from_local(instance) * in.normal;
+    out.uv = in.uv;
+    out.tangent = vec4f((world_from_local * vec4f(in.tangent.xyz, 0.0)).xyz, in.tangent.w);
+    return out;
+}
+
+// The unit vector from p towards the viewer, for either projection.
+fn view_vector(p: vec3f) -> vec3f {
+    if view.orthographic != 0u {
+        return view.view_axis;
+    }
+    return normalize(view.eye - p);
+}
+
+// V_i for one light at p: 1 lit, 0 in shadow, a colour behind transparent occluders.
+// `facing` is the normal on the side the light is on, for the normal offset.
+fn visibility(light: Light, p: vec3f, facing: vec3f, pixel: vec2f) -> vec3f {
+    if SHADOW_METHOD == SHADOWS_OFF || light.shadow_layer < 0 {
+        return vec3f(1.0);
+    }
+    if SHADOW_METHOD == SHADOWS_PROJECTED {
+        let mask = textureLoad(projected_mask, vec2i(pixel), 0);
+        return vec3f(1.0 - mask[light.shadow_slot]);
+    }
+    var layer = u32(light.shadow_layer);
+    if light.kind == LIGHT_POINT {
+        layer += cube_face(p - light.position);
+    }
+    let coordinates = shadow_lookup_point(shadows.layers[layer], light.position, p, facing, shadows.normal_offset);
+    if coordinates.w == 0.0 {
+        return vec3f(1.0);
+    }
+    var v = vec3f(shadow_filtered(
+        shadow_maps, shadow_linear, shadow_nearest, coordinates.xy, coordinates.z, layer, SHADOW_FILTER,
+        shadows.map_size,
+    ));
+    // A transparent receiver is not tinted by transparent occluders: in this one-layer
+    // approximation it would be tinted by itself.
+    if SHADOW_TRANSMISSION && material.transparent == 0u {
+        let size = vec2f(textureDimensions(transmission_maps));
+        let tint = textureLoad(transmission_maps, vec2i(coordinates.xy * size), layer, 0);
+        if coordinates.z > tint.a {
+            v *= tint.rgb;
+        }
+    }
+    return v;
+}
+
+// f_h(u, v): the height map's red channel (bilinear on level 0), or a procedural field.
+fn height_at(uv: vec2f) -> f32 {
+    switch HEIGHT_KIND {
+        case HEIGHT_SINE: {
+            return sine_height(uv, material.height_frequency, material.height_amplitude);
+        }
+        case HEIGHT_NOISE: {
+            return value_noise(uv, material.noise_seed, material.noise_cells, material.noise_octaves, material.height_amplitude).x;
+        }
+        default: {
+            return textureSampleLevel(height_texture, height_sampler, uv, 0.0).r;
+        }
+    }
+}
+
+// The finite-difference step Δ: bump_delta_texels texels of the height map, or of a procedural
+// field's own step (a 64th of a sine's shortest period, a 16th of the finest noise cell), as
+// src/texture/height.rs's default_delta.
+fn height_delta() -> vec2f {
+    switch HEIGHT_KIND {
+        case HEIGHT_SINE: {
+            return frame.bump_delta_texels / (64.0 * max(abs(material.height_frequency), vec2f(1.0)));
+        }
+        case HEIGHT_NOISE: {
+            let finest = max(material.noise_cells, 1u) << min(max(material.noise_octaves, 1u) - 1u, 20u);
+            return vec2f(frame.bump_delta_texels / (16.0 * f32(finest)));
+        }
+        default: {
+            return frame.bump_delta_texels / vec2f(textureDimensions(height_texture));
+        }
+    }
+}
+
+// The slopes (du, dv) = k·∇f_h: central differences (TECHNIQUES.md §3), or for procedural fields
+// their closed-form gradient when asked.
+fn height_slopes(uv: vec2f, k: f32) -> vec2f {
+    if BUMP_ANALYTIC && HEIGHT_KIND == HEIGHT_SINE {
+        return k * sine_height_gradient(uv, material.height_frequency, material.height_amplitude);
+    }
+    if BUMP_ANALYTIC && HEIGHT_KIND == HEIGHT_NOISE {
+        return k * value_noise(uv, material.noise_seed, material.noise_cells, material.noise_octaves, material.height_amplitude).yz;
+    }
+    let delta = height_delta();
+    return bump_central_differences(
+        height_at(uv + vec2f(delta.x, 0.0)), height_at(uv - vec2f(delta.x, 0.0)),
+        height_at(uv + vec2f(0.0, delta.y)), height_at(uv - vec2f(0.0, delta.y)),
+        delta, k,
+    );
+}
+
+// The surface colour C(p): the material's colour times its texture, or the level-colour view.
+fn surface_color(uv: vec2f, duv_dx: vec2f, duv_dy: vec2f) -> vec3f {
+    if !COLOR_TEXTURE {
+        return material.color;
+    }
+    if LEVEL_COLOUR {
+        let size = vec2f(textureDimensions(color_texture));
+        let lod = mip_lod(duv_dx, duv_dy, size, frame.lod_bias);
+        return mip_level_colour(clamp(lod, 0.0, f32(textureNumLevels(color_texture) - 1u)));
+    }
+    return material.color * textureSampleBias(color_texture, color_sampler, uv, frame.lod_bias).rgb;
+}
+
+// The shading normal: the interpolated normal, perturbed by the height field (TECHNIQUES.md §3:
+// t'u = tu + du·n, t'v = tv + dv·n, n' = normalize(t'u × t'v)) and by a normal map.
+fn shading_normal(in: VertexOut, tangents: SurfaceTangents) -> vec3f {
+    var n = normalize(in.normal);
+    if !BUMP || !tangents.valid {
+        return n;
+    }
+    if HEIGHT_KIND != HEIGHT_NONE {
+        let g = height_slopes(in.uv, material.bump_scale * frame.bump_scale);
+        n = perturbed_normal(n, tangents.tu, tangents.tv, g.x, g.y);
+    }
+    if NORMAL_MAP {
+        // glTF's frame: t along ∂p/∂u (in n's plane), the bitangent's sign from ∂p/∂v.
+        let t = tangents.tu - dot(tangents.tu, n) * n;
+        let handedness = select(1.0, -1.0, dot(cross(n, t), tangents.tv) < 0.0);
+        let rgb = textureSampleLevel(normal_texture, height_sampler, in.uv, 0.0).rgb;
+        n = normal_map_normal(n, vec4f(t, handedness), rgb, material.normal_scale);
+    }
+    return n;
+}
+
+// The radiance leaving the surface towards the viewer: ME + AG + Σ_i V_i·S_i·L_dir.
+fn shade(in: VertexOut) -> vec3f {
+    // Screen-space derivatives first, in uniform control flow: the texture's level of detail and
+    // the tangents ∂p/∂u, ∂p/∂v of the surface, from the change of position and uv across pixels.
+    let duv_dx = dpdx(in.uv);
+    let duv_dy = dpdy(in.uv);
+    var tangents = tangents_from_derivatives(dpdx(in.world), dpdy(in.world), duv_dx, duv_dy);
+    let color = surface_color(in.uv, duv_dx, duv_dy);
+    if FLAT_COLOUR {
+        return color;
+    }
+    if TANGENTS_PER_VERTEX {
+        // Interpolated per-vertex tangent t and bitangent sign·(n × t), both unit length.
+        let t = normalize(in.tangent.xyz);
+        tangents = SurfaceTangents(t, sign(in.tangent.w) * cross(normalize(in.normal), t), length(in.tangent.xyz) > 0.0);
+    }
+    let v = view_vector(in.world);
+    let n = facing_viewer(shading_normal(in, tangents), v);
+    if BUMP_VIEW == BUMP_VIEW_NORMALS {
+        return 0.5 + 0.5 * n;
+    }
+    if BUMP_VIEW == BUMP_VIEW_TANGENTS {
+        return 0.5 + 0.5 * normalize(tangents.tu);
+    }
+    let surface = Surface(
+        color, material.ka, material.kd, material.ks,
+        material.specular_color, material.shininess, material.emission,
+    );
+    var radiance = emitted_and_ambient(surface, frame.ambient, frame.terms);
+    var checker = -1.0;
+    for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {
+        let light = frame.lights[i];
+        let incidence = light_incidence(light, in.world);
+        if incidence.valid {
+            let facing = select(-n, n, dot(n, incidence.l) >= 0.0);
+            radiance += visibility(light, in.world, facing, in.clip.xy) * direct(surface, n, v, incidence, frame.terms);
+            if SHADOW_TEXELS_VIEW && SHADOW_METHOD == SHADOWS_MAP && light.shadow_layer >= 0 && checker < 0.0 {
+                var layer = u32(light.shadow_layer);
+                if light.kind == LIGHT_POINT {
+                    layer += cube_face(in.world - light.position);
+                }
+                checker = shadow_texel_checker(shadow_coordinates(shadows.layers[layer].clip_from_world, in.world).xy, shadows.map_size);
+            }
+        }
+    }
+    if checker >= 0.0 {
+        radiance *= mix(0.55, 1.0, checker);
+    }
+    return radiance;
+}
+
+@fragment
+fn fs_scene(in: VertexOut) -> @location(0) vec4f {
+    return vec4f(shade(in), 1.0);
+}

@@ -1,0 +1,340 @@
+//! The scene's geometry as the rasterizer draws it: each distinct mesh once, every object an
+//! instance of one, and the draw list of instanced calls.
+//!
+//! - **Shared meshes.** Spheres are instances of one unit sphere per tessellation, placed by
+//!   `world_from_local · translate(center) · scale(radius)`; other shapes share a mesh with every
+//!   object of identical shape; a file's mesh is shared by every node that uses it. Two thousand
+//!   spheres are one mesh in memory, not two thousand.
+//! - **Tessellation by size on screen.** A polygon with `n` sides inscribed in a circle of `R`
+//!   pixels departs from it by at most `R·(1 − cos(π/n)) ≈ R·π²/2n²`; keeping that under a
+//!   sixteenth of a pixel needs `n ≥ π·√(8R)`. (A quarter pixel was not enough: silhouettes held,
+//!   but the facets' flat shading positions cost seed-simple 20 dB of PSNR against the tracer.) Curved analytic shapes get the smallest level of
+//!   [`SEGMENT_LEVELS`] that does, at most `sphere_segments`, so a far sphere costs tens of
+//!   triangles and a near one what the setting allows.
+//! - **Instanced draws.** Objects are sorted by (transparency, material, mesh), and each run of
+//!   equal keys is one `draw_indexed` over a range of the instance buffer.
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use glam::{Mat4, Vec3};
+use wgpu::util::DeviceExt;
+
+use super::uniforms::{GpuInstance, Vertex};
+use crate::scene::{Camera, Mesh, Object, Projection, Scene, Shape};
+use crate::texture::tangents::tangents_or_generate;
+
+/// The tessellations curved shapes choose from.
+pub const SEGMENT_LEVELS: [u32; 10] = [8, 12, 16, 24, 32, 48, 64, 96, 128, 192];
+
+/// What makes two objects' meshes the same.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MeshKey {
+    /// The unit sphere at the origin, with this many slices.
+    Sphere(u32),
+    /// Shapes that have no unit form share a mesh with identical shapes: their parameters' bits.
+    Cuboid([u32; 6]),
+    Plane([u32; 4]),
+    Torus([u32; 2], u32),
+    RoundedBox([u32; 4], u32),
+    /// `Scene::meshes[i]`.
+    File(usize),
+}
+
+/// The mesh an object is an instance of, at `segments`, and the transform from that mesh to the
+/// world.
+pub fn instance_of(object: &Object, segments: u32) -> (MeshKey, Mat4) {
+    let bits = |v: &[f32]| -> Vec<u32> { v.iter().map(|x| x.to_bits()).collect() };
+    let key = match object.shape {
+        Shape::Sphere { center, radius } => {
+            let placed =
+                object.world_from_local * Mat4::from_translation(center) * Mat4::from_scale(Vec3::splat(radius));
+            return (MeshKey::Sphere(segments), placed);
+        }
+        Shape::Cuboid { min, max } => {
+            MeshKey::Cuboid(bits(&[min.x, min.y, min.z, max.x, max.y, max.z]).try_into().expect("six values"))
+        }
+        Shape::Plane { size, uv_scale } => {
+            MeshKey::Plane(bits(&[size.x, size.y, uv_scale.x, uv_scale.y]).try_into().expect("four values"))
+        }
+        Shape::Torus { major, minor } => MeshKey::Torus(bits(&[major, minor]).try_into().expect("two"), segments),
+        Shape::RoundedBox { half, radius } => {
+            MeshKey::RoundedBox(bits(&[half.x, half.y, half.z, radius]).try_into().expect("four"), segments)
+        }
+        Shape::Mesh(index) => MeshKey::File(index),
+    };
+    (key, object.world_from_local)
+}
+
+/// The triangles of a mesh key, in the mesh's own coordinates.
+fn build_mesh(scene: &Scene, key: MeshKey) -> std::borrow::Cow<'_, Mesh> {
+    use std::borrow::Cow;
+    let f = f32::from_bits;
+    match key {
+        MeshKey::Sphere(segments) => Cow::Owned(Mesh::sphere(Vec3::ZERO, 1.0, segments)),
+        MeshKey::Cuboid(b) => {
+            Cow::Owned(Mesh::cuboid(Vec3::new(f(b[0]), f(b[1]), f(b[2])), Vec3::new(f(b[3]), f(b[4]), f(b[5]))))
+        }
+        MeshKey::Plane(b) => {
+            Cow::Owned(Mesh::plane(glam::Vec2::new(f(b[0]), f(b[1])), glam::Vec2::new(f(b[2]), f(b[3]))))
+        }
+        MeshKey::Torus(b, segments) => Cow::Owned(Mesh::torus(f(b[0]), f(b[1]), segments)),
+        MeshKey::RoundedBox(b, segments) => {
+            Cow::Owned(Mesh::rounded_box(Vec3::new(f(b[0]), f(b[1]), f(b[2])), f(b[3]), segments))
+        }
+        MeshKey::File(index) => Cow::Borrowed(&scene.meshes[index]),
+    }
+}
+
+/// The radius, in pixels, that a world-space sphere of `radius` at `center` covers on screen; a
+/// very large number when the eye is inside it.
+fn screen_radius(camera: &Camera, center: Vec3, radius: f32) -> f32 {
+    let pixels_per_unit_at_one = camera.height as f32 / camera.window().1;
+    match camera.projection {
+        Projection::Orthographic => radius * pixels_per_unit_at_one,
+        Projection::Perspective => {
+            // window() is the window at the near plane; scale it to unit distance.
+            let depth = (center - camera.eye).dot(-camera.frame().ze);
+            if depth <= radius {
+                return f32::MAX;
+            }
+            radius * pixels_per_unit_at_one * camera.near / depth
+        }
+    }
+}
+
+/// Segments for a curved shape whose bounding sphere covers `pixels` on screen: the smallest level
+/// whose polygon stays within a sixteenth of a pixel of the circle, at most `max`.
+pub fn segments_for_pixels(pixels: f32, max: u32) -> u32 {
+    let needed = std::f32::consts::PI * (8.0 * pixels.max(0.0)).sqrt();
+    SEGMENT_LEVELS.iter().copied().find(|&n| n as f32 >= needed).unwrap_or(u32::MAX).min(max)
+}
+
+/// The world-space bounding sphere of an object's shape, from its local bounds.
+fn bounding_sphere(object: &Object, local: (Vec3, Vec3)) -> (Vec3, f32) {
+    let center = object.world_from_local.transform_point3((local.0 + local.1) / 2.0);
+    let scale = object.world_from_local.to_scale_rotation_translation().0.max_element();
+    (center, (local.1 - local.0).length() / 2.0 * scale)
+}
+
+/// A mesh on the GPU.
+pub struct GpuMesh {
+    pub vertices: wgpu::Buffer,
+    pub indices: wgpu::Buffer,
+    pub index_count: u32,
+}
+
+impl GpuMesh {
+    fn upload(device: &wgpu::Device, label: &str, mesh: &Mesh) -> GpuMesh {
+        // The file's tangents where it has them, MikkTSpace's otherwise (TECHNIQUES.md §3's
+        // per-vertex source).
+        let existing = (!mesh.tangents.is_empty()).then_some(mesh.tangents.as_slice());
+        let tangents = tangents_or_generate(mesh, existing);
+        let vertices: Vec<Vertex> = (0..mesh.positions.len())
+            .map(|i| Vertex {
+                position: mesh.positions[i].to_array(),
+                normal: mesh.normals[i].to_array(),
+                uv: mesh.uvs[i].to_array(),
+                tangent: tangents[i].to_array(),
+            })
+            .collect();
+        GpuMesh {
+            vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(&format!("geometry::vertices {label}")),
+                contents: bytemuck::cast_slice(&vertices),
+                usage: wgpu::BufferUsages::VERTEX,
+            }),
+            indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(&format!("geometry::indices {label}")),
+                contents: bytemuck::cast_slice(&mesh.indices),
+                usage: wgpu::BufferUsages::INDEX,
+            }),
+            index_count: mesh.indices.len() as u32,
+        }
+    }
+}
+
+/// One instanced draw: objects of one material that share one mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Batch {
+    pub mesh: MeshKey,
+    pub material: usize,
+    /// The material lets light through (kt > 0): it tints shadows rather than casting them.
+    pub transparent: bool,
+    pub instances: Range<u32>,
+}
+
+/// Per object, what does not change while the scene stays: its material, and for curved shapes
+/// the local bounds that size it on screen.
+struct ObjectInfo {
+    material: usize,
+    transparent: bool,
+    curved_bounds: Option<(Vec3, Vec3)>,
+}
+
+/// The meshes, the instance buffer and the draw list of one scene.
+pub struct SceneGeometry {
+    objects: Vec<ObjectInfo>,
+    meshes: HashMap<MeshKey, GpuMesh>,
+    instances: Option<wgpu::Buffer>,
+    /// The segments each object was last drawn with (0 for fixed shapes): the draw list is
+    /// rebuilt only when one of them changes.
+    segments: Vec<u32>,
+    pub batches: Vec<Batch>,
+    /// A world-space box around everything, computed once.
+    pub bounds: Option<(Vec3, Vec3)>,
+    /// Names this draw list among all the draw lists ever made: what is drawn from it (shadow
+    /// maps, projected polygons) is kept while it stays the same.
+    version: u64,
+}
+
+/// A fresh draw-list version, never handed out before.
+fn next_version() -> u64 {
+    static VERSION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    VERSION.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+impl SceneGeometry {
+    pub fn new(scene: &Scene) -> SceneGeometry {
+        let objects = scene
+            .objects
+            .iter()
+            .map(|object| ObjectInfo {
+                material: object.material.0,
+                transparent: scene.materials[object.material.0].is_transparent(),
+                curved_bounds: object.shape.curved_bounds(),
+            })
+            .collect();
+        SceneGeometry {
+            objects,
+            meshes: HashMap::new(),
+            instances: None,
+            segments: Vec::new(),
+            batches: Vec::new(),
+            bounds: scene.bounds(),
+            version: next_version(),
+        }
+    }
+
+    /// Chooses each curved shape's tessellation for `camera` (or `max_segments` everywhere when
+    /// `adaptive` is off), uploads meshes not seen before, and rebuilds the draw list if anything
+    /// changed. Returns whether it did.
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        camera: &Camera,
+        max_segments: u32,
+        adaptive: bool,
+    ) -> bool {
+        let segments: Vec<u32> = scene
+            .objects
+            .iter()
+            .zip(&self.objects)
+            .map(|(object, info)| match info.curved_bounds {
+                None => 0,
+                Some(_) if !adaptive => max_segments,
+                Some(local) => {
+                    let (center, radius) = bounding_sphere(object, local);
+                    segments_for_pixels(screen_radius(camera, center, radius), max_segments)
+                }
+            })
+            .collect();
+        if segments == self.segments && self.instances.is_some() {
+            return false;
+        }
+        let mut entries: Vec<(bool, usize, MeshKey, GpuInstance)> = scene
+            .objects
+            .iter()
+            .zip(&self.objects)
+            .zip(&segments)
+            .map(|((object, info), &n)| {
+                let (key, world_from_mesh) = instance_of(object, n);
+                (info.transparent, info.material, key, GpuInstance::new(world_from_mesh))
+            })
+            .collect();
+        // Opaque first, then by material and mesh: runs of equal keys become one draw.
+        entries.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)).then_with(|| mesh_order(&a.2).cmp(&mesh_order(&b.2))));
+        for (_, _, key, _) in &entries {
+            if !self.meshes.contains_key(key) {
+                let mesh = build_mesh(scene, *key);
+                self.meshes.insert(*key, GpuMesh::upload(device, &format!("{key:?}"), &mesh));
+            }
+        }
+        self.batches.clear();
+        for (index, (transparent, material, key, _)) in entries.iter().enumerate() {
+            let index = index as u32;
+            match self.batches.last_mut() {
+                Some(b) if b.transparent == *transparent && b.material == *material && b.mesh == *key => {
+                    b.instances.end = index + 1;
+                }
+                _ => self.batches.push(Batch {
+                    mesh: *key,
+                    material: *material,
+                    transparent: *transparent,
+                    instances: index..index + 1,
+                }),
+            }
+        }
+        let data: Vec<GpuInstance> = entries.iter().map(|e| e.3).collect();
+        let size = std::mem::size_of_val(data.as_slice()) as u64;
+        match &self.instances {
+            Some(buffer) if buffer.size() >= size => queue.write_buffer(buffer, 0, bytemuck::cast_slice(&data)),
+            _ if data.is_empty() => {}
+            _ => {
+                self.instances = Some(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("geometry::instances"),
+                    contents: bytemuck::cast_slice(&data),
+                    usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+                }));
+            }
+        }
+        self.segments = segments;
+        self.version = next_version();
+        true
+    }
+
+    /// The draw list's version: it changes whenever the list is rebuilt.
+    pub fn version(&self) -> u64 {
+        self.version
+    }
+
+    /// Records `batch`: binds its mesh and instances and draws them (the pipeline and material
+    /// group are the caller's).
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, batch: &Batch) {
+        let mesh = &self.meshes[&batch.mesh];
+        let instances = self.instances.as_ref().expect("prepare() made the instance buffer for this batch");
+        let stride = std::mem::size_of::<GpuInstance>() as u64;
+        pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+        pass.set_vertex_buffer(1, instances.slice(u64::from(batch.instances.start) * stride..));
+        pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..mesh.index_count, 0, 0..batch.instances.len() as u32);
+    }
+
+    /// Triangles drawn per view with the current draw list.
+    pub fn triangles(&self) -> u64 {
+        self.batches.iter().map(|b| u64::from(self.meshes[&b.mesh].index_count / 3) * b.instances.len() as u64).sum()
+    }
+
+    pub fn mesh_count(&self) -> usize {
+        self.meshes.len()
+    }
+
+    pub fn has_transparent(&self) -> bool {
+        self.objects.iter().any(|o| o.transparent)
+    }
+}
+
+/// A total order on mesh keys for sorting (their parameters are bit patterns, so any order will
+/// do as long as equal keys end up side by side).
+fn mesh_order(key: &MeshKey) -> (u8, [u32; 6], u32) {
+    match *key {
+        MeshKey::Sphere(n) => (0, [0; 6], n),
+        MeshKey::Cuboid(b) => (1, b, 0),
+        MeshKey::Plane(b) => (2, [b[0], b[1], b[2], b[3], 0, 0], 0),
+        MeshKey::Torus(b, n) => (3, [b[0], b[1], 0, 0, 0, 0], n),
+        MeshKey::RoundedBox(b, n) => (4, [b[0], b[1], b[2], b[3], 0, 0], n),
+        MeshKey::File(i) => (5, [0; 6], i as u32),
+    }
+}

@@ -1,0 +1,365 @@
+//! The scene pass: the z-buffer algorithm, drawn from one [`View`](super::view::View) with a
+//! variant. Every fragment of every surface is depth-tested against the nearest so far; the
+//! survivor is shaded by the illumination model (`shaders/scene.wgsl`, with the model itself in
+//! `shaders/common/lighting.wgsl`) for all lights, each weighted by its visibility from the
+//! shadow pass, into the linear HDR target.
+//!
+//! Variants, one shading module:
+//! - **Depth prepass** ([`ScenePass::record_prepass`]): the depth of the nearest surface at every
+//!   pixel, and nothing else. The shading pass that follows tests `Equal` against it, so the
+//!   illumination model runs once per pixel instead of once per fragment drawn: on a software
+//!   GPU, where fragment shading is nearly all of the frame, overdraw is paid in full.
+//! - **Opaque** ([`ScenePass::record_opaque`]): the plain z-buffer (`Less`, depth written) or,
+//!   after a prepass, shading only where the prepass's depth is.
+//!
+//! Pipeline constants specialise the shader per frame toggles ([`FrameKey`]) and per material
+//! inputs ([`MaterialKey`]); each combination is compiled once, the first time it is drawn.
+//! No back-face culling: planes are two-sided, and the shader turns the normal to the viewer.
+
+use std::collections::HashMap;
+
+use super::scene_gpu::{SceneGpu, SceneLayouts};
+use super::uniforms::{GpuInstance, Vertex};
+use super::view::ViewSlot;
+use super::{DEPTH_FORMAT, HDR_FORMAT};
+use crate::gpu::layout;
+use crate::scene::{Material, ProceduralHeight};
+use crate::settings::{BumpView, RenderSettings, ShadowFilter, ShadowMethod, ShadowView, TangentSource, TextureFilter};
+use crate::shaders;
+
+/// The frame's toggles that switch shader code on or off (the `override`s of
+/// `shaders/scene.wgsl`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct FrameKey {
+    pub shadow_method: u32,
+    pub shadow_filter: u32,
+    pub shadow_transmission: bool,
+    pub shadow_texels_view: bool,
+    pub level_colour: bool,
+    pub bump: bool,
+    pub bump_view: u32,
+    pub tangents_per_vertex: bool,
+    pub bump_analytic: bool,
+    pub flat_colour: bool,
+}
+
+/// `SHADOW_METHOD`: no shadows at all (no light casts one, or shadows are off).
+pub const SHADOWS_OFF: u32 = 0;
+pub const SHADOWS_MAP: u32 = 1;
+pub const SHADOWS_PROJECTED: u32 = 2;
+
+impl FrameKey {
+    /// `shadowed`: some light casts a shadow this frame; `transmission`: transparent occluders
+    /// were drawn into the transmission maps.
+    pub fn new(settings: &RenderSettings, shadowed: bool, transmission: bool) -> FrameKey {
+        let shadows = &settings.shadows;
+        FrameKey {
+            shadow_method: match (shadowed && shadows.enabled, shadows.method) {
+                (false, _) => SHADOWS_OFF,
+                (true, ShadowMethod::Map) => SHADOWS_MAP,
+                (true, ShadowMethod::Projected) => SHADOWS_PROJECTED,
+            },
+            shadow_filter: shadow_filter_code(shadows.filter),
+            shadow_transmission: transmission,
+            shadow_texels_view: shadows.view == ShadowView::Texels,
+            level_colour: settings.textures.filter == TextureFilter::LevelColour,
+            bump: settings.bump.enabled,
+            bump_view: match settings.bump.view {
+                BumpView::Off => 0,
+                BumpView::Normals => BUMP_VIEW_NORMALS,
+                BumpView::Tangents => BUMP_VIEW_TANGENTS,
+            },
+            tangents_per_vertex: settings.bump.tangents == TangentSource::PerVertex,
+            bump_analytic: settings.bump.analytic,
+            flat_colour: settings.raster.flat_colour,
+        }
+    }
+}
+
+/// The `SHADOW_FILTER_*` code of `shaders/common/shadow.wgsl`.
+pub fn shadow_filter_code(filter: ShadowFilter) -> u32 {
+    match filter {
+        ShadowFilter::None => 0,
+        ShadowFilter::Hardware => 1,
+        ShadowFilter::Pcf3x3 => 2,
+        ShadowFilter::Pcf5x5 => 3,
+        ShadowFilter::Poisson => 4,
+    }
+}
+
+/// Every `ShadowFilter` and its code, for the test that ties them to the WGSL.
+pub const SHADOW_FILTER_NAMES: [(&str, ShadowFilter); 5] = [
+    ("SHADOW_FILTER_NONE", ShadowFilter::None),
+    ("SHADOW_FILTER_HARDWARE", ShadowFilter::Hardware),
+    ("SHADOW_FILTER_PCF3", ShadowFilter::Pcf3x3),
+    ("SHADOW_FILTER_PCF5", ShadowFilter::Pcf5x5),
+    ("SHADOW_FILTER_POISSON", ShadowFilter::Poisson),
+];
+
+/// What a material brings to the shader: which textures and which height field.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct MaterialKey {
+    pub color_texture: bool,
+    /// `HEIGHT_*` of `shaders/scene.wgsl`: 0 none, 1 a height map, 2 a sine field, 3 value noise.
+    pub height_kind: u32,
+    pub normal_map: bool,
+}
+
+impl MaterialKey {
+    pub fn of(material: &Material) -> MaterialKey {
+        MaterialKey {
+            color_texture: material.texture.is_some(),
+            height_kind: match (&material.height_field, &material.height_map) {
+                (Some(ProceduralHeight::Sine { .. }), _) => HEIGHT_SINE,
+                (Some(ProceduralHeight::Noise { .. }), _) => HEIGHT_NOISE,
+                (None, Some(_)) => HEIGHT_TEXTURE,
+                (None, None) => HEIGHT_NONE,
+            },
+            normal_map: material.normal_map.is_some(),
+        }
+    }
+}
+
+/// `BUMP_VIEW_*` codes.
+pub const BUMP_VIEW_NORMALS: u32 = 1;
+pub const BUMP_VIEW_TANGENTS: u32 = 2;
+/// `HEIGHT_*` codes: where a material's bump heights come from.
+pub const HEIGHT_NONE: u32 = 0;
+pub const HEIGHT_TEXTURE: u32 = 1;
+pub const HEIGHT_SINE: u32 = 2;
+pub const HEIGHT_NOISE: u32 = 3;
+
+/// The names of the pipeline constants, in the order [`constants`] gives their values.
+pub const CONSTANT_NAMES: [&str; 13] = [
+    "SHADOW_METHOD",
+    "SHADOW_FILTER",
+    "SHADOW_TRANSMISSION",
+    "SHADOW_TEXELS_VIEW",
+    "LEVEL_COLOUR",
+    "BUMP",
+    "BUMP_VIEW",
+    "TANGENTS_PER_VERTEX",
+    "BUMP_ANALYTIC",
+    "FLAT_COLOUR",
+    "COLOR_TEXTURE",
+    "HEIGHT_KIND",
+    "NORMAL_MAP",
+];
+
+/// The pipeline constants of one variant.
+fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f64); 13] {
+    let flag = |b: bool| f64::from(u8::from(b));
+    let values = [
+        f64::from(frame.shadow_method),
+        f64::from(frame.shadow_filter),
+        flag(frame.shadow_transmission),
+        flag(frame.shadow_texels_view),
+        flag(frame.level_colour),
+        flag(frame.bump),
+        f64::from(frame.bump_view),
+        flag(frame.tangents_per_vertex),
+        flag(frame.bump_analytic),
+        flag(frame.flat_colour),
+        flag(material.color_texture),
+        f64::from(material.height_kind),
+        flag(material.normal_map),
+    ];
+    std::array::from_fn(|i| (CONSTANT_NAMES[i], values[i]))
+}
+
+/// The depth test of a shading variant.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum DepthMode {
+    /// The plain z-buffer: `Less`, depth written.
+    Write,
+    /// After a prepass: only the fragments at the prepass's depth, nothing written.
+    Equal,
+}
+
+pub struct ScenePass {
+    module: wgpu::ShaderModule,
+    layout: wgpu::PipelineLayout,
+    prepass: wgpu::RenderPipeline,
+    shading: HashMap<(DepthMode, FrameKey, MaterialKey), wgpu::RenderPipeline>,
+}
+
+/// What the pass draws into.
+pub struct SceneTargets<'a> {
+    pub hdr: &'a wgpu::TextureView,
+    pub depth: &'a wgpu::TextureView,
+    /// Linear radiance where nothing is drawn.
+    pub background: glam::Vec3,
+}
+
+/// The vertex buffers of every scene pipeline: the mesh's vertices, and the instances.
+pub const VERTEX_BUFFERS: [Option<wgpu::VertexBufferLayout<'static>>; 2] =
+    [Some(Vertex::LAYOUT), Some(GpuInstance::LAYOUT)];
+
+impl ScenePass {
+    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts) -> ScenePass {
+        let module = shaders::module(device, "scene::shader", shaders::SCENE);
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("scene::layout"),
+            bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.material), Some(&layouts.lighting)],
+            immediate_size: 0,
+        });
+        let prepass = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("scene::prepass_pipeline"),
+            layout: Some(&layout),
+            vertex: vertex_state(&module),
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less, true),
+            multisample: Default::default(),
+            fragment: None,
+            multiview_mask: None,
+            cache: None,
+        });
+        ScenePass { module, layout, prepass, shading: HashMap::new() }
+    }
+
+    /// Compiles the shading variants this frame needs that were not compiled before.
+    pub fn prepare(&mut self, device: &wgpu::Device, frame: FrameKey, materials: &[MaterialKey], after_prepass: bool) {
+        let depth = if after_prepass { DepthMode::Equal } else { DepthMode::Write };
+        for material in materials {
+            let key = (depth, frame, *material);
+            if !self.shading.contains_key(&key) {
+                let pipeline = self.shading_pipeline(device, depth, &frame, material);
+                self.shading.insert(key, pipeline);
+            }
+        }
+    }
+
+    fn shading_pipeline(
+        &self,
+        device: &wgpu::Device,
+        depth: DepthMode,
+        frame: &FrameKey,
+        material: &MaterialKey,
+    ) -> wgpu::RenderPipeline {
+        let constants = constants(frame, material);
+        let depth_state = match depth {
+            DepthMode::Write => layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less, true),
+            DepthMode::Equal => layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Equal, false),
+        };
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("scene::shading_pipeline"),
+            layout: Some(&self.layout),
+            vertex: vertex_state(&self.module),
+            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+            depth_stencil: depth_state,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &self.module,
+                entry_point: Some("fs_scene"),
+                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+                targets: &[Some(HDR_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    }
+
+    /// The number of shading variants compiled so far.
+    pub fn variant_count(&self) -> usize {
+        self.shading.len()
+    }
+
+    /// The depth of the nearest surface at every pixel of `view`, and nothing else.
+    pub fn record_prepass(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &SceneGpu,
+        lighting: &wgpu::BindGroup,
+        view: ViewSlot,
+        depth: &wgpu::TextureView,
+    ) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("scene::prepass"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(depth_attachment(depth, wgpu::LoadOp::Clear(1.0))),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.push_debug_group("depth prepass");
+        pass.set_pipeline(&self.prepass);
+        pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view)]);
+        pass.set_bind_group(2, lighting, &[]);
+        for batch in &scene.geometry.batches {
+            pass.set_bind_group(1, &scene.materials()[batch.material], &[]);
+            scene.geometry.draw(&mut pass, batch);
+        }
+        pass.pop_debug_group();
+    }
+
+    /// Shades every surface seen from `view` (transparent ones too, as opaque surfaces with
+    /// their illumination model, until the transparency technique draws them); `frame` must have been prepared, and
+    /// `after_prepass` must match that preparation.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_opaque(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &SceneGpu,
+        lighting: &wgpu::BindGroup,
+        view: ViewSlot,
+        frame: FrameKey,
+        targets: &SceneTargets,
+        after_prepass: bool,
+    ) {
+        let bg = targets.background.as_dvec3();
+        let (depth_mode, depth_load) = if after_prepass {
+            (DepthMode::Equal, wgpu::LoadOp::Load)
+        } else {
+            (DepthMode::Write, wgpu::LoadOp::Clear(1.0))
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("scene::opaque"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: targets.hdr,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color { r: bg.x, g: bg.y, b: bg.z, a: 1.0 }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(depth_attachment(targets.depth, depth_load)),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.push_debug_group("opaque");
+        pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view)]);
+        pass.set_bind_group(2, lighting, &[]);
+        // Batches come sorted by material: the pipeline changes only where the variant does.
+        let mut current = None;
+        for batch in &scene.geometry.batches {
+            let key = scene.material_keys[batch.material];
+            if current != Some(key) {
+                pass.set_pipeline(&self.shading[&(depth_mode, frame, key)]);
+                current = Some(key);
+            }
+            pass.set_bind_group(1, &scene.materials()[batch.material], &[]);
+            scene.geometry.draw(&mut pass, batch);
+        }
+        pass.pop_debug_group();
+    }
+}
+
+fn depth_attachment(view: &wgpu::TextureView, load: wgpu::LoadOp<f32>) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations { load, store: wgpu::StoreOp::Store }),
+        stencil_ops: None,
+    }
+}
+
+/// The vertex stage every scene pipeline shares (`vs_scene`).
+pub fn vertex_state(module: &wgpu::ShaderModule) -> wgpu::VertexState<'_> {
+    wgpu::VertexState {
+        module,
+        entry_point: Some("vs_scene"),
+        compilation_options: Default::default(),
+        buffers: &VERTEX_BUFFERS,
+    }
+}

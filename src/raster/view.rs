@@ -1,0 +1,124 @@
+//! Views: a camera as one pass sees it. One frame draws the scene from several cameras (the main
+//! camera, each light's view for pass 1 of the shadow maps, and, as their techniques land,
+//! mirrored cameras and the six faces of environment cubes), so each view has its own slot in one
+//! uniform buffer, chosen per pass by a dynamic offset of group 0.
+//!
+//! Slots are written with `queue.write_buffer` before the frame's commands are submitted: every
+//! pass of the frame reads its own slot, so no write can overtake another within the frame.
+
+use glam::{Mat4, Vec3, Vec4};
+
+use super::uniforms::GpuView;
+use crate::scene::{Camera, Projection};
+
+/// A camera for one pass: where it looks from and how it projects.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    pub clip_from_world: Mat4,
+    pub eye: Vec3,
+    /// Every view ray runs along `-view_axis` (orthographic cameras).
+    pub orthographic: bool,
+    /// `ze` of the eye frame: from the scene towards the eye.
+    pub view_axis: Vec3,
+    /// The view is mirrored, so its triangles' winding flips.
+    pub mirrored: bool,
+    /// Points `p` with `plane·(p, 1) < 0` are not drawn.
+    pub clip_plane: Option<Vec4>,
+}
+
+impl View {
+    /// The scene camera's view.
+    pub fn of_camera(camera: &Camera) -> View {
+        View {
+            clip_from_world: camera.clip_from_world(),
+            eye: camera.eye,
+            orthographic: camera.projection == Projection::Orthographic,
+            view_axis: camera.frame().ze,
+            mirrored: false,
+            clip_plane: None,
+        }
+    }
+
+    /// A view that only projects (a light's view for pass 1 of the shadow maps, which shades
+    /// nothing and so needs no eye).
+    pub fn projection_only(clip_from_world: Mat4) -> View {
+        View {
+            clip_from_world,
+            eye: Vec3::ZERO,
+            orthographic: false,
+            view_axis: Vec3::Z,
+            mirrored: false,
+            clip_plane: None,
+        }
+    }
+
+    pub fn to_gpu(&self) -> GpuView {
+        GpuView {
+            clip_from_world: self.clip_from_world.to_cols_array_2d(),
+            eye: self.eye.to_array(),
+            orthographic: u32::from(self.orthographic),
+            view_axis: self.view_axis.to_array(),
+            mirrored: u32::from(self.mirrored),
+            clip_plane: self.clip_plane.unwrap_or(Vec4::ZERO).to_array(),
+        }
+    }
+}
+
+/// Where each view of a frame lives in the view buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViewSlot {
+    /// The scene camera.
+    Main,
+    /// Layer `n` of the shadow maps.
+    ShadowLayer(u32),
+}
+
+impl ViewSlot {
+    fn index(self) -> u64 {
+        match self {
+            ViewSlot::Main => 0,
+            ViewSlot::ShadowLayer(layer) => 1 + u64::from(layer),
+        }
+    }
+}
+
+/// Slots for every view a frame can hold.
+pub const VIEW_SLOTS: u64 = 1 + super::shadow::views::MAX_LAYERS as u64;
+
+/// One uniform buffer holding every view of the frame, a slot each.
+pub struct ViewBuffer {
+    pub buffer: wgpu::Buffer,
+    stride: u64,
+}
+
+impl ViewBuffer {
+    pub fn new(device: &wgpu::Device) -> ViewBuffer {
+        let alignment = u64::from(device.limits().min_uniform_buffer_offset_alignment);
+        let stride = (std::mem::size_of::<GpuView>() as u64).next_multiple_of(alignment);
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("view::buffer"),
+            size: stride * VIEW_SLOTS,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ViewBuffer { buffer, stride }
+    }
+
+    pub fn write(&self, queue: &wgpu::Queue, slot: ViewSlot, view: &View) {
+        queue.write_buffer(&self.buffer, slot.index() * self.stride, bytemuck::bytes_of(&view.to_gpu()));
+    }
+
+    /// The dynamic offset that selects `slot` in group 0.
+    pub fn offset(&self, slot: ViewSlot) -> u32 {
+        (slot.index() * self.stride) as u32
+    }
+
+    /// The binding of one slot (a dynamic-offset uniform of one view's size).
+    pub fn binding(&self) -> wgpu::BindingResource<'_> {
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.buffer,
+            offset: 0,
+            size: wgpu::BufferSize::new(std::mem::size_of::<GpuView>() as u64),
+        })
+    }
+}
