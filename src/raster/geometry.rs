@@ -110,11 +110,15 @@ pub fn segments_for_pixels(pixels: f32, max: u32) -> u32 {
     SEGMENT_LEVELS.iter().copied().find(|&n| n as f32 >= needed).unwrap_or(u32::MAX).min(max)
 }
 
-/// The world-space bounding sphere of an object's shape, from its local bounds.
+/// The world-space bounding sphere of an object's shape: exact for a sphere, around its local box
+/// for other shapes.
 fn bounding_sphere(object: &Object, local: (Vec3, Vec3)) -> (Vec3, f32) {
-    let center = object.world_from_local.transform_point3((local.0 + local.1) / 2.0);
     let scale = object.world_from_local.to_scale_rotation_translation().0.max_element();
-    (center, (local.1 - local.0).length() / 2.0 * scale)
+    let (center, radius) = match object.shape {
+        Shape::Sphere { center, radius } => (center, radius),
+        _ => ((local.0 + local.1) / 2.0, (local.1 - local.0).length() / 2.0),
+    };
+    (object.world_from_local.transform_point3(center), radius * scale)
 }
 
 /// A mesh on the GPU.

@@ -30,7 +30,7 @@ use crate::gpu::mipmap::MipmapGenerator;
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::{Gpu, readback};
 use crate::scene::Scene;
-use crate::settings::{RenderSettings, ShadowMethod};
+use crate::settings::{Prepass, RenderSettings, ShadowMethod};
 use overlays::Overlays;
 use present::{PresentInput, PresentPass};
 use scene_gpu::{SceneGpu, SceneLayouts};
@@ -209,7 +209,12 @@ impl Renderer {
         scene_gpu.update_frame(queue, scene, &layout.first_layer, settings);
 
         let projected = shadows.enabled && shadows.method == ShadowMethod::Projected;
-        let prepass = settings.raster.depth_prepass || projected;
+        let prepass = projected
+            || match settings.raster.depth_prepass {
+                Prepass::Always => true,
+                Prepass::Never => false,
+                Prepass::Auto => scene_gpu.geometry.triangles() * 4 < u64::from(size.0) * u64::from(size.1),
+            };
         let transmission = shadows.transmission && scene_gpu.geometry.has_transparent();
         let frame_key = FrameKey::new(settings, !layout.views.is_empty(), transmission);
         self.scene.prepare(device, frame_key, &scene_gpu.material_keys, prepass);

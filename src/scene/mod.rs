@@ -12,6 +12,7 @@ pub mod light;
 pub mod material;
 pub mod mesh;
 pub mod shading;
+pub mod sphereflake;
 pub mod texture;
 
 use std::path::{Path, PathBuf};
