@@ -167,7 +167,8 @@ impl Headless {
     pub fn render(&mut self, gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> image::RgbaImage {
         self.renderer.render(gpu, scene, &mut self.scene_gpu, settings, &self.targets, &self.output.view);
         let (width, height) = self.targets.size;
-        let pixels = readback::read_rgba8(&gpu.device, &gpu.queue, &self.output.texture);
+        let pixels =
+            readback::read_rgba8(&gpu.device, &gpu.queue, &self.output.texture).expect("reading the frame back");
         image::RgbaImage::from_raw(width, height, pixels).expect("readback returns width × height RGBA8 pixels")
     }
 }
