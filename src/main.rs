@@ -204,29 +204,34 @@ fn render(args: SceneArgs, output_path: &Path) -> anyhow::Result<()> {
 }
 
 /// The rasterizer's image of `scene` with its settings; returns it and the adapter's name.
+/// The size is checked against the device's limits before anything is created, and every GPU
+/// error after that (validation, out of memory) comes back as an error, not a panic.
 fn rasterize(scene: &Scene, clock: &mut Stopwatch, timed_frames: bool) -> anyhow::Result<(image::RgbaImage, String)> {
     let gpu = clock.time("device", Gpu::headless)?;
-    let mut renderer = clock.time("pipelines", || Renderer::new(&gpu.device, OUTPUT_FORMAT));
     let size = (scene.camera.width, scene.camera.height);
-    let (mut scene_gpu, targets, output) = clock.time("upload", || {
-        let scene_gpu = renderer.upload(&gpu, scene);
-        let targets = renderer.targets(&gpu.device, size);
-        let output = GpuTexture::target(&gpu.device, "cli::output", size, OUTPUT_FORMAT);
-        gpu.wait();
-        (scene_gpu, targets, output)
-    });
-    // The first frame also pays for the driver's lazy pipeline compilation; the second is what
-    // an interactive frame costs. `--stats` reports both.
-    for lap in ["first frame", "frame"] {
-        clock.time(lap, || {
-            renderer.render(&gpu, scene, &mut scene_gpu, &scene.settings, &targets, &output.view);
+    gpu.check_image_size(size)?;
+    let pixels = gpu.checked(|| {
+        let mut renderer = clock.time("pipelines", || Renderer::new(&gpu.device, OUTPUT_FORMAT));
+        let (mut scene_gpu, targets, output) = clock.time("upload", || {
+            let scene_gpu = renderer.upload(&gpu, scene);
+            let targets = renderer.targets(&gpu.device, size);
+            let output = GpuTexture::target(&gpu.device, "cli::output", size, OUTPUT_FORMAT);
             gpu.wait();
+            (scene_gpu, targets, output)
         });
-        if !timed_frames {
-            break;
+        // The first frame also pays for the driver's lazy pipeline compilation; the second is
+        // what an interactive frame costs. `--stats` reports both.
+        for lap in ["first frame", "frame"] {
+            clock.time(lap, || {
+                renderer.render(&gpu, scene, &mut scene_gpu, &scene.settings, &targets, &output.view);
+                gpu.wait();
+            });
+            if !timed_frames {
+                break;
+            }
         }
-    }
-    let pixels = clock.time("readback", || readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture));
+        clock.time("readback", || readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture))
+    })??;
     let image = image::RgbaImage::from_raw(size.0, size.1, pixels).expect("readback returns one RGBA8 texel per pixel");
     Ok((image, gpu.describe()))
 }
