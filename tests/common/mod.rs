@@ -74,13 +74,14 @@ impl GoldenError {
     }
 
     /// What exceeds `tolerance`, one message each; empty when the render is within it. A NaN
-    /// statistic exceeds every tolerance (`NaN > t` is false, so the test is `!(x <= t)`).
+    /// statistic exceeds every tolerance, though `NaN > t` is false.
     pub fn excesses(&self, tolerance: Tolerance) -> Vec<String> {
+        let exceeds = |value: f32, limit: f32| value.is_nan() || value > limit;
         let mut excesses = Vec::new();
-        if !(self.flip_mean <= tolerance.flip_mean) {
+        if exceeds(self.flip_mean, tolerance.flip_mean) {
             excesses.push(format!("mean FLIP {:.5} > {}", self.flip_mean, tolerance.flip_mean));
         }
-        if !(self.worst_region <= tolerance.worst_region) {
+        if exceeds(self.worst_region, tolerance.worst_region) {
             excesses.push(format!(
                 "mean FLIP of the worst {REGION}×{REGION} region {:.5} > {}",
                 self.worst_region, tolerance.worst_region
