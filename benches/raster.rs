@@ -1,9 +1,12 @@
-//! Rasterizer benchmark: what shadows cost. Run with `cargo bench --bench raster`.
+//! Rasterizer benchmark: where a frame's time goes, and how the frame scales with the scene. Run
+//! with `cargo bench --bench raster` (`-- --quick` skips the largest scenes).
 //!
-//! 1. Frame time of the showcase at 1280×720 with 1, 2 and 4 shadowed lights, each against the
-//!    same lights with shadows off, measured in the same run: the ratio is the shadows' cost.
-//! 2. The cost of bump mapping: the showcase and the bump scene with it off and on.
-//! 3. Pass 1 alone (one spot light's depth map) at 1024² and 4096².
+//! 1. The showcase at 1280×720: the flat-colour floor (every surface in its material's colour, the
+//!    least this GPU can do with that geometry), everything off, each technique alone, all on, and
+//!    a camera-only change with the shadow maps kept; each as a ratio to the floor.
+//! 2. What shadows cost for 1, 2 and 4 shadowed lights, and pass 1 alone at two map sizes.
+//! 3. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
+//!    about a million triangles: upload, frame, triangles, beside `trace` of the same scene.
 //!
 //! Times are wall-clock from submit to the queue being idle (the median of several frames after
 //! warm-up), so they include the driver's work on the CPU: on lavapipe that is all of it.
@@ -13,9 +16,11 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use mirador::gpu::Gpu;
 use mirador::gpu::texture::GpuTexture;
-use mirador::raster::shadow::views::shadow_layout;
-use mirador::raster::{OUTPUT_FORMAT, Renderer};
-use mirador::scene::{Attenuation, Light, LightKind};
+use mirador::raster::{FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer, drawn_size};
+use mirador::scene::sphereflake::{sphere_count, sphereflake_toml};
+use mirador::scene::{Attenuation, Light, LightKind, Mesh, Object, Shape};
+use mirador::settings::{Prepass, ShadowFit};
+use mirador::trace::{RenderControl, Tracer};
 use mirador::{RenderSettings, Scene};
 
 const FRAMES: usize = 7;
@@ -23,6 +28,127 @@ const FRAMES: usize = 7;
 fn median(mut times: Vec<Duration>) -> Duration {
     times.sort();
     times[times.len() / 2]
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+/// A renderer with `scene` uploaded, ready to draw frames.
+struct Bench<'g> {
+    gpu: &'g Gpu,
+    renderer: Renderer,
+    scene_gpu: mirador::raster::scene_gpu::SceneGpu,
+    targets: FrameTargets,
+    output: GpuTexture,
+    upload: Duration,
+}
+
+impl<'g> Bench<'g> {
+    fn new(gpu: &'g Gpu, scene: &Scene) -> Bench<'g> {
+        let renderer = Renderer::new(&gpu.device, OUTPUT_FORMAT);
+        let start = Instant::now();
+        let scene_gpu = renderer.upload(gpu, scene);
+        gpu.wait();
+        let upload = start.elapsed();
+        let size = (scene.camera.width, scene.camera.height);
+        let targets = renderer.targets(&gpu.device, drawn_size(size, scene.settings.raster.render_scale));
+        let output = GpuTexture::target(&gpu.device, "bench::output", size, OUTPUT_FORMAT);
+        Bench { gpu, renderer, scene_gpu, targets, output, upload }
+    }
+
+    fn frame(&mut self, scene: &Scene, settings: &RenderSettings) -> (Duration, FrameReport) {
+        let start = Instant::now();
+        let report =
+            self.renderer.render(self.gpu, scene, &mut self.scene_gpu, settings, &mut self.targets, &self.output.view);
+        self.gpu.wait();
+        (start.elapsed(), report)
+    }
+
+    /// The median frame time after two warm-up frames (which compile the shader variants and
+    /// fill the caches).
+    fn median_frame(&mut self, scene: &Scene, settings: &RenderSettings) -> Duration {
+        let times = (0..FRAMES + 2).map(|_| self.frame(scene, settings).0).skip(2).collect();
+        median(times)
+    }
+}
+
+fn frame_time(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> Duration {
+    Bench::new(gpu, scene).median_frame(scene, settings)
+}
+
+/// The showcase with every technique switched off: no shadows, no bumps, no mip filtering.
+fn everything_off(base: &RenderSettings) -> RenderSettings {
+    let mut s = base.clone();
+    s.shadows.enabled = false;
+    s.bump.enabled = false;
+    s.textures.filter = mirador::settings::TextureFilter::Bilinear;
+    s
+}
+
+fn showcase_breakdown(gpu: &Gpu) {
+    let scene = Scene::showcase().expect("the built-in showcase loads");
+    let all = scene.settings.clone();
+    let off = everything_off(&all);
+    let mut flat = all.clone();
+    flat.raster.flat_colour = true;
+    let floor = frame_time(gpu, &scene, &flat);
+    println!("showcase, 1280×720, median of {FRAMES} frames, ratios to the flat-colour floor");
+    let row = |name: &str, t: Duration| {
+        println!("{name:>44} {:>9.1} ms {:>7.2}×", ms(t), t.as_secs_f64() / floor.as_secs_f64())
+    };
+    row("flat colour (the floor)", floor);
+    row("everything off (illumination model only)", frame_time(gpu, &scene, &off));
+    let mut alone = off.clone();
+    alone.textures.filter = all.textures.filter;
+    row("+ trilinear mipmaps alone", frame_time(gpu, &scene, &alone));
+    let mut alone = off.clone();
+    alone.bump.enabled = true;
+    row("+ bump mapping alone", frame_time(gpu, &scene, &alone));
+    let mut alone = off.clone();
+    alone.shadows.enabled = true;
+    row("+ shadow maps alone (kept across frames)", frame_time(gpu, &scene, &alone));
+    row("all on (kept shadow maps)", frame_time(gpu, &scene, &all));
+    let mut no_cache = all.clone();
+    no_cache.shadows.cache = false;
+    row("all on, shadow maps redrawn every frame", frame_time(gpu, &scene, &no_cache));
+    let mut never = all.clone();
+    never.raster.depth_prepass = Prepass::Never;
+    row("all on, no depth prepass", frame_time(gpu, &scene, &never));
+    let mut half = all.clone();
+    half.raster.render_scale = 0.5;
+    row("all on, render scale 0.5", frame_time(gpu, &scene, &half));
+
+    // A camera-only change: the point light's six layers are kept; the directional light's one
+    // layer follows the view frustum (fit = "view") and is redrawn, unless it is fitted to the
+    // scene.
+    for fit in [ShadowFit::View, ShadowFit::Scene] {
+        let mut settings = all.clone();
+        settings.shadows.fit = fit;
+        let mut bench = Bench::new(gpu, &scene);
+        let mut moving = scene.clone();
+        bench.median_frame(&moving, &settings);
+        let mut times = Vec::new();
+        let mut redrawn = 0;
+        for step in 0..FRAMES {
+            let angle = 0.01 * (step + 1) as f32;
+            moving.camera.eye = glam::Quat::from_rotation_y(angle) * scene.camera.eye;
+            let (t, report) = bench.frame(&moving, &settings);
+            times.push(t);
+            redrawn += report.shadow_layers_drawn;
+        }
+        let t = median(times);
+        row(&format!("all on, camera orbiting, fit {fit:?} ({redrawn} layers redrawn)"), t);
+    }
+
+    let traced = trace_time(&scene);
+    let raster = frame_time(gpu, &scene, &all);
+    println!(
+        "{:>44} {:>9.1} ms   raster is {:.2}× faster",
+        "trace (1 ray per pixel centre, 2 threads)",
+        ms(traced),
+        traced.as_secs_f64() / raster.as_secs_f64()
+    );
 }
 
 fn spot(name: &str, position: Vec3) -> Light {
@@ -40,101 +166,99 @@ fn spot(name: &str, position: Vec3) -> Light {
     }
 }
 
-/// The median frame time of `scene` with `settings`.
-fn frame_time(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> Duration {
-    let mut renderer = Renderer::new(&gpu.device, OUTPUT_FORMAT);
-    let mut scene_gpu = renderer.upload(gpu, scene);
-    let size = (scene.camera.width, scene.camera.height);
-    let targets = renderer.targets(&gpu.device, size);
-    let output = GpuTexture::target(&gpu.device, "bench::output", size, OUTPUT_FORMAT);
-    let mut times = Vec::new();
-    for frame in 0..FRAMES + 2 {
-        let start = Instant::now();
-        renderer.render(gpu, scene, &mut scene_gpu, settings, &targets, &output.view);
-        gpu.wait();
-        if frame >= 2 {
-            times.push(start.elapsed());
-        }
-    }
-    median(times)
-}
-
-/// The median time of pass 1 alone for `scene`'s lights.
-fn shadow_pass_time(gpu: &Gpu, scene: &Scene, settings: &RenderSettings) -> Duration {
-    let mut renderer = Renderer::new(&gpu.device, OUTPUT_FORMAT);
-    let scene_gpu = renderer.upload(gpu, scene);
-    let layout = shadow_layout(scene, &settings.shadows);
-    renderer.shadow.prepare(&gpu.device, &gpu.queue, &layout, &settings.shadows, scene_gpu.has_transparent());
-    let mut times = Vec::new();
-    for frame in 0..FRAMES + 2 {
-        let start = Instant::now();
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        renderer.shadow.record(&mut encoder, &scene_gpu, &layout);
-        gpu.queue.submit([encoder.finish()]);
-        gpu.wait();
-        if frame >= 2 {
-            times.push(start.elapsed());
-        }
-    }
-    median(times)
-}
-
-fn ms(d: Duration) -> f64 {
-    d.as_secs_f64() * 1e3
-}
-
-fn main() {
-    let gpu = Gpu::headless().expect("the benchmark needs a graphics adapter");
-    println!("adapter: {}", gpu.describe());
+fn shadow_costs(gpu: &Gpu) {
     let showcase = Scene::showcase().expect("the built-in showcase loads");
     let extra = [spot("spot A", Vec3::new(-3.0, 4.0, 4.0)), spot("spot B", Vec3::new(3.0, 3.5, -3.0))];
-    // The showcase's point light (six map layers) and directional light (one), then two spots.
     let all: Vec<Light> = showcase.lights.iter().cloned().chain(extra).collect();
-
-    println!("\nshowcase, 1280×720, median of {FRAMES} frames");
-    println!("{:>8} {:>7} {:>14} {:>13} {:>7}", "lights", "layers", "shadows off", "shadows on", "ratio");
+    println!("\nshadows at 1280×720, median of {FRAMES} frames (kept maps; redrawn maps in the last column)");
+    println!("{:>8} {:>14} {:>13} {:>7} {:>15}", "lights", "shadows off", "shadows on", "ratio", "maps redrawn");
     for count in [1, 2, 4] {
         let mut scene = showcase.clone();
         scene.lights = all[..count].to_vec();
         let on = scene.settings.clone();
         let mut off = on.clone();
         off.shadows.enabled = false;
-        let layers = shadow_layout(&scene, &on.shadows).views.len();
-        let (t_off, t_on) = (frame_time(&gpu, &scene, &off), frame_time(&gpu, &scene, &on));
+        let mut redrawn = on.clone();
+        redrawn.shadows.cache = false;
+        let (t_off, t_on, t_redrawn) =
+            (frame_time(gpu, &scene, &off), frame_time(gpu, &scene, &on), frame_time(gpu, &scene, &redrawn));
         println!(
-            "{count:>8} {layers:>7} {:>11.1} ms {:>10.1} ms {:>6.2}×",
+            "{count:>8} {:>11.1} ms {:>10.1} ms {:>6.2}× {:>12.1} ms",
             ms(t_off),
             ms(t_on),
-            t_on.as_secs_f64() / t_off.as_secs_f64()
+            t_on.as_secs_f64() / t_off.as_secs_f64(),
+            ms(t_redrawn)
         );
     }
+}
 
-    println!("\nbump mapping at 1280×720, median of {FRAMES} frames");
-    for name in ["showcase.toml", "bumps.toml"] {
-        let mut scene = Scene::load(&mirador::scene::builtin_path(name)).expect("a built-in scene loads");
-        (scene.camera.width, scene.camera.height) = (1280, 720);
-        let on = scene.settings.clone();
-        let mut off = on.clone();
-        off.bump.enabled = false;
-        let (t_off, t_on) = (frame_time(&gpu, &scene, &off), frame_time(&gpu, &scene, &on));
+fn trace_time(scene: &Scene) -> Duration {
+    let start = Instant::now();
+    let tracer = Tracer::new(scene, &scene.settings);
+    tracer.render(&RenderControl::default()).expect("nothing cancels the benchmark");
+    start.elapsed()
+}
+
+/// A sphere displaced into a bumpy mesh of about `triangles` triangles, as a scene's only mesh.
+fn million_triangle_scene() -> Scene {
+    let mut scene = Scene::showcase().expect("the built-in showcase loads");
+    let mut mesh = Mesh::sphere(Vec3::ZERO, 1.0, 1024);
+    for (p, n) in mesh.positions.iter_mut().zip(&mesh.normals) {
+        let bump = 0.03 * ((13.0 * p.x).sin() * (11.0 * p.y).sin() * (7.0 * p.z).cos());
+        *p += *n * bump;
+    }
+    mesh.compute_normals();
+    scene.meshes.push(mesh);
+    let material = scene.objects.iter().find(|o| o.name == "shiny sphere").expect("the showcase has it").material;
+    scene.objects.retain(|o| o.name == "floor");
+    scene.objects.push(Object {
+        name: "bumpy mesh".into(),
+        shape: Shape::Mesh(scene.meshes.len() - 1),
+        material,
+        world_from_local: glam::Mat4::from_translation(Vec3::new(0.0, 1.0, 0.0)),
+    });
+    scene
+}
+
+fn growing_scenes(gpu: &Gpu, quick: bool) {
+    println!("\nscenes that grow, 1280×720, all techniques on, median of {FRAMES} frames (kept shadow maps)");
+    println!(
+        "{:>22} {:>9} {:>11} {:>10} {:>11} {:>11} {:>10}",
+        "scene", "objects", "triangles", "upload", "frame", "trace", "trace/raster"
+    );
+    let mut scenes: Vec<(String, Scene)> = Vec::new();
+    for size in if quick { 2..=3 } else { 2..=4 } {
+        let path = std::path::PathBuf::from(format!("sphereflake-{size}.toml"));
+        let scene =
+            mirador::scene::file::parse(&sphereflake_toml(size, 1280, 720), &path).expect("a sphereflake parses");
+        assert_eq!(scene.objects.len() as u64, sphere_count(size) + 1);
+        scenes.push((format!("sphereflake {size}"), scene));
+    }
+    if !quick {
+        scenes.push(("1M-triangle mesh".into(), million_triangle_scene()));
+    }
+    for (name, scene) in &scenes {
+        let mut bench = Bench::new(gpu, scene);
+        let frame = bench.median_frame(scene, &scene.settings);
+        let (_, report) = bench.frame(scene, &scene.settings);
+        let traced = trace_time(scene);
         println!(
-            "{name:>14}: off {:>7.1} ms, on {:>7.1} ms, {:.2}×",
-            ms(t_off),
-            ms(t_on),
-            t_on.as_secs_f64() / t_off.as_secs_f64()
+            "{name:>22} {:>9} {:>11} {:>7.1} ms {:>8.1} ms {:>8.1} ms {:>9.2}×",
+            scene.objects.len(),
+            report.triangles,
+            ms(bench.upload),
+            ms(frame),
+            ms(traced),
+            traced.as_secs_f64() / frame.as_secs_f64()
         );
     }
+}
 
-    println!("\npass 1 for one spot light (one layer), showcase geometry, median of {FRAMES}");
-    let mut scene = showcase.clone();
-    scene.lights = vec![spot("spot", Vec3::new(-3.0, 4.0, 4.0))];
-    let mut base = None;
-    for size in [1024, 4096] {
-        let mut settings = scene.settings.clone();
-        settings.shadows.map_size = size;
-        let t = shadow_pass_time(&gpu, &scene, &settings);
-        let ratio = base.map_or(1.0, |b: Duration| t.as_secs_f64() / b.as_secs_f64());
-        base.get_or_insert(t);
-        println!("{:>6}²: {:>8.2} ms  ({ratio:.2}× the 1024² pass)", size, ms(t));
-    }
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let gpu = Gpu::headless().expect("the benchmark needs a graphics adapter");
+    println!("adapter: {}\n", gpu.describe());
+    showcase_breakdown(&gpu);
+    shadow_costs(&gpu);
+    growing_scenes(&gpu, quick);
 }

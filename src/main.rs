@@ -11,7 +11,7 @@ use clap::{CommandFactory, Parser, Subcommand};
 use mirador::compare::sheet::{Panel, flip_legend, sheet, with_footer};
 use mirador::gpu::texture::GpuTexture;
 use mirador::gpu::{Gpu, Stopwatch, readback};
-use mirador::raster::{OUTPUT_FORMAT, Renderer, drawn_size};
+use mirador::raster::{FrameReport, OUTPUT_FORMAT, Renderer, drawn_size};
 use mirador::settings::AntiAliasing;
 use mirador::trace::accel::AccelKind;
 use mirador::trace::{RenderControl, Tracer};
@@ -205,51 +205,63 @@ fn render(args: SceneArgs, output_path: &Path) -> anyhow::Result<()> {
 
 /// The rasterizer's image of `scene` with its settings; returns it and the adapter's name. With
 /// `timed_frames`, also a second frame (what an interactive frame costs, with everything the
-/// first one cached) and a third with each pass submitted and timed on its own.
+/// first one cached) and a third with each pass submitted and timed on its own. The size is
+/// checked against the device's limits before anything is created, and every GPU error after
+/// that (validation, out of memory) comes back as an error, not a panic.
 fn rasterize(scene: &Scene, clock: &mut Stopwatch, timed_frames: bool) -> anyhow::Result<(image::RgbaImage, String)> {
     let gpu = clock.time("device", Gpu::headless)?;
-    let mut renderer = clock.time("pipelines", || Renderer::new(&gpu.device, OUTPUT_FORMAT));
     let size = (scene.camera.width, scene.camera.height);
-    let (mut scene_gpu, mut targets, output) = clock.time("upload", || {
-        let scene_gpu = renderer.upload(&gpu, scene);
-        let targets = renderer.targets(&gpu.device, drawn_size(size, scene.settings.raster.render_scale));
-        let output = GpuTexture::target(&gpu.device, "cli::output", size, OUTPUT_FORMAT);
-        gpu.wait();
-        (scene_gpu, targets, output)
-    });
-    // The first frame also pays for the driver's lazy pipeline compilation and fills the caches
-    // (shadow maps, tessellations); the second is what an interactive frame costs.
-    let mut frame = |renderer: &mut Renderer| {
-        let report = renderer.render(&gpu, scene, &mut scene_gpu, &scene.settings, &mut targets, &output.view);
-        gpu.wait();
-        report
-    };
-    let first = clock.time("first frame", || frame(&mut renderer));
-    if timed_frames {
-        let second = clock.time("frame", || frame(&mut renderer));
-        renderer.profile = true;
-        renderer.invalidate_shadows();
-        let profiled = frame(&mut renderer);
-        println!(
-            "raster: {} triangles per view in {} meshes, {} shader variants, drawn at {}×{}",
-            first.triangles,
-            scene_gpu.geometry.mesh_count(),
-            renderer.shader_variants(),
-            first.drawn_size.0,
-            first.drawn_size.1
-        );
-        println!(
-            "shadow layers drawn: {} in the first frame, {} in the second (kept across frames)",
-            first.shadow_layers_drawn, second.shadow_layers_drawn
-        );
-        println!("passes (each submitted and waited for on its own, shadow maps redrawn):");
-        for (name, time) in &profiled.passes {
-            println!("{name:>20}: {:9.3} ms", time.as_secs_f64() * 1e3);
+    gpu.check_image_size(size)?;
+    let pixels = gpu.checked(|| {
+        let mut renderer = clock.time("pipelines", || Renderer::new(&gpu.device, OUTPUT_FORMAT));
+        let (mut scene_gpu, mut targets, output) = clock.time("upload", || {
+            let scene_gpu = renderer.upload(&gpu, scene);
+            let targets = renderer.targets(&gpu.device, drawn_size(size, scene.settings.raster.render_scale));
+            let output = GpuTexture::target(&gpu.device, "cli::output", size, OUTPUT_FORMAT);
+            gpu.wait();
+            (scene_gpu, targets, output)
+        });
+        // The first frame also pays for the driver's lazy pipeline compilation and fills the
+        // caches (shadow maps, tessellations); the second is what an interactive frame costs.
+        let mut frame = |renderer: &mut Renderer| {
+            let report = renderer.render(&gpu, scene, &mut scene_gpu, &scene.settings, &mut targets, &output.view);
+            gpu.wait();
+            report
+        };
+        let first = clock.time("first frame", || frame(&mut renderer));
+        if timed_frames {
+            let second = clock.time("frame", || frame(&mut renderer));
+            renderer.profile = true;
+            renderer.invalidate_shadows();
+            let profiled = frame(&mut renderer);
+            print_frame_stats(&first, &second, &profiled, scene_gpu.geometry.mesh_count(), renderer.shader_variants());
         }
-    }
-    let pixels = clock.time("readback", || readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture));
+        clock.time("readback", || readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture))
+    })??;
     let image = image::RgbaImage::from_raw(size.0, size.1, pixels).expect("readback returns one RGBA8 texel per pixel");
     Ok((image, gpu.describe()))
+}
+
+/// `--stats` for the rasterizer: what the frames drew and where a frame's time goes.
+fn print_frame_stats(
+    first: &FrameReport,
+    second: &FrameReport,
+    profiled: &FrameReport,
+    meshes: usize,
+    variants: usize,
+) {
+    println!(
+        "raster: {} triangles per view in {meshes} meshes, {variants} shader variants, drawn at {}×{}",
+        first.triangles, first.drawn_size.0, first.drawn_size.1
+    );
+    println!(
+        "shadow layers drawn: {} in the first frame, {} in the second (kept across frames)",
+        first.shadow_layers_drawn, second.shadow_layers_drawn
+    );
+    println!("passes (each submitted and waited for on its own, shadow maps redrawn):");
+    for (name, time) in &profiled.passes {
+        println!("{name:>20}: {:9.3} ms", time.as_secs_f64() * 1e3);
+    }
 }
 
 /// The tracer's image of `scene` with its settings.

@@ -8,6 +8,16 @@ fn mirador(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mirador")).args(args).output().expect("running the mirador binary")
 }
 
+/// `mirador` on a device that offers only wgpu's downlevel limits: textures of at most 2048
+/// pixels a side, as on many small GPUs.
+fn mirador_on_a_small_device(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mirador"))
+        .args(args)
+        .env("MIRADOR_LIMITS", "downlevel")
+        .output()
+        .expect("running the mirador binary")
+}
+
 /// A fresh, empty directory for one test's outputs.
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mirador-cli-{name}-{}", std::process::id()));
@@ -102,6 +112,71 @@ fn bad_sizes_and_settings_are_rejected() {
     assert_fails_cleanly(&mirador(&["render", &seed, "-o", out, "--set", "exposure=-2"]), &["exposure"], &dir);
     let jpeg = dir.join("out.jpg");
     assert_fails_cleanly(&mirador(&["render", &seed, "-o", jpeg.to_str().unwrap()]), &["out.jpg", ".png"], &dir);
+}
+
+/// Fails unless one line of stderr holds all of `needles`: the error is one line, whichever
+/// notices the driver prints around it.
+fn assert_one_line(output: &Output, needles: &[&str]) {
+    let message = stderr(output);
+    assert!(
+        message.lines().any(|line| needles.iter().all(|needle| line.contains(needle))),
+        "no single line says all of {needles:?}: {message}"
+    );
+}
+
+#[test]
+fn a_size_beyond_the_devices_texture_limit_names_the_limit() {
+    let dir = scratch("texture-limit");
+    let out = dir.join("out.png");
+    let output = mirador_on_a_small_device(&[
+        "render",
+        &asset("scenes/seed-simple.toml"),
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "3000",
+        "--height",
+        "2000",
+    ]);
+    let needles = ["error: a 3000×2000 image", "max_texture_dimension_2d", "2048"];
+    assert_fails_cleanly(&output, &needles, &dir);
+    assert_one_line(&output, &needles);
+}
+
+#[test]
+fn a_gpu_validation_error_is_an_error_not_a_panic() {
+    // Shadow maps of 4096² pass the settings' own check but not a 2048-pixel device: wgpu's
+    // validation error must come back through the error scopes as one line.
+    let dir = scratch("validation");
+    let out = dir.join("out.png");
+    let output = mirador_on_a_small_device(&[
+        "render",
+        "-o",
+        out.to_str().unwrap(),
+        "--width",
+        "64",
+        "--height",
+        "36",
+        "--set",
+        "shadows.enabled=true",
+        "--set",
+        "shadows.map_size=4096",
+    ]);
+    let needles = ["error: the GPU reported a validation error", "shadow::", "4096 exceeds the limit of 2048"];
+    assert_fails_cleanly(&output, &needles, &dir);
+    assert_one_line(&output, &needles);
+}
+
+#[test]
+fn an_unknown_limits_setting_is_named() {
+    let dir = scratch("limits");
+    let out = dir.join("out.png");
+    let output = Command::new(env!("CARGO_BIN_EXE_mirador"))
+        .args(["render", "-o", out.to_str().unwrap(), "--width", "8", "--height", "8"])
+        .env("MIRADOR_LIMITS", "tiny")
+        .output()
+        .expect("running the mirador binary");
+    assert_fails_cleanly(&output, &["MIRADOR_LIMITS=tiny", "downlevel"], &dir);
 }
 
 #[test]

@@ -1,30 +1,38 @@
-//! Golden images of the built-in scenes, compared by mean FLIP. Lavapipe renders these
-//! bit-identically run to run; the threshold leaves room for other drivers (Vulkan and GL differ
-//! by a FLIP mean of about 0.002) while catching any visible change: moving the seed-simple light
-//! by 5 units, or halving the ambient light, costs more than 0.01 (see the last test).
+//! Golden images of the built-in scenes, compared by FLIP: the mean over the image and the mean
+//! over its worst 32×32 region. Lavapipe renders these bit-identically run to run; the
+//! thresholds leave room for other drivers and versions (see [`TOLERANCE`]) while catching any
+//! visible change: moving the seed-simple light by 5 units, or halving the
+//! ambient light, costs more than 0.01 of mean; a wrong 40×40 patch, which the mean dilutes below
+//! 0.01, costs far more than the region threshold (see the tests at the end).
 
 mod common;
 
-/// The largest mean FLIP error a golden image may show.
-const MAX_FLIP_MEAN: f32 = 0.01;
+use common::{GoldenError, Tolerance};
+
+/// What a golden image may differ by. Measured on lavapipe (llvmpipe, LLVM 15) against these
+/// goldens: mean FLIP 0.0006 (seed-simple) to 0.0036 (shadows), worst region 0.004
+/// (seed-simple) to 0.027 (bumps); the region threshold leaves twice the largest. Visible changes
+/// measure far above it: a 40×40 patch 20% darker 0.44, the seed-simple light moved 5 units
+/// 0.20, the bottom 8 rows left black 0.30.
+const TOLERANCE: Tolerance = Tolerance { flip_mean: 0.01, worst_region: 0.05 };
 
 #[test]
 fn seed_simple() {
     let scene = common::load("scenes/seed-simple.toml");
-    common::assert_golden("seed-simple", &common::raster(&scene, &scene.settings), MAX_FLIP_MEAN);
+    common::assert_golden("seed-simple", &common::raster(&scene, &scene.settings), TOLERANCE);
 }
 
 #[test]
 fn showcase() {
     let mut scene = common::load("scenes/showcase.toml");
     (scene.camera.width, scene.camera.height) = (640, 360);
-    common::assert_golden("showcase", &common::raster(&scene, &scene.settings), MAX_FLIP_MEAN);
+    common::assert_golden("showcase", &common::raster(&scene, &scene.settings), TOLERANCE);
 }
 
 #[test]
 fn shadow_stage_with_shadow_maps() {
     let scene = common::load("scenes/shadows.toml");
-    common::assert_golden("shadows-map", &common::raster(&scene, &scene.settings), MAX_FLIP_MEAN);
+    common::assert_golden("shadows-map", &common::raster(&scene, &scene.settings), TOLERANCE);
 }
 
 #[test]
@@ -32,7 +40,7 @@ fn shadow_stage_with_projected_polygons() {
     let scene = common::load("scenes/shadows.toml");
     let mut settings = scene.settings.clone();
     settings.shadows.method = mirador::settings::ShadowMethod::Projected;
-    common::assert_golden("shadows-projected", &common::raster(&scene, &settings), MAX_FLIP_MEAN);
+    common::assert_golden("shadows-projected", &common::raster(&scene, &settings), TOLERANCE);
 }
 
 /// The showcase's floor running to the horizon, in each texture filter (TECHNIQUES.md §2).
@@ -54,14 +62,14 @@ fn floor_in_every_texture_filter() {
     ] {
         let mut settings = scene.settings.clone();
         settings.textures.filter = filter;
-        common::assert_golden(name, &common::raster(&scene, &settings), MAX_FLIP_MEAN);
+        common::assert_golden(name, &common::raster(&scene, &settings), TOLERANCE);
     }
 }
 
 #[test]
 fn bump_mapped_tile_and_ball() {
     let scene = common::load("scenes/bumps.toml");
-    common::assert_golden("bumps", &common::raster(&scene, &scene.settings), MAX_FLIP_MEAN);
+    common::assert_golden("bumps", &common::raster(&scene, &scene.settings), TOLERANCE);
 }
 
 /// The threshold is meaningful: small but visible changes to the scene exceed it.
@@ -74,10 +82,109 @@ fn the_threshold_catches_visible_changes() {
         position.x -= 5.0;
     }
     let flip = mirador::compare::difference(&reference, &common::raster(&moved, &moved.settings)).unwrap().flip_mean;
-    assert!(flip > MAX_FLIP_MEAN, "moving the light 5 units changed the image by only {flip}");
+    assert!(flip > TOLERANCE.flip_mean, "moving the light 5 units changed the image by only {flip}");
 
     let mut dimmer = scene.clone();
     dimmer.ambient = glam::Vec3::splat(0.1);
     let flip = mirador::compare::difference(&reference, &common::raster(&dimmer, &dimmer.settings)).unwrap().flip_mean;
-    assert!(flip > MAX_FLIP_MEAN, "halving the ambient light changed the image by only {flip}");
+    assert!(flip > TOLERANCE.flip_mean, "halving the ambient light changed the image by only {flip}");
+}
+
+/// The showcase golden (640×360), the image the tests below damage.
+fn showcase_golden() -> image::RgbaImage {
+    image::open(common::golden_dir().join("showcase.png")).expect("the showcase golden").into_rgba8()
+}
+
+/// A local change fails though the whole-image mean stays under its threshold: the case the
+/// region statistic is there for. A 40×40 patch painted magenta, or made 20% darker.
+#[test]
+fn a_wrong_patch_fails_though_the_mean_passes() {
+    let golden = showcase_golden();
+    let paints: [fn(&mut image::Rgba<u8>); 2] = [
+        |pixel| *pixel = image::Rgba([255, 0, 255, 255]),
+        |pixel| pixel.0[..3].iter_mut().for_each(|c| *c = (f32::from(*c) * 0.8) as u8),
+    ];
+    for paint in paints {
+        let mut patched = golden.clone();
+        for y in 280..320 {
+            for x in 300..340 {
+                paint(patched.get_pixel_mut(x, y));
+            }
+        }
+        let error = GoldenError::between(&golden, &patched).unwrap();
+        assert!(error.flip_mean < TOLERANCE.flip_mean, "the mean alone would pass: {error:?}");
+        let excesses = error.excesses(TOLERANCE);
+        assert!(excesses.len() == 1 && excesses[0].contains("region"), "{excesses:?}");
+    }
+}
+
+/// A render that lost its last 8 rows (a readback band left black) fails.
+#[test]
+fn a_missing_band_fails() {
+    let golden = showcase_golden();
+    let mut damaged = golden.clone();
+    for y in golden.height() - 8..golden.height() {
+        for x in 0..golden.width() {
+            damaged.put_pixel(x, y, image::Rgba([0, 0, 0, 255]));
+        }
+    }
+    let error = GoldenError::between(&golden, &damaged).unwrap();
+    assert!(!error.excesses(TOLERANCE).is_empty(), "a black band passed: {error:?}");
+}
+
+/// A corrupted golden file, or one of another size, fails with the file named and the render
+/// kept for inspection; an intact copy of the same golden passes.
+#[test]
+fn a_corrupted_or_resized_golden_fails() {
+    let dir = std::env::temp_dir().join(format!("mirador-golden-corrupt-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let golden = showcase_golden();
+    let bytes = std::fs::read(common::golden_dir().join("showcase.png")).unwrap();
+    std::fs::write(dir.join("intact.png"), &bytes).unwrap();
+    std::fs::write(dir.join("truncated.png"), &bytes[..bytes.len() / 2]).unwrap();
+    image::imageops::resize(&golden, 320, 180, image::imageops::FilterType::Triangle)
+        .save(dir.join("resized.png"))
+        .unwrap();
+    let error = common::check_golden(&dir, "intact", &golden, TOLERANCE).unwrap();
+    assert_eq!((error.flip_mean, error.worst_region), (0.0, 0.0));
+    for name in ["truncated", "resized"] {
+        let message = common::check_golden(&dir, name, &golden, TOLERANCE).unwrap_err();
+        assert!(message.contains(name), "{message}");
+        assert!(dir.join(format!("{name}-actual.png")).exists(), "{name}: the render is kept");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// NaN cannot reach the comparison through the images, which are 8-bit (the output transform
+/// maps NaN radiance to 0, `output.rs`); but a NaN in the per-pixel errors must fail, not slip
+/// through `NaN > threshold` being false.
+#[test]
+fn a_nan_error_fails_every_tolerance() {
+    let mut errors = vec![0.0; 64 * 64];
+    errors[64 * 10 + 20] = f32::NAN;
+    let error = GoldenError::from_flip(&errors, 64, 64);
+    assert_eq!(error.excesses(TOLERANCE).len(), 2, "{error:?}");
+    let generous = Tolerance { flip_mean: 1.0, worst_region: 1.0 };
+    assert_eq!(error.excesses(generous).len(), 2, "{error:?}");
+    assert!(GoldenError::from_flip(&vec![0.0; 64 * 64], 64, 64).excesses(TOLERANCE).is_empty());
+}
+
+/// The region statistic against hand-computed values: one bright 32×32 block is its own worst
+/// region; the same error spread thinly is not.
+#[test]
+fn the_worst_region_is_the_mean_of_the_worst_window() {
+    let (width, height) = (100, 60);
+    let mut block = vec![0.0; width * height];
+    for y in 20..52 {
+        for x in 50..82 {
+            block[y * width + x] = 0.5;
+        }
+    }
+    let error = GoldenError::from_flip(&block, width as u32, height as u32);
+    assert!((error.worst_region - 0.5).abs() < 1e-6, "{error:?}");
+    assert!((error.flip_mean - 0.5 * 1024.0 / 6000.0).abs() < 1e-6, "{error:?}");
+    let spread = vec![0.5 * 1024.0 / 6000.0; width * height];
+    let error = GoldenError::from_flip(&spread, width as u32, height as u32);
+    assert!((error.worst_region - error.flip_mean).abs() < 1e-6, "{error:?}");
 }

@@ -72,7 +72,7 @@ fn gpu_present_pass_matches_the_rust_transform() {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         present.record(&gpu.queue, &mut encoder, &input, &output.view, exposure);
         gpu.queue.submit([encoder.finish()]);
-        let bytes = readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture);
+        let bytes = readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture).expect("reading the output back");
         let cpu = mirador::output::encode_image(width, height, &exact, exposure);
         let worst = bytes.iter().zip(cpu.as_raw()).map(|(&g, &c)| g.abs_diff(c)).max().unwrap();
         assert!(worst <= 1, "exposure {exposure}: GPU and CPU output transforms differ by up to {worst}/255");

@@ -10,6 +10,9 @@ use image::RgbaImage;
 pub struct Difference {
     /// Mean FLIP error over all pixels, in [0, 1]; 0 means identical.
     pub flip_mean: f32,
+    /// The FLIP error of each pixel, rows from the top: for statistics the mean dilutes, such as
+    /// the worst region of the golden-image tests.
+    pub flip_errors: Vec<f32>,
     /// Peak signal-to-noise ratio of the 8-bit RGB values, in dB (infinite when identical).
     pub psnr_db: f64,
     /// The per-pixel FLIP error through the magma colour map (black: no error; yellow: large).
@@ -41,7 +44,7 @@ pub fn difference(reference: &RgbaImage, test: &RgbaImage) -> Result<Difference,
     let colored = error.apply_color_lut(&nv_flip::magma_lut()).to_vec();
     let error_map = RgbaImage::from_raw(w, h, colored.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 255]).collect())
         .expect("the error map has one RGB triple per pixel");
-    Ok(Difference { flip_mean, psnr_db: psnr(&a, &b), error_map })
+    Ok(Difference { flip_mean, flip_errors: error.to_vec(), psnr_db: psnr(&a, &b), error_map })
 }
 
 /// PSNR of two equally long byte buffers with peak 255.

@@ -28,6 +28,15 @@ pub enum GpuError {
     NoAdapter { tried: String },
     #[error("the {adapter} adapter refused to create a device: {source}")]
     Device { adapter: String, source: wgpu::RequestDeviceError },
+    #[error("MIRADOR_LIMITS={0}: unknown value; `downlevel` is the only one")]
+    UnknownLimits(String),
+    #[error(
+        "a {width}×{height} image does not fit this device ({adapter}): its max_texture_dimension_2d \
+         limit is {limit} pixels a side"
+    )]
+    ImageTooLarge { width: u32, height: u32, limit: u32, adapter: String },
+    #[error("the GPU reported {kind}: {message}")]
+    Reported { kind: &'static str, message: String },
 }
 
 impl Gpu {
@@ -81,14 +90,21 @@ impl Gpu {
         Err(GpuError::NoAdapter { tried: tried.join(", ") })
     }
 
-    /// A device for `adapter`, asking only for what every backend Mirador supports can give.
+    /// A device for `adapter`, asking only for what every backend Mirador supports can give,
+    /// and for the adapter's largest textures. `MIRADOR_LIMITS=downlevel` leaves the texture size
+    /// at wgpu's downlevel default (2048 pixels a side), to try Mirador as a small device runs it.
     pub fn with_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, GpuError> {
         let info = adapter.get_info();
         log::info!("adapter: {} ({:?})", info.name, info.backend);
+        let required_limits = match std::env::var("MIRADOR_LIMITS") {
+            Ok(value) if value == "downlevel" => wgpu::Limits::downlevel_defaults(),
+            Ok(value) => return Err(GpuError::UnknownLimits(value)),
+            Err(_) => wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+        };
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("mirador::device"),
             required_features: wgpu::Features::empty(),
-            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            required_limits,
             ..Default::default()
         }))
         .map_err(|source| GpuError::Device { adapter: info.name.clone(), source })?;
@@ -105,6 +121,68 @@ impl Gpu {
     pub fn wait(&self) {
         self.device.poll(wgpu::PollType::wait_indefinitely()).expect("polling the device for completion");
     }
+
+    /// Whether render targets of `size` fit this device; checked before anything is created, so
+    /// that a too-large request names the limit instead of failing inside wgpu.
+    pub fn check_image_size(&self, size: (u32, u32)) -> Result<(), GpuError> {
+        check_image_size(&self.device.limits(), size).map_err(|limit| GpuError::ImageTooLarge {
+            width: size.0,
+            height: size.1,
+            limit,
+            adapter: self.describe(),
+        })
+    }
+
+    /// Runs `work` with its GPU errors captured: an out-of-memory, internal or validation error
+    /// raised by any wgpu call `work` makes on this thread becomes `Err(GpuError::Reported)`
+    /// instead of reaching wgpu's default handler, which panics. Each scope keeps its first
+    /// error; out of memory is reported before the others, which usually follow from it (a
+    /// texture that could not be allocated is invalid wherever it is used next). `work`'s own
+    /// result is returned when the GPU reported nothing.
+    pub fn checked<T>(&self, work: impl FnOnce() -> T) -> Result<T, GpuError> {
+        let out_of_memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let internal = self.device.push_error_scope(wgpu::ErrorFilter::Internal);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let value = work();
+        // Popped innermost first, as scopes must be.
+        let validation = pollster::block_on(validation.pop());
+        let internal = pollster::block_on(internal.pop());
+        let out_of_memory = pollster::block_on(out_of_memory.pop());
+        match out_of_memory.or(internal).or(validation) {
+            None => Ok(value),
+            Some(error) => Err(reported(&error)),
+        }
+    }
+}
+
+/// `Err(limit)` when an image of `size` exceeds `limits.max_texture_dimension_2d`.
+pub fn check_image_size(limits: &wgpu::Limits, (width, height): (u32, u32)) -> Result<(), u32> {
+    let limit = limits.max_texture_dimension_2d;
+    if width > limit || height > limit { Err(limit) } else { Ok(()) }
+}
+
+/// A wgpu error on one line: its kind, then each cause in turn ("In Device::create_texture,
+/// label = 'shadow::maps': Dimension X value 4096 exceeds the limit of 2048"). wgpu's own
+/// description spreads the same causes over an indented tree.
+fn reported(error: &wgpu::Error) -> GpuError {
+    let kind = match error {
+        wgpu::Error::OutOfMemory { .. } => "an out-of-memory error",
+        wgpu::Error::Validation { .. } => "a validation error",
+        wgpu::Error::Internal { .. } => "an internal error",
+    };
+    let mut causes: Vec<String> = Vec::new();
+    let mut cause = std::error::Error::source(error);
+    while let Some(inner) = cause {
+        let text = inner.to_string();
+        if causes.last() != Some(&text) && !text.is_empty() {
+            causes.push(text);
+        }
+        cause = inner.source();
+    }
+    if causes.is_empty() {
+        causes.push(error.to_string());
+    }
+    GpuError::Reported { kind, message: causes.join(": ").replace('\n', " ") }
 }
 
 /// What an adapter must be able to draw to: a window's surface, or nothing.

@@ -327,7 +327,8 @@ impl Headless {
             self.renderer.render(gpu, scene, &mut self.scene_gpu, settings, &mut self.targets, &self.output.view);
         let size = self.output.texture.size();
         let (width, height) = (size.width, size.height);
-        let pixels = readback::read_rgba8(&gpu.device, &gpu.queue, &self.output.texture);
+        let pixels =
+            readback::read_rgba8(&gpu.device, &gpu.queue, &self.output.texture).expect("reading the frame back");
         image::RgbaImage::from_raw(width, height, pixels).expect("readback returns width × height RGBA8 pixels")
     }
 }

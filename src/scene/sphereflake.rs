@@ -128,9 +128,10 @@ mod tests {
     fn every_child_touches_its_parent_and_never_overlaps_the_root() {
         let flake = spheres(2);
         let (root, r0) = flake[0];
-        for &(c, r) in &flake[1..10] {
+        let first_level: Vec<_> = flake.iter().filter(|(_, r)| (r - r0 / 3.0).abs() < 1e-7).collect();
+        assert_eq!(first_level.len(), 9);
+        for &&(c, r) in &first_level {
             assert!((c.distance(root) - (r0 + r)).abs() < 1e-6, "a first-level child touches the root");
-            assert!((r - r0 / 3.0).abs() < 1e-7);
         }
         for &(c, r) in &flake[1..] {
             assert!(c.distance(root) >= r0 + r - 1e-5, "no sphere reaches into the root");

@@ -1,9 +1,11 @@
 //! Shared test harness: one headless device per test binary, scene rendering, and golden images
 //! compared by FLIP.
 //!
-//! Golden images live in `tests/golden/NAME.png`. A comparison that fails writes
-//! `tests/golden/NAME-actual.png` and `NAME-diff.png` (the FLIP error map; both ignored by git)
-//! beside the golden. To bless new goldens, run the tests with `MIRADOR_BLESS=1`, then open every
+//! Golden images live in `tests/golden/NAME.png` and are compared by two statistics of the
+//! per-pixel FLIP error (see [`Tolerance`]): the mean over the image, and the mean over its worst
+//! 32×32 region, which catches a local change the whole-image mean dilutes. A comparison that
+//! fails writes `tests/golden/NAME-actual.png` and `NAME-diff.png` (the FLIP error map; both
+//! ignored by git) beside the golden. To bless new goldens, run the tests with `MIRADOR_BLESS=1`, then open every
 //! image that changed and look at it before committing it (see README.md).
 
 #![allow(dead_code)]
@@ -35,43 +37,158 @@ pub fn raster(scene: &Scene, settings: &RenderSettings) -> image::RgbaImage {
     mirador::raster::render_image(gpu(), scene, settings)
 }
 
-/// Compares `actual` with `tests/golden/{name}.png` by mean FLIP error and fails above
-/// `max_flip_mean`, leaving the actual image and the error map beside the golden.
-pub fn assert_golden(name: &str, actual: &image::RgbaImage, max_flip_mean: f32) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join("golden");
-    let golden_path = dir.join(format!("{name}.png"));
-    let actual_path = dir.join(format!("{name}-actual.png"));
-    let diff_path = dir.join(format!("{name}-diff.png"));
+/// What a render may differ from its golden by, in FLIP error (0: identical, 1: as different
+/// as black and white).
+#[derive(Clone, Copy, Debug)]
+pub struct Tolerance {
+    /// The largest mean over the whole image: bounds a change spread over the image.
+    pub flip_mean: f32,
+    /// The largest mean over any `REGION`×`REGION` window: bounds a local change, which the
+    /// whole-image mean dilutes (a wrong 40×40 patch is 0.7% of a 640×360 image).
+    pub worst_region: f32,
+}
+
+/// The side, in pixels, of the windows [`GoldenError::worst_region`] averages over.
+pub const REGION: u32 = 32;
+
+/// How a render differs from its golden, in the statistics a [`Tolerance`] bounds.
+#[derive(Clone, Copy, Debug)]
+pub struct GoldenError {
+    pub flip_mean: f32,
+    pub worst_region: f32,
+}
+
+impl GoldenError {
+    /// The statistics of per-pixel FLIP errors, rows from the top. A NaN error makes both NaN.
+    pub fn from_flip(errors: &[f32], width: u32, height: u32) -> GoldenError {
+        assert_eq!(errors.len(), (width * height) as usize, "one error per pixel");
+        let sum: f64 = errors.iter().map(|&e| f64::from(e)).sum();
+        let flip_mean = (sum / errors.len().max(1) as f64) as f32;
+        GoldenError { flip_mean, worst_region: worst_window_mean(errors, width, height, REGION) }
+    }
+
+    /// Compares two images (`golden` the reference).
+    pub fn between(golden: &image::RgbaImage, actual: &image::RgbaImage) -> Result<GoldenError, String> {
+        let difference = mirador::compare::difference(golden, actual).map_err(|e| e.to_string())?;
+        Ok(GoldenError::from_flip(&difference.flip_errors, golden.width(), golden.height()))
+    }
+
+    /// What exceeds `tolerance`, one message each; empty when the render is within it. A NaN
+    /// statistic exceeds every tolerance, though `NaN > t` is false.
+    pub fn excesses(&self, tolerance: Tolerance) -> Vec<String> {
+        let exceeds = |value: f32, limit: f32| value.is_nan() || value > limit;
+        let mut excesses = Vec::new();
+        if exceeds(self.flip_mean, tolerance.flip_mean) {
+            excesses.push(format!("mean FLIP {:.5} > {}", self.flip_mean, tolerance.flip_mean));
+        }
+        if exceeds(self.worst_region, tolerance.worst_region) {
+            excesses.push(format!(
+                "mean FLIP of the worst {REGION}×{REGION} region {:.5} > {}",
+                self.worst_region, tolerance.worst_region
+            ));
+        }
+        excesses
+    }
+}
+
+/// The largest mean of `errors` over any `side`×`side` window (clamped to the image), from a
+/// summed-area table; NaN when any error is NaN, which `f64::max` would otherwise skip.
+fn worst_window_mean(errors: &[f32], width: u32, height: u32, side: u32) -> f32 {
+    if errors.iter().any(|e| e.is_nan()) {
+        return f32::NAN;
+    }
+    let (w, h) = (width as usize, height as usize);
+    let (sw, sh) = (side.min(width) as usize, side.min(height) as usize);
+    // table[y][x] holds the sum of errors above and left of pixel (x, y).
+    let mut table = vec![0.0f64; (w + 1) * (h + 1)];
+    for y in 0..h {
+        let mut row = 0.0;
+        for x in 0..w {
+            row += f64::from(errors[y * w + x]);
+            table[(y + 1) * (w + 1) + x + 1] = table[y * (w + 1) + x + 1] + row;
+        }
+    }
+    let at = |x: usize, y: usize| table[y * (w + 1) + x];
+    let mut worst = 0.0f64;
+    for y in 0..=h - sh {
+        for x in 0..=w - sw {
+            let sum = at(x + sw, y + sh) - at(x, y + sh) - at(x + sw, y) + at(x, y);
+            worst = worst.max(sum);
+        }
+    }
+    (worst / (sw * sh) as f64) as f32
+}
+
+/// The directory of the golden images.
+pub fn golden_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join("golden")
+}
+
+/// Compares `actual` with `tests/golden/{name}.png` and fails beyond `tolerance` (see
+/// [`check_golden`]). With `MIRADOR_BLESS` set, writes the golden instead.
+pub fn assert_golden(name: &str, actual: &image::RgbaImage, tolerance: Tolerance) {
+    let golden_path = golden_dir().join(format!("{name}.png"));
     if std::env::var_os("MIRADOR_BLESS").is_some() {
         mirador::output::write_png_atomically(actual, &golden_path).expect("writing the blessed golden");
         eprintln!("blessed {} — look at it before committing", golden_path.display());
         return;
     }
+    match check_golden(&golden_dir(), name, actual, tolerance) {
+        Ok(error) => eprintln!(
+            "{name}: mean FLIP {:.5}, worst {REGION}×{REGION} region {:.5}",
+            error.flip_mean, error.worst_region
+        ),
+        Err(message) => panic!("{message}"),
+    }
+}
+
+/// Compares `actual` with `{dir}/{name}.png`. When it is beyond `tolerance`, or the golden is
+/// missing or unreadable or of another size, writes `{name}-actual.png` (and `{name}-diff.png`,
+/// the FLIP error map, when there is one) beside the golden and says why.
+pub fn check_golden(
+    dir: &Path,
+    name: &str,
+    actual: &image::RgbaImage,
+    tolerance: Tolerance,
+) -> Result<GoldenError, String> {
+    let golden_path = dir.join(format!("{name}.png"));
+    let actual_path = dir.join(format!("{name}-actual.png"));
+    let diff_path = dir.join(format!("{name}-diff.png"));
+    let keep_actual = || actual.save(&actual_path).expect("writing the actual image");
     let golden = match image::open(&golden_path) {
         Ok(image) => image.into_rgba8(),
         Err(e) => {
-            actual.save(&actual_path).expect("writing the actual image");
-            panic!(
-                "no golden image {} ({e}); the render is in {}. Look at it, then bless with MIRADOR_BLESS=1",
+            keep_actual();
+            return Err(format!(
+                "no readable golden image {} ({e}); the render is in {}. Look at it, then bless with MIRADOR_BLESS=1",
                 golden_path.display(),
                 actual_path.display()
-            );
+            ));
         }
     };
-    let difference = mirador::compare::difference(&golden, actual).unwrap_or_else(|e| panic!("{name}: {e}"));
-    if difference.flip_mean > max_flip_mean {
-        actual.save(&actual_path).expect("writing the actual image");
+    let difference = match mirador::compare::difference(&golden, actual) {
+        Ok(difference) => difference,
+        Err(e) => {
+            keep_actual();
+            return Err(format!("{name}: {e}; the render is in {}", actual_path.display()));
+        }
+    };
+    let error = GoldenError::from_flip(&difference.flip_errors, golden.width(), golden.height());
+    let excesses = error.excesses(tolerance);
+    if !excesses.is_empty() {
+        keep_actual();
         difference.error_map.save(&diff_path).expect("writing the error map");
-        panic!(
-            "{name}: mean FLIP {:.5} > {max_flip_mean} (PSNR {:.2} dB); see {} and {}",
-            difference.flip_mean,
+        return Err(format!(
+            "{name}: {} (PSNR {:.2} dB); see {} and {}",
+            excesses.join(", "),
             difference.psnr_db,
             actual_path.display(),
             diff_path.display()
-        );
+        ));
     }
     let _ = std::fs::remove_file(&actual_path);
     let _ = std::fs::remove_file(&diff_path);
+    Ok(error)
 }
 
 /// Where a compute probe finds its data in bind group 0.
