@@ -51,10 +51,10 @@ const HEIGHT_NOISE: u32 = 3u;
 // Group 2: the shadow pass's outputs and how to read them.
 @group(2) @binding(0) var<uniform> shadows: Shadows;
 @group(2) @binding(1) var shadow_maps: texture_depth_2d_array;
-@group(2) @binding(2) var shadow_linear: sampler_comparison;
-@group(2) @binding(3) var shadow_nearest: sampler_comparison;
-@group(2) @binding(4) var transmission_maps: texture_2d_array<f32>;
-@group(2) @binding(5) var projected_mask: texture_2d<f32>;
+// One comparison sampler for every filter: GL binds a texture to a single sampler.
+@group(2) @binding(2) var shadow_sampler: sampler_comparison;
+@group(2) @binding(3) var transmission_maps: texture_2d_array<f32>;
+@group(2) @binding(4) var projected_mask: texture_2d<f32>;
 
 struct VertexIn {
     @location(0) position: vec3f,
@@ -114,7 +114,7 @@ fn visibility(light: Light, p: vec3f, facing: vec3f, pixel: vec2f) -> vec3f {
         return vec3f(1.0);
     }
     var v = vec3f(shadow_filtered(
-        shadow_maps, shadow_linear, shadow_nearest, coordinates.xy, coordinates.z, layer, SHADOW_FILTER,
+        shadow_maps, shadow_sampler, coordinates.xy, coordinates.z, layer, SHADOW_FILTER,
         shadows.map_size,
     ));
     // A transparent receiver is not tinted by transparent occluders: in this one-layer

@@ -68,13 +68,13 @@ fn shadow_coordinates(clip_from_world: mat4x4f, p: vec3f) -> vec4f {
 // is "p's depth ≤ stored depth". PCF filters compare first and average after: the hardware's 2×2
 // filter weighs the four texels around the lookup bilinearly, and a (2r+1)² grid of such taps
 // one texel apart adds up to one separable kernel over 2r+2 texels a side, with 1-D weights
-// (1 − f, 1, …, 1, f)/(2r+1). That kernel is evaluated here with plain texel loads, which a
-// software GPU runs several times faster than comparison samplers; the Poisson disc, whose taps
-// fall between texels, keeps the hardware's comparison sampler.
+// (1 − f, 1, …, 1, f)/(2r+1). That kernel is evaluated here from comparison gathers, four texels
+// a call: (r+1)² gathers instead of (2r+1)² filtered samples, which on a software GPU is most of
+// the cost of a shadow (docs/performance.md). The Poisson disc, whose taps fall between texels,
+// keeps filtered samples.
 fn shadow_filtered(
     map: texture_depth_2d_array,
     linear: sampler_comparison,
-    nearest: sampler_comparison,
     uv: vec2f,
     depth: f32,
     layer: u32,
@@ -84,8 +84,9 @@ fn shadow_filtered(
     let size = f32(map_size);
     switch filter_mode {
         case SHADOW_FILTER_NONE: {
-            let texel = clamp(vec2i(floor(uv * size)), vec2i(0), vec2i(i32(map_size) - 1));
-            return select(0.0, 1.0, depth <= textureLoad(map, texel, layer, 0));
+            // The nearest texel: the bilinear filter at its very centre weighs it alone.
+            let centre = (floor(uv * size) + 0.5) / size;
+            return textureSampleCompareLevel(map, linear, centre, layer, depth);
         }
         case SHADOW_FILTER_POISSON: {
             let texel = 1.0 / size;
@@ -96,36 +97,42 @@ fn shadow_filtered(
             return lit / 16.0;
         }
         case SHADOW_FILTER_HARDWARE: {
-            return shadow_tent(map, uv, depth, layer, map_size, 0);
+            return shadow_tent(map, linear, uv, depth, layer, map_size, 0);
         }
         case SHADOW_FILTER_PCF3: {
-            return shadow_tent(map, uv, depth, layer, map_size, 1);
+            return shadow_tent(map, linear, uv, depth, layer, map_size, 1);
         }
         default: {
-            return shadow_tent(map, uv, depth, layer, map_size, 2);
+            return shadow_tent(map, linear, uv, depth, layer, map_size, 2);
         }
     }
 }
 
 // (2r+1)² bilinear comparison taps one texel apart around uv, as one separable kernel over
-// (2r+2)² texels; texels outside the map repeat its edge (clamp to edge).
-fn shadow_tent(map: texture_depth_2d_array, uv: vec2f, depth: f32, layer: u32, map_size: u32, r: i32) -> f32 {
-    let p = uv * f32(map_size) - 0.5;
+// (2r+2)² texels, gathered 2×2 texels at a time (textureGatherCompare's components are the
+// texels (0, 1), (1, 1), (1, 0), (0, 0) of its footprint); texels outside the map repeat its
+// edge (the sampler clamps to edge).
+fn shadow_tent(map: texture_depth_2d_array, cmp: sampler_comparison, uv: vec2f, depth: f32, layer: u32, map_size: u32, r: i32) -> f32 {
+    let size = f32(map_size);
+    let p = uv * size - 0.5;
     let base = floor(p);
     let f = p - base;
-    let first = vec2i(base) - vec2i(r);
-    let last = i32(map_size) - 1;
+    let first = base - f32(r);
     let n = 2 * r + 2;
     var lit = 0.0;
-    for (var j = 0; j < n; j++) {
-        let wy = select(select(1.0, f.y, j == n - 1), 1.0 - f.y, j == 0);
-        var row = 0.0;
-        for (var i = 0; i < n; i++) {
-            let wx = select(select(1.0, f.x, i == n - 1), 1.0 - f.x, i == 0);
-            let texel = clamp(first + vec2i(i, j), vec2i(0), vec2i(last));
-            row += wx * select(0.0, 1.0, depth <= textureLoad(map, texel, layer, 0));
+    for (var by = 0; by < r + 1; by++) {
+        for (var bx = 0; bx < r + 1; bx++) {
+            // The corner shared by the block's four texels.
+            let corner = (first + vec2f(f32(2 * bx + 1), f32(2 * by + 1))) / size;
+            let g = textureGatherCompare(map, cmp, corner, layer, depth);
+            let i = 2 * bx;
+            let j = 2 * by;
+            let wx0 = select(select(1.0, f.x, i == n - 1), 1.0 - f.x, i == 0);
+            let wx1 = select(1.0, f.x, i + 1 == n - 1);
+            let wy0 = select(select(1.0, f.y, j == n - 1), 1.0 - f.y, j == 0);
+            let wy1 = select(1.0, f.y, j + 1 == n - 1);
+            lit += wy0 * (wx0 * g.w + wx1 * g.z) + wy1 * (wx0 * g.x + wx1 * g.y);
         }
-        lit += wy * row;
     }
     let side = f32(2 * r + 1);
     return lit / (side * side);

@@ -287,11 +287,10 @@ fn lighting_group<'c>(
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: maps.uniform.binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(maps.depth) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(maps.linear) },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(maps.nearest) },
-                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(maps.transmission) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(maps.sampler) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(maps.transmission) },
                 wgpu::BindGroupEntry {
-                    binding: 5,
+                    binding: 4,
                     resource: wgpu::BindingResource::TextureView(&targets.shadow_mask.view),
                 },
             ],

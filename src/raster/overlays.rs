@@ -18,14 +18,18 @@ use crate::settings::{ShadowSettings, ShadowView};
 use crate::shaders;
 
 pub struct Overlays {
-    map_view: MapView,
+    module: wgpu::ShaderModule,
+    /// Made on first use: GL cannot read a depth texture without comparing it, so there this
+    /// one view fails (with a clear error) while every other pass runs.
+    map_view: std::cell::OnceCell<MapView>,
     frusta: Frusta,
 }
 
 impl Overlays {
     pub fn new(device: &wgpu::Device, scene_layouts: &SceneLayouts) -> Overlays {
         let module = shaders::module(device, "overlays::shader", shaders::OVERLAYS);
-        Overlays { map_view: MapView::new(device, &module), frusta: Frusta::new(device, &module, scene_layouts) }
+        let frusta = Frusta::new(device, &module, scene_layouts);
+        Overlays { module, map_view: std::cell::OnceCell::new(), frusta }
     }
 
     /// Draws the overlays that `settings` asks for over `frame`'s HDR image.
@@ -47,7 +51,8 @@ impl Overlays {
         if settings.view == ShadowView::Map {
             let layer = settings.view_layer.min(layout.views.len() as u32 - 1);
             let ratio = layout.views[layer as usize].depth_ratio;
-            self.map_view.record(device, queue, encoder, maps.depth, layer, ratio, frame.size, &frame.hdr.view);
+            let map_view = self.map_view.get_or_init(|| MapView::new(device, &self.module));
+            map_view.record(device, queue, encoder, maps.depth, layer, ratio, frame.size, &frame.hdr.view);
         }
         if settings.show_frusta {
             self.frusta.record(device, encoder, scene, layout, &frame.hdr.view, &frame.depth.view);
@@ -60,6 +65,7 @@ struct MapView {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     uniform: UniformBuffer<GpuShownLayer>,
+    sampler: wgpu::Sampler,
 }
 
 #[repr(C)]
@@ -78,6 +84,7 @@ impl MapView {
             entries: &[
                 layout::texture(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
                 layout::uniform(2, wgpu::ShaderStages::FRAGMENT),
+                layout::sampler(3, wgpu::SamplerBindingType::NonFiltering),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -94,7 +101,11 @@ impl MapView {
             &[Some(HDR_FORMAT.into())],
         );
         let uniform = UniformBuffer::new(device, "overlays::map_view_uniform", &GpuShownLayer::zeroed());
-        MapView { pipeline, layout, uniform }
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("overlays::map_view_sampler"),
+            ..Default::default()
+        });
+        MapView { pipeline, layout, uniform, sampler }
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -117,6 +128,7 @@ impl MapView {
             entries: &[
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(maps) },
                 wgpu::BindGroupEntry { binding: 2, resource: self.uniform.binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&self.sampler) },
             ],
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {

@@ -55,9 +55,8 @@ impl SceneLayouts {
                 layout::uniform(0, wgpu::ShaderStages::FRAGMENT),
                 layout::texture(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
                 layout::sampler(2, wgpu::SamplerBindingType::Comparison),
-                layout::sampler(3, wgpu::SamplerBindingType::Comparison),
-                layout::texture(4, unfilterable, wgpu::TextureViewDimension::D2Array),
-                layout::texture(5, unfilterable, wgpu::TextureViewDimension::D2),
+                layout::texture(3, unfilterable, wgpu::TextureViewDimension::D2Array),
+                layout::texture(4, unfilterable, wgpu::TextureViewDimension::D2),
             ],
         });
         SceneLayouts { frame, material, lighting }

@@ -173,8 +173,8 @@ pub struct ShadowMaps<'a> {
     pub uniform: &'a UniformBuffer<GpuShadows>,
     pub depth: &'a wgpu::TextureView,
     pub transmission: &'a wgpu::TextureView,
-    pub linear: &'a wgpu::Sampler,
-    pub nearest: &'a wgpu::Sampler,
+    /// The comparison sampler (bilinear, clamped to the edge) every filter reads the maps with.
+    pub sampler: &'a wgpu::Sampler,
     /// Changes whenever the textures are recreated, so bind groups that read them can follow.
     pub generation: u64,
     /// How many layers were drawn this frame (the others were kept from earlier frames).
@@ -192,8 +192,7 @@ pub struct ShadowPass {
     drawn: Vec<Option<LayerInputs>>,
     generation: u64,
     uniform: UniformBuffer<GpuShadows>,
-    linear: wgpu::Sampler,
-    nearest: wgpu::Sampler,
+    sampler: wgpu::Sampler,
 }
 
 impl ShadowPass {
@@ -236,18 +235,16 @@ impl ShadowPass {
             multiview_mask: None,
             cache: None,
         });
-        let comparison = |label, filter| {
-            device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some(label),
-                address_mode_u: wgpu::AddressMode::ClampToEdge,
-                address_mode_v: wgpu::AddressMode::ClampToEdge,
-                mag_filter: filter,
-                min_filter: filter,
-                // Lit where the reference (the point's depth) is no farther than the stored one.
-                compare: Some(wgpu::CompareFunction::LessEqual),
-                ..Default::default()
-            })
-        };
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow::comparison_sampler"),
+            address_mode_u: wgpu::AddressMode::ClampToEdge,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            // Lit where the reference (the point's depth) is no farther than the stored one.
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
         ShadowPass {
             module,
             pipeline_layout,
@@ -257,8 +254,7 @@ impl ShadowPass {
             drawn: Vec::new(),
             generation: 0,
             uniform: UniformBuffer::new(device, "shadow::uniform", &GpuShadows::zeroed()),
-            linear: comparison("shadow::linear_sampler", wgpu::FilterMode::Linear),
-            nearest: comparison("shadow::nearest_sampler", wgpu::FilterMode::Nearest),
+            sampler,
         }
     }
 
@@ -347,8 +343,7 @@ impl ShadowPass {
             uniform: &self.uniform,
             depth: &targets.depth_array,
             transmission: &targets.transmission_array,
-            linear: &self.linear,
-            nearest: &self.nearest,
+            sampler: &self.sampler,
             generation: self.generation,
             layers_drawn,
         }
