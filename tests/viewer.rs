@@ -105,8 +105,10 @@ fn the_showcase_in_the_window_is_the_headless_render() {
         &dir,
     );
     succeeded(&output);
-    let [(path, view)] = views(&output)[..] else { panic!("one screenshot line expected: {output:?}") };
-    assert_eq!(path, shot);
+    let views = views(&output);
+    let [(path, view)] = &views[..] else { panic!("one screenshot line expected: {output:?}") };
+    let view = *view;
+    assert_eq!(path, &shot);
     let image = image::open(&shot).expect("the screenshot is a PNG").into_rgba8();
     assert!(view[0] > 100, "the side panel is left of the view: {view:?}");
     assert_eq!((view[0] + view[2], view[1] + view[3]), image.dimensions(), "the view fills the rest of the window");

@@ -106,11 +106,14 @@ impl Screen {
     pub fn paint(&mut self, output: egui::FullOutput, screenshot: Option<&Path>) -> anyhow::Result<Presented> {
         self.input.handle_platform_output(&self.window, output.platform_output);
         let jobs = self.egui.tessellate(output.shapes, output.pixels_per_point);
-        for (id, deltas) in &output.textures_delta.set {
-            for delta in deltas {
-                self.painter.update_texture(&self.gpu.device, &self.gpu.queue, *id, delta);
+        let mut textures = output.textures_delta;
+        for (id, deltas) in textures.set.drain() {
+            for delta in &deltas {
+                self.painter.update_texture(&self.gpu.device, &self.gpu.queue, id, delta);
             }
         }
+        let freed: Vec<egui::TextureId> = textures.free.drain().collect();
+        textures.clear();
         let frame = match self.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(frame) => Some((frame, false)),
             wgpu::CurrentSurfaceTexture::Suboptimal(frame) => Some((frame, true)),
@@ -130,7 +133,7 @@ impl Screen {
             }
         };
         let Some((frame, suboptimal)) = frame else {
-            for id in &output.textures_delta.free {
+            for id in &freed {
                 self.painter.free_texture(id);
             }
             return Ok(Presented::Skipped);
@@ -154,7 +157,7 @@ impl Screen {
         });
         queue.submit(extra.into_iter().chain([encoder.finish()]));
         queue.present(frame);
-        for id in &output.textures_delta.free {
+        for id in &freed {
             self.painter.free_texture(id);
         }
         if suboptimal {
