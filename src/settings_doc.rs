@@ -70,46 +70,144 @@ fn choice<T: ValueEnum + Serialize>(tooltip: &'static str) -> FieldDoc {
 /// The description of the setting or section at the dotted path `key`, `None` for unknown keys.
 pub fn describe(key: &str) -> Option<FieldDoc> {
     Some(match key {
-        "terms" => doc("Which terms of the illumination model L = ME + AG + Σ V·S·(ka·C + kd·C·(n·l) + ks·S·(r·v)^e) are drawn (TECHNIQUES.md §1)."),
-        "terms.ambient" => doc("The ambient terms: global AG = A ⊗ kd·C and each light's ka·C. Off: surfaces no light reaches go black."),
-        "terms.diffuse" => doc("Lambert's kd·C·max(0, n·l): matte shading that depends on the angle to the light, not on the viewer."),
-        "terms.specular" => doc("Phong's ks·S·max(0, r·v)^e: the highlight that moves with the viewer; e (shininess) sets its size."),
+        "terms" => doc(
+            "Which terms of the illumination model L = ME + AG + Σ V·S·(ka·C + kd·C·(n·l) + ks·S·(r·v)^e) are drawn (TECHNIQUES.md §1).",
+        ),
+        "terms.ambient" => doc(
+            "The ambient terms: global AG = A ⊗ kd·C and each light's ka·C. Off: surfaces no light reaches go black.",
+        ),
+        "terms.diffuse" => {
+            doc("Lambert's kd·C·max(0, n·l): matte shading that depends on the angle to the light, not on the viewer.")
+        }
+        "terms.specular" => {
+            doc("Phong's ks·S·max(0, r·v)^e: the highlight that moves with the viewer; e (shininess) sets its size.")
+        }
         "terms.emission" => doc("ME, the material's own emitted radiance, added whatever the lights."),
-        "exposure" => number("Multiplies linear radiance before the clamp to [0, 1] and the sRGB encoding (the shared output transform).", 0.01, 16.0),
-        "sphere_segments" => number("Slices around the rasterizer's tessellated spheres, tori and rounded boxes; the tracer's shapes are exact, so few slices show polygonal silhouettes in the difference view.", 3.0, 512.0),
-        "textures" => doc("Texture filtering (TECHNIQUES.md §2): mip level from log(distance), trilinear blending between the two nearest levels."),
-        "textures.filter" => choice::<TextureFilter>("How a texel is read: one texel, bilinear, within one mip level, between two (trilinear), anisotropic, or each level in its own colour."),
-        "textures.tracer_lod" => choice::<TracerLod>("How the ray tracer picks the mip level at a hit: the ray cone's footprint, or the seed's log(distance) rule."),
-        "textures.anisotropy" => number("Most samples along the footprint's long axis for the anisotropic filter (1 = isotropic).", 1.0, 16.0),
-        "textures.lod_bias" => number("Added to the mip level λ: positive blurs, negative sharpens and brings back the aliasing mipmaps remove.", -8.0, 8.0),
-        "bump" => doc("Bump mapping (TECHNIQUES.md §3): n' = normalize((t_u + du·n) × (t_v + dv·n)) from a height field's differences."),
-        "bump.enabled" => doc("Perturb the shading normal by the height field's slope; off shades with the geometric normal n."),
-        "bump.tangents" => choice::<TangentSource>("Where the rasterizer's tangents t_u = ∂p/∂u, t_v = ∂p/∂v come from."),
-        "bump.scale" => number("Multiplies every material's k in du = k·(f(u+Δ) − f(u−Δ))/2Δ: relief depth (negative inverts it).", -8.0, 8.0),
-        "bump.delta_texels" => number("The finite-difference step Δ in texels of the height map: small follows detail, large smooths it.", 0.05, 64.0),
-        "bump.analytic" => doc("For procedural height fields, the exact derivatives instead of finite differences (compare the two)."),
-        "bump.view" => choice::<BumpView>("Teaching view: show the perturbed normal n' or the tangent t_u as colour instead of the shading."),
-        "shadows" => doc("Cast shadows (TECHNIQUES.md §4): the visibility V of each light in Σ V·S·(…), by shadow maps or projected polygons; shadow rays in the tracer."),
-        "shadows.enabled" => doc("Compute V for each light; off, every point sees every light (V = 1) in both renderers."),
-        "shadows.method" => choice::<ShadowMethod>("Image precision (two-pass z-buffer from the light) or object precision (casters projected onto planar receivers)."),
-        "shadows.map_size" => number("Texels on each side of a shadow map (pass 1's depth buffer A): small maps give blocky edges.", 256.0, 4096.0),
-        "shadows.filter" => choice::<ShadowFilter>("How the stored depth d is compared around the projected point q: one texel, 2×2, 3×3, 5×5 or a Poisson disc (PCF)."),
-        "shadows.depth_bias" => number("Constant added to d before d < ‖q − y‖: cures self-shadowing acne; too much detaches shadows (peter-panning).", 0.0, 10000.0),
-        "shadows.slope_bias" => number("Bias that grows with the surface's depth slope as the light sees it: acne on grazing surfaces.", 0.0, 16.0),
-        "shadows.normal_offset" => number("Moves the lookup point q along n by this many shadow-map texels before projecting it.", 0.0, 16.0),
-        "shadows.distance" => number("How far from the eye a directional light's orthographic map reaches (0: four times eye–centre, at most far).", 0.0, 10000.0),
-        "shadows.transmission" => doc("Transparent casters (kt > 0) let kt·MT through: coloured, partial shadows (0 < V < 1) instead of black ones."),
-        "shadows.view" => choice::<ShadowView>("Teaching view: the shadow map's depths, or its texels as they land on the receivers."),
-        "shadows.view_layer" => number("Which shadow map the map view shows (a point light has six, one per cube face).", 0.0, 95.0),
-        "shadows.show_frusta" => doc("Draw each shadowed light's view volume (the frustum pass 1 renders) into the scene."),
-        "trace" => doc("The Whitted ray tracer's own settings (TECHNIQUES.md §7): recursion, anti-aliasing, acceleration."),
-        "trace.max_depth" => number("Deepest recursion of reflected kps·L(r) and refracted kt·L(t) rays; 0 leaves local shading only.", 0.0, 64.0),
-        "trace.anti_aliasing" => choice::<AntiAliasing>("How pixels are sampled: one ray through the centre (pixel-aligned with the rasterizer), grids, jitter, corners or adaptive."),
-        "trace.samples" => number("Rays per pixel side for regular and jittered sampling (samples² rays a pixel).", 1.0, 16.0),
+        "exposure" => number(
+            "Multiplies linear radiance before the clamp to [0, 1] and the sRGB encoding (the shared output transform).",
+            0.01,
+            16.0,
+        ),
+        "sphere_segments" => number(
+            "Slices around the rasterizer's tessellated spheres, tori and rounded boxes; the tracer's shapes are exact, so few slices show polygonal silhouettes in the difference view.",
+            3.0,
+            512.0,
+        ),
+        "textures" => doc(
+            "Texture filtering (TECHNIQUES.md §2): mip level from log(distance), trilinear blending between the two nearest levels.",
+        ),
+        "textures.filter" => choice::<TextureFilter>(
+            "How a texel is read: one texel, bilinear, within one mip level, between two (trilinear), anisotropic, or each level in its own colour.",
+        ),
+        "textures.tracer_lod" => choice::<TracerLod>(
+            "How the ray tracer picks the mip level at a hit: the ray cone's footprint, or the seed's log(distance) rule.",
+        ),
+        "textures.anisotropy" => number(
+            "Most samples along the footprint's long axis for the anisotropic filter (1 = isotropic).",
+            1.0,
+            16.0,
+        ),
+        "textures.lod_bias" => number(
+            "Added to the mip level λ: positive blurs, negative sharpens and brings back the aliasing mipmaps remove.",
+            -8.0,
+            8.0,
+        ),
+        "bump" => doc(
+            "Bump mapping (TECHNIQUES.md §3): n' = normalize((t_u + du·n) × (t_v + dv·n)) from a height field's differences.",
+        ),
+        "bump.enabled" => {
+            doc("Perturb the shading normal by the height field's slope; off shades with the geometric normal n.")
+        }
+        "bump.tangents" => {
+            choice::<TangentSource>("Where the rasterizer's tangents t_u = ∂p/∂u, t_v = ∂p/∂v come from.")
+        }
+        "bump.scale" => number(
+            "Multiplies every material's k in du = k·(f(u+Δ) − f(u−Δ))/2Δ: relief depth (negative inverts it).",
+            -8.0,
+            8.0,
+        ),
+        "bump.delta_texels" => number(
+            "The finite-difference step Δ in texels of the height map: small follows detail, large smooths it.",
+            0.05,
+            64.0,
+        ),
+        "bump.analytic" => {
+            doc("For procedural height fields, the exact derivatives instead of finite differences (compare the two).")
+        }
+        "bump.view" => choice::<BumpView>(
+            "Teaching view: show the perturbed normal n' or the tangent t_u as colour instead of the shading.",
+        ),
+        "shadows" => doc(
+            "Cast shadows (TECHNIQUES.md §4): the visibility V of each light in Σ V·S·(…), by shadow maps or projected polygons; shadow rays in the tracer.",
+        ),
+        "shadows.enabled" => {
+            doc("Compute V for each light; off, every point sees every light (V = 1) in both renderers.")
+        }
+        "shadows.method" => choice::<ShadowMethod>(
+            "Image precision (two-pass z-buffer from the light) or object precision (casters projected onto planar receivers).",
+        ),
+        "shadows.map_size" => number(
+            "Texels on each side of a shadow map (pass 1's depth buffer A): small maps give blocky edges.",
+            256.0,
+            4096.0,
+        ),
+        "shadows.filter" => choice::<ShadowFilter>(
+            "How the stored depth d is compared around the projected point q: one texel, 2×2, 3×3, 5×5 or a Poisson disc (PCF).",
+        ),
+        "shadows.depth_bias" => number(
+            "Constant added to d before d < ‖q − y‖: cures self-shadowing acne; too much detaches shadows (peter-panning).",
+            0.0,
+            10000.0,
+        ),
+        "shadows.slope_bias" => number(
+            "Bias that grows with the surface's depth slope as the light sees it: acne on grazing surfaces.",
+            0.0,
+            16.0,
+        ),
+        "shadows.normal_offset" => {
+            number("Moves the lookup point q along n by this many shadow-map texels before projecting it.", 0.0, 16.0)
+        }
+        "shadows.distance" => number(
+            "How far from the eye a directional light's orthographic map reaches (0: four times eye–centre, at most far).",
+            0.0,
+            10000.0,
+        ),
+        "shadows.transmission" => doc(
+            "Transparent casters (kt > 0) let kt·MT through: coloured, partial shadows (0 < V < 1) instead of black ones.",
+        ),
+        "shadows.view" => {
+            choice::<ShadowView>("Teaching view: the shadow map's depths, or its texels as they land on the receivers.")
+        }
+        "shadows.view_layer" => {
+            number("Which shadow map the map view shows (a point light has six, one per cube face).", 0.0, 95.0)
+        }
+        "shadows.show_frusta" => {
+            doc("Draw each shadowed light's view volume (the frustum pass 1 renders) into the scene.")
+        }
+        "trace" => {
+            doc("The Whitted ray tracer's own settings (TECHNIQUES.md §7): recursion, anti-aliasing, acceleration.")
+        }
+        "trace.max_depth" => number(
+            "Deepest recursion of reflected kps·L(r) and refracted kt·L(t) rays; 0 leaves local shading only.",
+            0.0,
+            64.0,
+        ),
+        "trace.anti_aliasing" => choice::<AntiAliasing>(
+            "How pixels are sampled: one ray through the centre (pixel-aligned with the rasterizer), grids, jitter, corners or adaptive.",
+        ),
+        "trace.samples" => {
+            number("Rays per pixel side for regular and jittered sampling (samples² rays a pixel).", 1.0, 16.0)
+        }
         "trace.seed" => number("Seed of the jittered pattern: the same seed draws the same image.", 0.0, 1.0e9),
-        "trace.adaptive_threshold" => number("Adaptive sampling splits a square while its corners differ by more than this (0–1 output values).", 0.0, 1.0),
+        "trace.adaptive_threshold" => number(
+            "Adaptive sampling splits a square while its corners differ by more than this (0–1 output values).",
+            0.0,
+            1.0,
+        ),
         "trace.adaptive_max_level" => number("Deepest subdivision of adaptive sampling.", 0.0, 6.0),
-        "trace.accelerator" => choice::<AccelKind>("How rays find the nearest hit: BVH, uniform grid, octree, or every primitive (brute force); the image is the same."),
+        "trace.accelerator" => choice::<AccelKind>(
+            "How rays find the nearest hit: BVH, uniform grid, octree, or every primitive (brute force); the image is the same.",
+        ),
         _ => return None,
     })
 }

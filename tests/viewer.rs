@@ -18,8 +18,7 @@ use mirador::Scene;
 const MAX_FLIP_MEAN: f32 = 0.01;
 
 fn on_path(program: &str) -> bool {
-    std::env::var_os("PATH")
-        .is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
+    std::env::var_os("PATH").is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
 }
 
 /// The viewer with `args`, under `xvfb-run -a` when it exists, else on the current display.
@@ -59,7 +58,8 @@ fn views(output: &Output) -> Vec<(PathBuf, [u32; 4])> {
         .filter_map(|line| {
             let rest = line.strip_prefix("screenshot ")?;
             let (path, geometry) = rest.split_once(" window ")?;
-            let numbers: Vec<u32> = geometry.split_once(" view ")?.1.split(' ').filter_map(|n| n.parse().ok()).collect();
+            let numbers: Vec<u32> =
+                geometry.split_once(" view ")?.1.split(' ').filter_map(|n| n.parse().ok()).collect();
             Some((PathBuf::from(path), numbers.try_into().ok()?))
         })
         .collect()
@@ -127,7 +127,8 @@ fn the_showcase_in_the_window_is_the_headless_render() {
 #[test]
 fn scripted_toggles_and_view_modes_run_and_exit_cleanly() {
     let dir = scratch("modes");
-    let shots: Vec<PathBuf> = ["toggled", "split", "difference", "traced"].iter().map(|n| dir.join(format!("{n}.png"))).collect();
+    let shots: Vec<PathBuf> =
+        ["toggled", "split", "difference", "traced"].iter().map(|n| dir.join(format!("{n}.png"))).collect();
     let step = |s: &str| s.to_string();
     let mut steps = vec![
         step("overlay off"),
@@ -196,7 +197,10 @@ fn scripted_toggles_and_view_modes_run_and_exit_cleanly() {
 
     // The toggled frame differs from the default one.
     let toggled = crop(&image::open(&shots[0]).unwrap().into_rgba8(), views[0].1);
-    assert!(flip(&crop(&raster, [0, 0, views[0].1[2], views[0].1[3]]), &toggled, "toggled", &dir) > 0.02, "toggles change the image");
+    assert!(
+        flip(&crop(&raster, [0, 0, views[0].1[2], views[0].1[3]]), &toggled, "toggled", &dir) > 0.02,
+        "toggles change the image"
+    );
 }
 
 #[test]
@@ -206,10 +210,8 @@ fn a_scene_that_fails_to_load_keeps_the_previous_one() {
     std::fs::write(&bad, "[camera\neye = [0, 0, 1]\n").unwrap();
     let shot = dir.join("after.png");
     let load = format!("load {}", bad.display());
-    let output = viewer(
-        &["--size", "640x400", "--frames", "2", "--step", &load, "--screenshot", shot.to_str().unwrap()],
-        &dir,
-    );
+    let output =
+        viewer(&["--size", "640x400", "--frames", "2", "--step", &load, "--screenshot", shot.to_str().unwrap()], &dir);
     succeeded(&output);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(stderr.contains("broken.toml"), "the load error names the file: {stderr}");

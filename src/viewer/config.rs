@@ -64,7 +64,10 @@ pub fn load(path: &Path) -> (ViewerConfig, Option<String>) {
         }
         Err(e) => {
             let message = e.message().trim().to_string();
-            (ViewerConfig::default(), Some(format!("{}: not a valid viewer configuration ({message}); ignored", path.display())))
+            (
+                ViewerConfig::default(),
+                Some(format!("{}: not a valid viewer configuration ({message}); ignored", path.display())),
+            )
         }
     }
 }

@@ -142,7 +142,8 @@ impl Viewer {
     /// Draws one frame.
     pub fn frame(&mut self, screen: &mut Screen) -> anyhow::Result<FrameEnd> {
         let start = Instant::now();
-        let mut times = FrameTimes { frame: self.last_frame.map_or(Duration::ZERO, |t| start - t), ..Default::default() };
+        let mut times =
+            FrameTimes { frame: self.last_frame.map_or(Duration::ZERO, |t| start - t), ..Default::default() };
         self.last_frame = Some(start);
         let mut input = CameraInput::default();
         self.run_script(&mut input)?;
@@ -187,7 +188,8 @@ impl Viewer {
         let scale = self.scale(Instant::now());
         if let Some((_, _, width, height)) = self.view_pixels {
             let full_size = (width, height);
-            let scaled = (((width as f32) * scale).round().max(1.0) as u32, ((height as f32) * scale).round().max(1.0) as u32);
+            let scaled =
+                (((width as f32) * scale).round().max(1.0) as u32, ((height as f32) * scale).round().max(1.0) as u32);
             let filter = if scaled == full_size { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
             self.scene.scene.camera.width = scaled.0;
             self.scene.scene.camera.height = scaled.1;
@@ -255,9 +257,8 @@ impl Viewer {
                 Action::Frame => self.frame_scene(),
                 Action::Reset => self.reset_camera(),
                 Action::Screenshot => {
-                    let seconds = std::time::SystemTime::now()
-                        .duration_since(std::time::UNIX_EPOCH)
-                        .map_or(0, |d| d.as_secs());
+                    let seconds =
+                        std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
                     self.screenshot = Some(PathBuf::from(format!("mirador-{seconds}.png")));
                 }
                 Action::DismissError => self.scene.error = None,
@@ -336,10 +337,12 @@ impl Viewer {
         let mut scene = self.scene.scene.clone();
         scene.camera = camera.clone();
         self.traced.worker.trace(self.key, &scene, settings);
-        if self.view.mode == ViewMode::Difference && full_resolution && !self.traced.worker.compared(self.key) {
-            if let Some(image) = self.raster.read_back(&screen.gpu) {
-                self.traced.worker.compare(self.key, image);
-            }
+        if self.view.mode == ViewMode::Difference
+            && full_resolution
+            && !self.traced.worker.compared(self.key)
+            && let Some(image) = self.raster.read_back(&screen.gpu)
+        {
+            self.traced.worker.compare(self.key, image);
         }
     }
 

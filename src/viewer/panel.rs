@@ -19,7 +19,11 @@ fn label(key: &str) -> String {
 }
 
 fn tooltip(key: &str) -> FieldDoc {
-    describe(key).unwrap_or(FieldDoc { tooltip: "(no description: add one to src/settings_doc.rs)", choices: Vec::new(), range: None })
+    describe(key).unwrap_or(FieldDoc {
+        tooltip: "(no description: add one to src/settings_doc.rs)",
+        choices: Vec::new(),
+        range: None,
+    })
 }
 
 /// Draws the settings, one section per technique; returns the assignments (`key=value`) the user
@@ -83,7 +87,10 @@ fn field(ui: &mut egui::Ui, key: &str, value: &toml::Value, changes: &mut Vec<St
         let changed: Option<toml::Value> = match value {
             toml::Value::Boolean(on) => {
                 let mut on = *on;
-                ui.checkbox(&mut on, name.as_str()).on_hover_text(doc.tooltip).changed().then_some(toml::Value::Boolean(on))
+                ui.checkbox(&mut on, name.as_str())
+                    .on_hover_text(doc.tooltip)
+                    .changed()
+                    .then_some(toml::Value::Boolean(on))
             }
             toml::Value::Integer(n) => {
                 let mut n = *n;
@@ -97,8 +104,7 @@ fn field(ui: &mut egui::Ui, key: &str, value: &toml::Value, changes: &mut Vec<St
                 let mut x = *x;
                 let (low, high) = doc.range.unwrap_or((-1e6, 1e6));
                 let speed = ((high - low) / 1000.0).clamp(1e-3, 10.0);
-                let response =
-                    ui.add(egui::DragValue::new(&mut x).range(low..=high).speed(speed).max_decimals(3));
+                let response = ui.add(egui::DragValue::new(&mut x).range(low..=high).speed(speed).max_decimals(3));
                 ui.label(name.as_str()).on_hover_text(doc.tooltip);
                 response.on_hover_text(doc.tooltip).changed().then_some(toml::Value::Float(x))
             }
@@ -108,7 +114,8 @@ fn field(ui: &mut egui::Ui, key: &str, value: &toml::Value, changes: &mut Vec<St
                     .selected_text(current.replace('_', " "))
                     .show_ui(ui, |ui| {
                         for choice in &doc.choices {
-                            let mut item = ui.selectable_label(*current == choice.value, choice.value.replace('_', " "));
+                            let mut item =
+                                ui.selectable_label(*current == choice.value, choice.value.replace('_', " "));
                             if let Some(help) = &choice.help {
                                 item = item.on_hover_text(help);
                             }

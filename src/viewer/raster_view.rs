@@ -96,7 +96,12 @@ impl RasterView {
             start.elapsed()
         });
         if self.bound != Some((size, filter)) {
-            egui_renderer.update_egui_texture_from_wgpu_texture(&gpu.device, &frame.display_view, filter, self.texture_id);
+            egui_renderer.update_egui_texture_from_wgpu_texture(
+                &gpu.device,
+                &frame.display_view,
+                filter,
+                self.texture_id,
+            );
             self.bound = Some((size, filter));
         }
         (self.texture_id, elapsed)

@@ -11,7 +11,8 @@ fn vec3_ui(ui: &mut egui::Ui, name: &str, v: &mut Vec3, speed: f32, tip: &str) -
     ui.horizontal(|ui| {
         let mut changed = false;
         for c in 0..3 {
-            changed |= ui.add(egui::DragValue::new(&mut v[c]).speed(speed).max_decimals(3)).on_hover_text(tip).changed();
+            changed |=
+                ui.add(egui::DragValue::new(&mut v[c]).speed(speed).max_decimals(3)).on_hover_text(tip).changed();
         }
         ui.label(name).on_hover_text(tip);
         changed
@@ -58,9 +59,22 @@ pub fn camera_ui(ui: &mut egui::Ui, camera: &mut Camera, error: &mut Option<Stri
     changed |= vec3_ui(ui, "eye", &mut edited.eye, 0.05, "Where the eye is: the origin of the primary rays.");
     changed |= vec3_ui(ui, "center", &mut edited.center, 0.05, "The point looked at: ze = normalize(eye − center).");
     changed |= vec3_ui(ui, "up", &mut edited.up, 0.01, "Which way is up: xe = normalize(up × ze), ye = ze × xe.");
-    changed |= number_ui(ui, "fovy", &mut edited.fovy_degrees, 1.0..=179.0, "Vertical field of view in degrees: h = 2·near·tan(fovy/2).");
-    changed |= number_ui(ui, "near", &mut edited.near, 1e-4..=1e4, "Distance of the near plane, where the view window lies.");
-    changed |= number_ui(ui, "far", &mut edited.far, 1e-3..=1e6, "Distance of the far clipping plane (the z-buffer's depth range).");
+    changed |= number_ui(
+        ui,
+        "fovy",
+        &mut edited.fovy_degrees,
+        1.0..=179.0,
+        "Vertical field of view in degrees: h = 2·near·tan(fovy/2).",
+    );
+    changed |=
+        number_ui(ui, "near", &mut edited.near, 1e-4..=1e4, "Distance of the near plane, where the view window lies.");
+    changed |= number_ui(
+        ui,
+        "far",
+        &mut edited.far,
+        1e-3..=1e6,
+        "Distance of the far clipping plane (the z-buffer's depth range).",
+    );
     if !changed {
         return false;
     }
@@ -117,13 +131,15 @@ pub fn lights_ui(ui: &mut egui::Ui, lights: &mut [Light]) -> bool {
             let direction_tip = "The direction the light travels (unit); l = −direction at every point.";
             match &mut light.kind {
                 LightKind::Point { position } => {
-                    changed |= vec3_ui(ui, "position", position, 0.05, "Where the light is; l = normalize(position − p).");
+                    changed |=
+                        vec3_ui(ui, "position", position, 0.05, "Where the light is; l = normalize(position − p).");
                 }
                 LightKind::Directional { direction } => {
                     changed |= direction_ui(ui, direction, direction_tip);
                 }
                 LightKind::Spot { position, direction, inner, outer } => {
-                    changed |= vec3_ui(ui, "position", position, 0.05, "Where the light is; l = normalize(position − p).");
+                    changed |=
+                        vec3_ui(ui, "position", position, 0.05, "Where the light is; l = normalize(position − p).");
                     changed |= direction_ui(ui, direction, "The spot's axis (unit).");
                     let (mut inner_deg, mut outer_deg) = (inner.to_degrees(), outer.to_degrees());
                     let cone = "Full strength within `inner` of the axis, none beyond `outer`, smoothstep between.";
@@ -136,8 +152,19 @@ pub fn lights_ui(ui: &mut egui::Ui, lights: &mut [Light]) -> bool {
                     }
                 }
             }
-            changed |= colour_ui(ui, "colour", &mut light.color, "The light's linear RGB colour, multiplied by intensity: S_i.");
-            changed |= number_ui(ui, "intensity", &mut light.intensity, 0.0..=1e4, "Multiplies the colour: S_i = colour · intensity · fat.");
+            changed |= colour_ui(
+                ui,
+                "colour",
+                &mut light.color,
+                "The light's linear RGB colour, multiplied by intensity: S_i.",
+            );
+            changed |= number_ui(
+                ui,
+                "intensity",
+                &mut light.intensity,
+                0.0..=1e4,
+                "Multiplies the colour: S_i = colour · intensity · fat.",
+            );
         });
     }
     changed
@@ -158,19 +185,51 @@ fn direction_ui(ui: &mut egui::Ui, direction: &mut Vec3, tip: &str) -> bool {
 /// changed.
 pub fn material_ui(ui: &mut egui::Ui, material: &mut Material) -> bool {
     let mut changed = false;
-    changed |= colour_ui(ui, "colour C", &mut material.color, "C: the surface colour (times its texture) in ka·C and kd·C.");
+    changed |=
+        colour_ui(ui, "colour C", &mut material.color, "C: the surface colour (times its texture) in ka·C and kd·C.");
     changed |= number_ui(ui, "ka", &mut material.ka, 0.0..=1.0, "Ambient coefficient: ka·C per visible light.");
     changed |= number_ui(ui, "kd", &mut material.kd, 0.0..=1.0, "Diffuse coefficient: kd·C·max(0, n·l), Lambert.");
     changed |= number_ui(ui, "ks", &mut material.ks, 0.0..=1.0, "Specular coefficient: ks·S·max(0, r·v)^e, Phong.");
-    changed |= colour_ui(ui, "specular S", &mut material.specular_color, "S: the highlight's colour (white for plastics, the base colour for metals).");
-    changed |= number_ui(ui, "shininess e", &mut material.shininess, 0.0..=10000.0, "Phong exponent e: larger gives a smaller, sharper highlight.");
+    changed |= colour_ui(
+        ui,
+        "specular S",
+        &mut material.specular_color,
+        "S: the highlight's colour (white for plastics, the base colour for metals).",
+    );
+    changed |= number_ui(
+        ui,
+        "shininess e",
+        &mut material.shininess,
+        0.0..=10000.0,
+        "Phong exponent e: larger gives a smaller, sharper highlight.",
+    );
     changed |= colour_ui(ui, "emission ME", &mut material.emission, "ME: radiance the surface emits by itself.");
-    changed |= number_ui(ui, "mirror kps", &mut material.mirror, 0.0..=1.0, "kps·MPS·L(r): perfect mirror reflection (traced; the rasterizer's planar mirrors later).");
+    changed |= number_ui(
+        ui,
+        "mirror kps",
+        &mut material.mirror,
+        0.0..=1.0,
+        "kps·MPS·L(r): perfect mirror reflection (traced; the rasterizer's planar mirrors later).",
+    );
     changed |= colour_ui(ui, "mirror MPS", &mut material.mirror_color, "MPS: the colour of the mirror reflection.");
-    changed |= number_ui(ui, "transmission kt", &mut material.transmission, 0.0..=1.0, "kt·MT·L(t): light through the surface; kt > 0 also tints shadows.");
-    changed |= colour_ui(ui, "transmission MT", &mut material.transmission_color, "MT: the colour of the transmitted light.");
-    changed |= number_ui(ui, "ior", &mut material.ior, 1.0..=4.0, "Index of refraction: Snell's n_i sin θ_i = n_t sin θ_t.");
-    changed |= number_ui(ui, "bump k", &mut material.bump_scale, -16.0..=16.0, "The bump scale k of du = k·∂f/∂u (with a height map or field).");
+    changed |= number_ui(
+        ui,
+        "transmission kt",
+        &mut material.transmission,
+        0.0..=1.0,
+        "kt·MT·L(t): light through the surface; kt > 0 also tints shadows.",
+    );
+    changed |=
+        colour_ui(ui, "transmission MT", &mut material.transmission_color, "MT: the colour of the transmitted light.");
+    changed |=
+        number_ui(ui, "ior", &mut material.ior, 1.0..=4.0, "Index of refraction: Snell's n_i sin θ_i = n_t sin θ_t.");
+    changed |= number_ui(
+        ui,
+        "bump k",
+        &mut material.bump_scale,
+        -16.0..=16.0,
+        "The bump scale k of du = k·∂f/∂u (with a height map or field).",
+    );
     changed
 }
 
@@ -178,7 +237,8 @@ pub fn material_ui(ui: &mut egui::Ui, material: &mut Material) -> bool {
 pub fn set_material(material: &mut Material, assignment: &str) -> Result<(), String> {
     let (key, value) = assignment.split_once('=').ok_or("expected key=value")?;
     let (key, value) = (key.trim(), value.trim());
-    let number = || value.parse::<f32>().ok().filter(|x| x.is_finite()).ok_or(format!("{key}: `{value}` is not a number"));
+    let number =
+        || value.parse::<f32>().ok().filter(|x| x.is_finite()).ok_or(format!("{key}: `{value}` is not a number"));
     let colour = || -> Result<Vec3, String> {
         let parts: Vec<f32> = value
             .trim_matches(|c| c == '[' || c == ']')

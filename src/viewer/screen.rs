@@ -123,7 +123,8 @@ impl Screen {
                 None
             }
             wgpu::CurrentSurfaceTexture::Lost => {
-                self.surface = self.gpu.instance.create_surface(self.window.clone()).context("recreating the lost surface")?;
+                self.surface =
+                    self.gpu.instance.create_surface(self.window.clone()).context("recreating the lost surface")?;
                 self.resize(self.window.inner_size());
                 None
             }
@@ -145,13 +146,13 @@ impl Screen {
         };
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer::ui") });
         let extra = self.painter.update_buffers(device, queue, &mut encoder, &jobs, &screen);
-        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("viewer::surface_view"),
-            ..Default::default()
-        });
+        let view = frame
+            .texture
+            .create_view(&wgpu::TextureViewDescriptor { label: Some("viewer::surface_view"), ..Default::default() });
         self.record_ui(&mut encoder, &view, &jobs, &screen);
         let shot = screenshot.map(|_| {
-            let texture = crate::gpu::texture::GpuTexture::target(device, "viewer::screenshot", self.size(), self.config.format);
+            let texture =
+                crate::gpu::texture::GpuTexture::target(device, "viewer::screenshot", self.size(), self.config.format);
             self.record_ui(&mut encoder, &texture.view, &jobs, &screen);
             texture
         });

@@ -90,7 +90,9 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
     Ok(match verb {
         "set" => Step::Set(assignment("set")?),
         "material" => Step::Material(assignment("material")?),
-        "view" => Step::View(ViewMode::parse(args).ok_or_else(|| fail("the view is raster, traced, split or difference"))?),
+        "view" => {
+            Step::View(ViewMode::parse(args).ok_or_else(|| fail("the view is raster, traced, split or difference"))?)
+        }
         "split" => {
             let [x] = numbers(args).ok_or_else(|| fail("expected a fraction of the width"))?;
             if !(0.0..=1.0).contains(&x) {

@@ -181,7 +181,10 @@ fn file(request: Request, pending: &mut Option<Request>, raster: &mut Option<(u6
 
 /// The FLIP comparison, once the raster image and the final traced image of one request are both
 /// there.
-fn compare_ready(raster: &mut Option<(u64, RgbaImage)>, finished: &Option<(u64, RgbaImage)>) -> Option<DifferenceFrame> {
+fn compare_ready(
+    raster: &mut Option<(u64, RgbaImage)>,
+    finished: &Option<(u64, RgbaImage)>,
+) -> Option<DifferenceFrame> {
     let ((raster_key, raster_image), (traced_key, traced_image)) = (raster.as_ref()?, finished.as_ref()?);
     if raster_key != traced_key {
         return None;

@@ -113,7 +113,8 @@ fn keys(ctx: &egui::Context, model: &mut UiModel, output: &mut UiOutput) {
             }
         }
         if *model.navigation == Navigation::Fly {
-            let axis = |plus, minus| f32::from(u8::from(input.key_down(plus))) - f32::from(u8::from(input.key_down(minus)));
+            let axis =
+                |plus, minus| f32::from(u8::from(input.key_down(plus))) - f32::from(u8::from(input.key_down(minus)));
             output.camera.walk = Vec3::new(axis(Key::D, Key::A), axis(Key::E, Key::Q), axis(Key::W, Key::S));
             output.camera.fast = input.modifiers.shift;
         }
@@ -133,15 +134,17 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
         }
     });
     ui.horizontal(|ui| {
-        ui.selectable_value(model.navigation, Navigation::Orbit, "orbit").on_hover_text("Drag to turn around the target (G).");
+        ui.selectable_value(model.navigation, Navigation::Orbit, "orbit")
+            .on_hover_text("Drag to turn around the target (G).");
         ui.selectable_value(model.navigation, Navigation::Fly, "fly").on_hover_text("WASD to walk, drag to look (G).");
         if ui.button("help").clicked() {
             model.view.help_open = true;
         }
     });
     ui.horizontal(|ui| {
-        ui.add(egui::Slider::new(&mut model.view.motion_scale, 0.25..=1.0).step_by(0.05))
-            .on_hover_text("The render scale while the camera moves: fewer pixels, more frames; full resolution again when it stops.");
+        ui.add(egui::Slider::new(&mut model.view.motion_scale, 0.25..=1.0).step_by(0.05)).on_hover_text(
+            "The render scale while the camera moves: fewer pixels, more frames; full resolution again when it stops.",
+        );
         ui.label("scale when moving");
     });
     ui.separator();
@@ -182,7 +185,9 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     );
     ui.separator();
     let source = model.scene.scene.source.as_ref().map_or("(built in)".to_string(), |p| p.display().to_string());
-    ui.label(format!("scene: {source}")).on_hover_text("Drop a .toml scene or a .gltf/.glb model on the window to open it; the file is reloaded when it changes.");
+    ui.label(format!("scene: {source}")).on_hover_text(
+        "Drop a .toml scene or a .gltf/.glb model on the window to open it; the file is reloaded when it changes.",
+    );
     for notice in model.notices.iter().rev().take(3) {
         ui.small(notice);
     }
@@ -190,7 +195,8 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
 
 /// Rounds a rectangle to whole physical pixels, so images drawn into it are pixel-aligned.
 fn snap(rect: Rect, pixels_per_point: f32) -> Rect {
-    let round = |p: Pos2| Pos2::new((p.x * pixels_per_point).round(), (p.y * pixels_per_point).round()) / pixels_per_point;
+    let round =
+        |p: Pos2| Pos2::new((p.x * pixels_per_point).round(), (p.y * pixels_per_point).round()) / pixels_per_point;
     Rect::from_min_max(round(rect.min), round(rect.max))
 }
 
@@ -242,15 +248,21 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
         overlay(ui, model, rect);
     }
     if let Some(error) = model.scene.error.clone() {
-        egui::Area::new(egui::Id::unique("mirador::scene_error")).fixed_pos(rect.min + egui::vec2(12.0, 12.0)).show(ui.ctx(), |ui| {
-            egui::Frame::popup(ui.style()).fill(Color32::from_rgb(90, 20, 20)).show(ui, |ui| {
-                ui.set_max_width(rect.width() - 40.0);
-                ui.colored_label(Color32::WHITE, format!("The scene could not be loaded; the previous one is kept.\n{error}"));
-                if ui.button("dismiss").clicked() {
-                    output.actions.push(Action::DismissError);
-                }
-            });
-        });
+        egui::Area::new(egui::Id::unique("mirador::scene_error")).fixed_pos(rect.min + egui::vec2(12.0, 12.0)).show(
+            ui.ctx(),
+            |ui| {
+                egui::Frame::popup(ui.style()).fill(Color32::from_rgb(90, 20, 20)).show(ui, |ui| {
+                    ui.set_max_width(rect.width() - 40.0);
+                    ui.colored_label(
+                        Color32::WHITE,
+                        format!("The scene could not be loaded; the previous one is kept.\n{error}"),
+                    );
+                    if ui.button("dismiss").clicked() {
+                        output.actions.push(Action::DismissError);
+                    }
+                });
+            },
+        );
     }
 }
 
@@ -280,7 +292,9 @@ fn camera_input(ui: &egui::Ui, response: &egui::Response, rect: Rect, ppp: f32, 
 /// The split view's divider: a line you can drag.
 fn divider(ui: &mut egui::Ui, model: &mut UiModel, rect: Rect, x: f32) {
     let handle = Rect::from_min_max(Pos2::new(x - 5.0, rect.min.y), Pos2::new(x + 5.0, rect.max.y));
-    let response = ui.interact(handle, ui.scope_id().with("split_divider"), Sense::drag()).on_hover_cursor(egui::CursorIcon::ResizeHorizontal);
+    let response = ui
+        .interact(handle, ui.scope_id().with("split_divider"), Sense::drag())
+        .on_hover_cursor(egui::CursorIcon::ResizeHorizontal);
     if response.dragged()
         && let Some(pointer) = response.interact_pointer_pos()
     {
@@ -302,10 +316,14 @@ fn divider(ui: &mut egui::Ui, model: &mut UiModel, rect: Rect, x: f32) {
 /// corner.
 fn overlay(ui: &egui::Ui, model: &UiModel, rect: Rect) {
     let mut text = model.stats.overlay_text(model.scale);
-    text += &format!("\nview: {}  ({})", model.view.mode.label(), match model.navigation {
-        Navigation::Orbit => "orbit",
-        Navigation::Fly => "fly",
-    });
+    text += &format!(
+        "\nview: {}  ({})",
+        model.view.mode.label(),
+        match model.navigation {
+            Navigation::Orbit => "orbit",
+            Navigation::Fly => "fly",
+        }
+    );
     if model.view.mode.needs_traced() {
         text += &match model.traced.image.as_ref() {
             Some(shown) if shown.key == model.key && shown.complete => {

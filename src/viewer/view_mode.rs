@@ -57,6 +57,13 @@ pub struct ViewState {
 
 impl Default for ViewState {
     fn default() -> Self {
-        ViewState { mode: ViewMode::Raster, split: 0.5, motion_scale: 0.5, panel_open: true, help_open: false, overlay_open: true }
+        ViewState {
+            mode: ViewMode::Raster,
+            split: 0.5,
+            motion_scale: 0.5,
+            panel_open: true,
+            help_open: false,
+            overlay_open: true,
+        }
     }
 }
