@@ -188,8 +188,9 @@ impl App {
         let was_done = viewer.script_done();
         let result = viewer.frame(screen);
         self.frames += 1;
-        if self.options.stats && !was_done && viewer.script_done() {
-            // Measure the state the script set up, not the steps getting there.
+        // Measure the state the script set up, not the steps getting there nor the first frames
+        // (the driver compiles its pipelines lazily).
+        if (!was_done && viewer.script_done()) || (self.frames == 2 && viewer.script_done()) {
             viewer.stats.reset();
         }
         match result {
