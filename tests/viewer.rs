@@ -219,7 +219,7 @@ fn a_scene_that_fails_to_load_keeps_the_previous_one() {
 }
 
 #[test]
-fn bad_steps_are_refused_before_a_window_opens() {
+fn bad_steps_and_outputs_fail_with_a_message() {
     let dir = scratch("bad-steps");
     for args in [
         vec!["--frames", "1", "--step", "dance"],

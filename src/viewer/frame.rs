@@ -384,6 +384,10 @@ impl Viewer {
             Step::Frame => self.frame_scene(),
             Step::Reset => self.reset_camera(),
             Step::Navigate(navigation) => self.navigation = navigation,
+            Step::Pick(pixel) if self.view_pixels.is_none() => {
+                // The view has no size before its first frame: pick on the next one.
+                self.script.steps.push_front(Step::Pick(pixel));
+            }
             Step::Pick(pixel) => {
                 self.pick(pixel);
                 if self.scene.picked.is_none() {

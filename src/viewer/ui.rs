@@ -347,7 +347,10 @@ fn overlay(ui: &egui::Ui, model: &UiModel, rect: Rect) {
         .interactable(false)
         .show(ui.ctx(), |ui| {
             egui::Frame::popup(ui.style()).fill(Color32::from_black_alpha(170)).show(ui, |ui| {
-                ui.label(egui::RichText::new(text).monospace().color(Color32::WHITE).size(12.0));
+                ui.add(
+                    egui::Label::new(egui::RichText::new(text).monospace().color(Color32::WHITE).size(12.0))
+                        .wrap_mode(egui::TextWrapMode::Extend),
+                );
             });
         });
 }
