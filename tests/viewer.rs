@@ -233,3 +233,33 @@ fn bad_steps_and_outputs_fail_with_a_message() {
         assert!(stderr.contains("error"), "{args:?}: {stderr}");
     }
 }
+
+#[test]
+fn a_scene_file_changed_on_disk_is_reloaded() {
+    let dir = scratch("reload");
+    let scene = dir.join("scene.toml");
+    let original = std::fs::read_to_string(common::asset("scenes/seed-simple.toml")).expect("the seed scene");
+    std::fs::write(&scene, &original).unwrap();
+    let binary = env!("CARGO_BIN_EXE_mirador");
+    assert!(on_path("xvfb-run"), "install Xvfb (`sudo apt-get install xvfb`) to run the viewer tests");
+    let mut child = Command::new("xvfb-run")
+        .args(["-a", binary, "view", scene.to_str().unwrap(), "--size", "480x320", "--frames", "2"])
+        .args(["--step", "wait 60"])
+        .env("XDG_CONFIG_HOME", &dir)
+        .env("RUST_LOG", "mirador=info")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("starting the viewer");
+    // Touch the file until the viewer is done: it polls the modification time twice a second.
+    let mut edits = 0;
+    while child.try_wait().expect("polling the viewer").is_none() {
+        std::thread::sleep(std::time::Duration::from_millis(300));
+        edits += 1;
+        std::fs::write(&scene, format!("{original}\n# edit {edits}\n")).unwrap();
+    }
+    let output = child.wait_with_output().expect("the viewer's output");
+    succeeded(&output);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("changed on disk"), "the edited scene was reloaded: {stderr}");
+}
