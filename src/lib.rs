@@ -7,6 +7,7 @@
 //! - [`raster`]: the z-buffer renderer, one pass per technique.
 //! - [`output`]: the output transform both renderers share.
 //! - [`compare`]: image metrics for golden images and raster-vs-trace comparisons.
+//! - [`viewer`]: the interactive window (winit + egui) over both renderers.
 
 // Checks like `!(x > 0.0)` are written that way on purpose: unlike `x <= 0.0` they also reject
 // NaN, which user input can carry.
@@ -18,9 +19,11 @@ pub mod output;
 pub mod raster;
 pub mod scene;
 pub mod settings;
+pub mod settings_doc;
 pub mod shaders;
 pub mod texture;
 pub mod trace;
+pub mod viewer;
 
 pub use scene::Scene;
 pub use settings::RenderSettings;

@@ -1,12 +1,12 @@
-//! The `mirador` command line: headless screenshots from the rasterizer (`render`) and the ray
-//! tracer (`trace`), and the two side by side (`compare`). The viewer takes the bare `mirador`
-//! once it lands.
+//! The `mirador` command line: the interactive viewer (`view`, and the bare `mirador`), headless
+//! screenshots from the rasterizer (`render`) and the ray tracer (`trace`), and the two side by
+//! side (`compare`).
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{Context, bail};
-use clap::{CommandFactory, Parser, Subcommand};
+use clap::{Parser, Subcommand};
 
 use mirador::compare::sheet::{Panel, flip_legend, sheet, with_footer};
 use mirador::gpu::texture::GpuTexture;
@@ -30,6 +30,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Open the interactive viewer (what `mirador` alone does): raster, ray traced, split and
+    /// difference views, every technique's settings in a panel. Press F1 in the window for keys.
+    View(ViewArgs),
     /// Render a scene with the z-buffer rasterizer into a PNG.
     Render {
         #[command(flatten)]
@@ -87,6 +90,46 @@ struct SceneArgs {
     stats: bool,
 }
 
+#[derive(clap::Args, Default)]
+struct ViewArgs {
+    /// Scene file (TOML, or a .gltf/.glb model). Default: the built-in showcase.
+    scene: Option<PathBuf>,
+    /// Change a render setting, as a dotted key and a TOML value: `--set shadows.enabled=false`.
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Run this many frames (after the scripted steps), then exit. Scripted runs neither read
+    /// nor write the remembered settings.
+    #[arg(long, value_name = "N")]
+    frames: Option<u64>,
+    /// With --frames: write the window's image after the last frame (PNG, atomically).
+    #[arg(long, value_name = "FILE", requires = "frames")]
+    screenshot: Option<PathBuf>,
+    /// A scripted step, one per frame, in order: `set KEY=VALUE`, `view raster|traced|split|difference`,
+    /// `split X`, `orbit DX DY`, `pan DX DY`, `zoom N`, `frame`, `reset`, `navigate orbit|fly`,
+    /// `walk X Y Z`, `pick X Y`, `material KEY=VALUE`, `load FILE`, `scale S`, `help on|off`,
+    /// `panel on|off`, `overlay on|off`, `wait N`, `wait traced`, `screenshot FILE.png`.
+    #[arg(long = "step", value_name = "STEP", requires = "frames")]
+    steps: Vec<String>,
+    /// A file of steps, one a line (`#` comments); run before any --step.
+    #[arg(long, value_name = "FILE", requires = "frames")]
+    script: Option<PathBuf>,
+    /// Print frame times, frames per second and the UI's share at the end.
+    #[arg(long)]
+    stats: bool,
+    /// The window's inner size, WIDTHxHEIGHT (default: as last time, else 1280x720).
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    size: Option<[u32; 2]>,
+}
+
+fn parse_size(text: &str) -> Result<[u32; 2], String> {
+    let (w, h) = text.split_once(['x', 'X', '×']).ok_or("expected WIDTHxHEIGHT, e.g. 1280x720")?;
+    let side = |s: &str| s.trim().parse::<u32>().ok().filter(|v| (64..=8192).contains(v));
+    match (side(w), side(h)) {
+        (Some(w), Some(h)) => Ok([w, h]),
+        _ => Err("each side must be a whole number of pixels from 64 to 8192".into()),
+    }
+}
+
 #[derive(clap::Args)]
 struct TraceArgs {
     /// Anti-aliasing (default: the scene's `trace.anti_aliasing`, else one ray per pixel centre).
@@ -118,10 +161,8 @@ fn main() -> ExitCode {
         Some(Command::Compare { scene, trace, output, raster_out, trace_out, error_out }) => {
             compare(scene, trace, &output, [raster_out, trace_out, error_out])
         }
-        None => {
-            Cli::command().print_help().expect("writing help to stdout");
-            Ok(())
-        }
+        Some(Command::View(args)) => view(args),
+        None => view(ViewArgs::default()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -130,6 +171,29 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn view(args: ViewArgs) -> anyhow::Result<()> {
+    use mirador::viewer::{ViewerOptions, run, script};
+    if let Some(path) = &args.screenshot {
+        check_png(path)?;
+    }
+    let mut steps = match &args.script {
+        Some(path) => script::parse_file(path)?,
+        None => Vec::new(),
+    };
+    for step in &args.steps {
+        steps.push(script::parse(step)?);
+    }
+    run(ViewerOptions {
+        scene: args.scene,
+        set: args.set,
+        frames: args.frames,
+        screenshot: args.screenshot,
+        steps,
+        stats: args.stats,
+        size: args.size,
+    })
 }
 
 /// Every output must be a PNG; checked before any work is done.

@@ -198,10 +198,17 @@ fn an_existing_image_survives_a_failed_render() {
 }
 
 #[test]
-fn no_arguments_print_help() {
-    let output = mirador(&[]);
-    assert!(output.status.success());
-    assert!(String::from_utf8_lossy(&output.stdout).contains("render"));
+fn no_arguments_open_the_viewer_or_say_there_is_no_display() {
+    let output = Command::new(env!("CARGO_BIN_EXE_mirador"))
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .expect("running the mirador binary");
+    let message = stderr(&output);
+    assert!(!output.status.success());
+    assert!(!message.contains("panicked"), "{message}");
+    assert!(message.contains("no display") && message.contains("mirador render"), "{message}");
+    assert_eq!(message.trim().lines().count(), 1, "one line: {message}");
 }
 
 #[test]

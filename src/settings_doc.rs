@@ -1,0 +1,298 @@
+//! What every render setting means, in the course's terms: the one table the viewer's panel reads
+//! its tooltips, choices and ranges from.
+//!
+//! The panel is generated from `RenderSettings` itself (serialized to TOML and walked), so a new
+//! technique's section appears in the viewer by being added to `src/settings.rs`. What cannot be
+//! read from the struct — a one-line explanation of what the toggle changes in the formula, the
+//! range a number may take — lives here, keyed by the same dotted path `--set` uses
+//! (`shadows.map_size`). A unit test serializes the default settings and fails for any key this
+//! table does not describe, so a toggle cannot land without its tooltip.
+//!
+//! The choices of an enum setting come from its `clap::ValueEnum` variants (their doc comments are
+//! the help of each choice) spelled as serde writes them, so they are always the values `--set`
+//! and scene files accept.
+
+use clap::ValueEnum;
+use serde::Serialize;
+
+use crate::settings::{
+    AccelKind, AntiAliasing, BumpView, Prepass, ShadowFilter, ShadowFit, ShadowMethod, ShadowView, TangentSource,
+    TextureFilter, TracerLod,
+};
+
+/// One value an enum setting can take.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Choice {
+    /// As serde writes it: the value of `--set key="value"`.
+    pub value: String,
+    /// The variant's doc comment, when it has one.
+    pub help: Option<String>,
+}
+
+/// What the panel needs to know about one setting or section.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FieldDoc {
+    /// One line: what the toggle changes, in the formula's or the course's terms.
+    pub tooltip: &'static str,
+    /// For enum settings, every value they accept (empty otherwise).
+    pub choices: Vec<Choice>,
+    /// For numbers, the inclusive range the panel's control allows (validation may be stricter).
+    pub range: Option<(f64, f64)>,
+}
+
+/// The choices of an enum, spelled as serde writes them, with each variant's doc comment.
+pub fn choices_of<T: ValueEnum + Serialize>() -> Vec<Choice> {
+    T::value_variants()
+        .iter()
+        .filter_map(|variant| {
+            let value = match toml::Value::try_from(variant) {
+                Ok(toml::Value::String(name)) => name,
+                _ => return None,
+            };
+            let help = variant.to_possible_value().and_then(|p| p.get_help().map(|h| h.to_string()));
+            Some(Choice { value, help })
+        })
+        .collect()
+}
+
+fn doc(tooltip: &'static str) -> FieldDoc {
+    FieldDoc { tooltip, choices: Vec::new(), range: None }
+}
+
+fn number(tooltip: &'static str, low: f64, high: f64) -> FieldDoc {
+    FieldDoc { tooltip, choices: Vec::new(), range: Some((low, high)) }
+}
+
+fn choice<T: ValueEnum + Serialize>(tooltip: &'static str) -> FieldDoc {
+    FieldDoc { tooltip, choices: choices_of::<T>(), range: None }
+}
+
+/// The description of the setting or section at the dotted path `key`, `None` for unknown keys.
+pub fn describe(key: &str) -> Option<FieldDoc> {
+    Some(match key {
+        "terms" => doc(
+            "Which terms of the illumination model L = ME + AG + Σ V·S·(ka·C + kd·C·(n·l) + ks·S·(r·v)^e) are drawn (TECHNIQUES.md §1).",
+        ),
+        "terms.ambient" => doc(
+            "The ambient terms: global AG = A ⊗ kd·C and each light's ka·C. Off: surfaces no light reaches go black.",
+        ),
+        "terms.diffuse" => {
+            doc("Lambert's kd·C·max(0, n·l): matte shading that depends on the angle to the light, not on the viewer.")
+        }
+        "terms.specular" => {
+            doc("Phong's ks·S·max(0, r·v)^e: the highlight that moves with the viewer; e (shininess) sets its size.")
+        }
+        "terms.emission" => doc("ME, the material's own emitted radiance, added whatever the lights."),
+        "exposure" => number(
+            "Multiplies linear radiance before the clamp to [0, 1] and the sRGB encoding (the shared output transform).",
+            0.01,
+            16.0,
+        ),
+        "sphere_segments" => number(
+            "Slices around the rasterizer's tessellated spheres, tori and rounded boxes; the tracer's shapes are exact, so few slices show polygonal silhouettes in the difference view.",
+            3.0,
+            512.0,
+        ),
+        "textures" => doc(
+            "Texture filtering (TECHNIQUES.md §2): mip level from log(distance), trilinear blending between the two nearest levels.",
+        ),
+        "textures.filter" => choice::<TextureFilter>(
+            "How a texel is read: one texel, bilinear, within one mip level, between two (trilinear), anisotropic, or each level in its own colour.",
+        ),
+        "textures.tracer_lod" => choice::<TracerLod>(
+            "How the ray tracer picks the mip level at a hit: the ray cone's footprint, or the seed's log(distance) rule.",
+        ),
+        "textures.anisotropy" => number(
+            "Most samples along the footprint's long axis for the anisotropic filter (1 = isotropic).",
+            1.0,
+            16.0,
+        ),
+        "textures.lod_bias" => number(
+            "Added to the mip level λ: positive blurs, negative sharpens and brings back the aliasing mipmaps remove.",
+            -8.0,
+            8.0,
+        ),
+        "bump" => doc(
+            "Bump mapping (TECHNIQUES.md §3): n' = normalize((t_u + du·n) × (t_v + dv·n)) from a height field's differences.",
+        ),
+        "bump.enabled" => {
+            doc("Perturb the shading normal by the height field's slope; off shades with the geometric normal n.")
+        }
+        "bump.tangents" => {
+            choice::<TangentSource>("Where the rasterizer's tangents t_u = ∂p/∂u, t_v = ∂p/∂v come from.")
+        }
+        "bump.scale" => number(
+            "Multiplies every material's k in du = k·(f(u+Δ) − f(u−Δ))/2Δ: relief depth (negative inverts it).",
+            -8.0,
+            8.0,
+        ),
+        "bump.delta_texels" => number(
+            "The finite-difference step Δ in texels of the height map: small follows detail, large smooths it.",
+            0.05,
+            64.0,
+        ),
+        "bump.analytic" => {
+            doc("For procedural height fields, the exact derivatives instead of finite differences (compare the two).")
+        }
+        "bump.view" => choice::<BumpView>(
+            "Teaching view: show the perturbed normal n' or the tangent t_u as colour instead of the shading.",
+        ),
+        "shadows" => doc(
+            "Cast shadows (TECHNIQUES.md §4): the visibility V of each light in Σ V·S·(…), by shadow maps or projected polygons; shadow rays in the tracer.",
+        ),
+        "shadows.enabled" => {
+            doc("Compute V for each light; off, every point sees every light (V = 1) in both renderers.")
+        }
+        "shadows.method" => choice::<ShadowMethod>(
+            "Image precision (two-pass z-buffer from the light) or object precision (casters projected onto planar receivers).",
+        ),
+        "shadows.map_size" => number(
+            "Texels on each side of a shadow map (pass 1's depth buffer A): small maps give blocky edges.",
+            256.0,
+            4096.0,
+        ),
+        "shadows.filter" => choice::<ShadowFilter>(
+            "How the stored depth d is compared around the projected point q: one texel, 2×2, 3×3, 5×5 or a Poisson disc (PCF).",
+        ),
+        "shadows.depth_bias" => number(
+            "Constant added to d before d < ‖q − y‖: cures self-shadowing acne; too much detaches shadows (peter-panning).",
+            0.0,
+            10000.0,
+        ),
+        "shadows.slope_bias" => number(
+            "Bias that grows with the surface's depth slope as the light sees it: acne on grazing surfaces.",
+            0.0,
+            16.0,
+        ),
+        "shadows.normal_offset" => {
+            number("Moves the lookup point q along n by this many shadow-map texels before projecting it.", 0.0, 16.0)
+        }
+        "shadows.distance" => number(
+            "How far from the eye a directional light's orthographic map reaches (0: four times eye–centre, at most far).",
+            0.0,
+            10000.0,
+        ),
+        "shadows.fit" => choice::<ShadowFit>(
+            "What a directional light's map covers: the view frustum (finer texels, redrawn as the camera moves) or the whole scene (kept).",
+        ),
+        "shadows.cache" => doc(
+            "Keep each map layer across frames until its light, the casters or the bias change: pass 1 depends on the light, not the camera.",
+        ),
+        "shadows.transmission" => doc(
+            "Transparent casters (kt > 0) let kt·MT through: coloured, partial shadows (0 < V < 1) instead of black ones.",
+        ),
+        "shadows.view" => {
+            choice::<ShadowView>("Teaching view: the shadow map's depths, or its texels as they land on the receivers.")
+        }
+        "shadows.view_layer" => {
+            number("Which shadow map the map view shows (a point light has six, one per cube face).", 0.0, 95.0)
+        }
+        "shadows.show_frusta" => {
+            doc("Draw each shadowed light's view volume (the frustum pass 1 renders) into the scene.")
+        }
+        "raster" => doc(
+            "How the rasterizer spends its time. None of these changes what a technique computes; each trades time for a measured difference.",
+        ),
+        "raster.depth_prepass" => choice::<Prepass>(
+            "Draw every pixel's depth first, then evaluate the illumination model once per pixel instead of once per fragment drawn.",
+        ),
+        "raster.adaptive_tessellation" => doc(
+            "Tessellate spheres, tori and rounded boxes by their size on screen (outline within 1/16 pixel), at most sphere_segments.",
+        ),
+        "raster.render_scale" => number(
+            "Draw at this fraction of the window's size and upscale: fewer pixels shaded, a blurrier image.",
+            0.1,
+            1.0,
+        ),
+        "raster.flat_colour" => doc(
+            "Every surface in its material's colour C, no lighting: the least the GPU can do with this geometry (the benchmarks' floor).",
+        ),
+        "trace" => {
+            doc("The Whitted ray tracer's own settings (TECHNIQUES.md §7): recursion, anti-aliasing, acceleration.")
+        }
+        "trace.max_depth" => number(
+            "Deepest recursion of reflected kps·L(r) and refracted kt·L(t) rays; 0 leaves local shading only.",
+            0.0,
+            64.0,
+        ),
+        "trace.anti_aliasing" => choice::<AntiAliasing>(
+            "How pixels are sampled: one ray through the centre (pixel-aligned with the rasterizer), grids, jitter, corners or adaptive.",
+        ),
+        "trace.samples" => {
+            number("Rays per pixel side for regular and jittered sampling (samples² rays a pixel).", 1.0, 16.0)
+        }
+        "trace.seed" => number("Seed of the jittered pattern: the same seed draws the same image.", 0.0, 1.0e9),
+        "trace.adaptive_threshold" => number(
+            "Adaptive sampling splits a square while its corners differ by more than this (0–1 output values).",
+            0.0,
+            1.0,
+        ),
+        "trace.adaptive_max_level" => number("Deepest subdivision of adaptive sampling.", 0.0, 6.0),
+        "trace.accelerator" => choice::<AccelKind>(
+            "How rays find the nearest hit: BVH, uniform grid, octree, or every primitive (brute force); the image is the same.",
+        ),
+        _ => return None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::RenderSettings;
+
+    /// Every dotted key of a serialized value: sections and their settings.
+    fn keys(prefix: &str, table: &toml::Table, out: &mut Vec<(String, toml::Value)>) {
+        for (name, value) in table {
+            let key = if prefix.is_empty() { name.clone() } else { format!("{prefix}.{name}") };
+            if let toml::Value::Table(inner) = value {
+                keys(&key, inner, out);
+            }
+            out.push((key, value.clone()));
+        }
+    }
+
+    #[test]
+    fn every_setting_has_a_description() {
+        let table = toml::Table::try_from(RenderSettings::default()).expect("settings serialize");
+        let mut all = Vec::new();
+        keys("", &table, &mut all);
+        let missing: Vec<&str> = all.iter().filter(|(k, _)| describe(k).is_none()).map(|(k, _)| k.as_str()).collect();
+        assert!(missing.is_empty(), "add a description to src/settings_doc.rs for: {missing:?}");
+        for (key, value) in &all {
+            let doc = describe(key).expect("checked above");
+            assert!(!doc.tooltip.is_empty() && !doc.tooltip.contains('\n'), "{key}: a tooltip is one line");
+            match value {
+                toml::Value::String(current) => {
+                    assert!(!doc.choices.is_empty(), "{key}: a string setting lists its choices");
+                    assert!(doc.choices.iter().any(|c| &c.value == current), "{key}: `{current}` is among its choices");
+                }
+                toml::Value::Integer(_) | toml::Value::Float(_) => {
+                    let (low, high) = doc.range.unwrap_or_else(|| panic!("{key}: a number has a range"));
+                    assert!(low < high, "{key}: the range is not empty");
+                }
+                _ => {}
+            }
+        }
+    }
+
+    #[test]
+    fn every_choice_is_accepted_by_set() {
+        let table = toml::Table::try_from(RenderSettings::default()).expect("settings serialize");
+        let mut all = Vec::new();
+        keys("", &table, &mut all);
+        for (key, _) in all.iter().filter(|(_, v)| v.is_str()) {
+            for choice in describe(key).expect("described").choices {
+                let mut settings = RenderSettings::default();
+                settings.set(&format!("{key}=\"{}\"", choice.value)).unwrap_or_else(|e| panic!("{key}: {e}"));
+            }
+        }
+    }
+
+    #[test]
+    fn choices_use_serde_names_and_carry_help() {
+        let filters = choices_of::<TextureFilter>();
+        let names: Vec<&str> = filters.iter().map(|c| c.value.as_str()).collect();
+        assert!(names.contains(&"nearest_mip") && names.contains(&"level_colour"), "{names:?}");
+        assert!(filters.iter().all(|c| c.help.is_some()), "every filter has a doc comment");
+    }
+}

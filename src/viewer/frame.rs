@@ -1,0 +1,416 @@
+//! One frame of the viewer, top to bottom: scripted step → file watch → traced images in →
+//! UI (egui) → camera and settings changes → raster image at the view's size × render scale →
+//! traced request → paint the window (and a screenshot when asked).
+
+use std::collections::VecDeque;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context as _, bail};
+use glam::Vec2;
+
+use super::camera_control::{self, CameraInput, Navigation};
+use super::config::ViewerConfig;
+use super::hud::{FrameStats, FrameTimes};
+use super::raster_view::RasterView;
+use super::scene_panel;
+use super::scene_state::SceneState;
+use super::screen::{Presented, Screen};
+use super::script::Step;
+use super::traced::TracedView;
+use super::ui::{self, Action, UiModel, UiOutput};
+use super::view_mode::{ViewMode, ViewState};
+use crate::RenderSettings;
+use crate::scene::{Camera, Light};
+
+/// How long the camera counts as moving after its last change: the render scale stays low.
+const SETTLE: Duration = Duration::from_millis(250);
+/// The longest a `wait traced` step waits.
+const TRACE_TIMEOUT: Duration = Duration::from_secs(600);
+
+/// Everything the viewer holds, grouped by concern.
+pub struct Viewer {
+    pub scene: SceneState,
+    pub settings: RenderSettings,
+    pub navigation: Navigation,
+    pub view: ViewState,
+    raster: RasterView,
+    traced: TracedView,
+    pub stats: FrameStats,
+    script: Script,
+    camera_error: Option<String>,
+    pub notices: Vec<String>,
+    /// When the camera last moved plus [`SETTLE`].
+    moving_until: Option<Instant>,
+    last_frame: Option<Instant>,
+    /// What the current traced request was made from, and its key.
+    request: Option<(Camera, RenderSettings, u64, Vec<Light>)>,
+    key: u64,
+    /// The 3D view's size in pixels, and where it sits in the window.
+    pub view_pixels: Option<(u32, u32, u32, u32)>,
+    screenshot: Option<PathBuf>,
+}
+
+/// Scripted steps still to run and the wait in progress.
+#[derive(Default)]
+struct Script {
+    steps: VecDeque<Step>,
+    wait_frames: u32,
+    wait_traced_since: Option<Instant>,
+}
+
+/// What a frame tells the event loop.
+pub struct FrameEnd {
+    /// When the window should be drawn again at the latest (`None`: only on input).
+    pub next: Option<Instant>,
+}
+
+impl Viewer {
+    pub fn new(
+        screen: &mut Screen,
+        scene: crate::Scene,
+        config: &ViewerConfig,
+        steps: Vec<Step>,
+        wake: impl Fn() + Send + 'static,
+    ) -> Viewer {
+        let (settings, warnings) = super::config::apply_settings(&scene.settings, &config.settings);
+        let mut scene = SceneState::new(scene);
+        scene.scene.settings = settings.clone();
+        let raster = RasterView::new(&screen.gpu, &mut screen.painter, &scene.scene, scene.revision);
+        Viewer {
+            scene,
+            settings,
+            navigation: Navigation::Orbit,
+            view: ViewState {
+                mode: config.mode,
+                split: config.split,
+                motion_scale: config.motion_scale,
+                ..Default::default()
+            },
+            raster,
+            traced: TracedView::new(wake),
+            stats: FrameStats::default(),
+            script: Script { steps: steps.into(), ..Default::default() },
+            camera_error: None,
+            notices: warnings,
+            moving_until: None,
+            last_frame: None,
+            request: None,
+            key: 0,
+            view_pixels: None,
+            screenshot: None,
+        }
+    }
+
+    /// Whether every scripted step has run.
+    pub fn script_done(&self) -> bool {
+        self.script.steps.is_empty() && self.script.wait_frames == 0 && self.script.wait_traced_since.is_none()
+    }
+
+    /// What the configuration file should remember now.
+    pub fn remembered(&self, window: [u32; 2]) -> ViewerConfig {
+        ViewerConfig {
+            window,
+            mode: self.view.mode,
+            split: self.view.split,
+            motion_scale: self.view.motion_scale,
+            settings: super::config::changed_settings(&self.settings, &self.scene.seed_settings),
+        }
+    }
+
+    /// Opens a scene file (dropped, or from a script), keeping the current settings.
+    pub fn open(&mut self, path: &Path) {
+        if self.scene.load(path, &self.settings) {
+            self.camera_error = None;
+            self.notice(format!("opened {}", path.display()));
+        }
+    }
+
+    fn notice(&mut self, message: String) {
+        log::info!("{message}");
+        self.notices.push(message);
+        if self.notices.len() > 20 {
+            self.notices.remove(0);
+        }
+    }
+
+    /// Asks for a screenshot of the window at the end of this frame.
+    pub fn request_screenshot(&mut self, path: PathBuf) {
+        self.screenshot = Some(path);
+    }
+
+    /// Draws one frame.
+    pub fn frame(&mut self, screen: &mut Screen) -> anyhow::Result<FrameEnd> {
+        let start = Instant::now();
+        let mut times =
+            FrameTimes { frame: self.last_frame.map_or(Duration::ZERO, |t| start - t), ..Default::default() };
+        self.last_frame = Some(start);
+        let mut input = CameraInput::default();
+        self.run_script(&mut input)?;
+        if self.scene.reload_if_changed(&self.settings) {
+            self.notice("scene file changed on disk: reloaded".into());
+        }
+        self.traced.poll(&screen.egui);
+
+        // The UI decides the 3D view's size and gathers input.
+        let ui_start = Instant::now();
+        let raw = screen.input.take_egui_input(&screen.window);
+        let raster_id = self.raster.texture_id();
+        let scale = self.scale(start);
+        let mut output = UiOutput::default();
+        let full = {
+            let mut model = UiModel {
+                settings: &self.settings,
+                scene: &mut self.scene,
+                view: &mut self.view,
+                navigation: &mut self.navigation,
+                raster: raster_id,
+                traced: &self.traced,
+                key: self.key,
+                stats: &self.stats,
+                passes: &self.raster.report.passes,
+                scale,
+                camera_error: &mut self.camera_error,
+                notices: &self.notices,
+            };
+            screen.egui.run_ui(raw, |ui| output = ui::draw(ui, &mut model))
+        };
+        times.ui = ui_start.elapsed();
+        let repaint = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
+        self.apply(&output, input, start);
+
+        // The raster image at the view's size times the render scale.
+        let ppp = full.pixels_per_point;
+        let view_rect = output.view_rect;
+        self.view_pixels = view_rect.map(|r| {
+            let px = |x: f32| (x * ppp).round().max(0.0) as u32;
+            (px(r.min.x), px(r.min.y), px(r.width()).max(1), px(r.height()).max(1))
+        });
+        let scale = self.scale(Instant::now());
+        if let Some((_, _, width, height)) = self.view_pixels {
+            let full_size = (width, height);
+            let scaled =
+                (((width as f32) * scale).round().max(1.0) as u32, ((height as f32) * scale).round().max(1.0) as u32);
+            let filter = if scaled == full_size { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
+            self.scene.scene.camera.width = scaled.0;
+            self.scene.scene.camera.height = scaled.1;
+            let (_, raster_time) = self.raster.render(
+                &screen.gpu,
+                &mut screen.painter,
+                (&self.scene.scene, self.scene.revision),
+                &self.settings,
+                filter,
+                true,
+            );
+            times.raster = raster_time;
+            self.request_traced(full_size, scaled == full_size, screen);
+        }
+
+        let paint_start = Instant::now();
+        let screenshot = self.screenshot.take();
+        let presented = screen.paint(full, screenshot.as_deref())?;
+        times.paint = paint_start.elapsed();
+        if let Some(path) = screenshot {
+            match presented {
+                Presented::Shown => {
+                    let (x, y, w, h) = self.view_pixels.unwrap_or_default();
+                    let (ww, wh) = screen.size();
+                    println!("screenshot {} window {ww}x{wh} view {x} {y} {w} {h}", path.display());
+                    self.notice(format!("screenshot written to {}", path.display()));
+                }
+                // Not drawn this time: try again next frame.
+                Presented::Skipped => self.screenshot = Some(path),
+            }
+        }
+        self.stats.record(times);
+        let moved = self.moving_until.is_some_and(|t| t > start + SETTLE - Duration::from_millis(1));
+        let soon = |delay: Duration| Instant::now() + delay;
+        let next = [
+            moved.then(Instant::now),
+            repaint.filter(|d| *d < Duration::from_secs(3600)).map(soon),
+            self.moving_until,
+            Some(soon(Duration::from_millis(500))),
+        ]
+        .into_iter()
+        .flatten()
+        .min();
+        Ok(FrameEnd { next })
+    }
+
+    fn scale(&self, now: Instant) -> f32 {
+        if self.moving_until.is_some_and(|t| now < t) { self.view.motion_scale } else { 1.0 }
+    }
+
+    /// Applies what the UI gathered: camera input, edits, settings, picks and actions.
+    fn apply(&mut self, output: &UiOutput, scripted: CameraInput, now: Instant) {
+        let mut input = output.camera;
+        input.rotate += scripted.rotate;
+        input.pan += scripted.pan;
+        input.zoom += scripted.zoom;
+        input.walk += scripted.walk;
+        let before = self.scene.scene.camera.clone();
+        if input.moves() {
+            let size = self.scene.size();
+            self.scene.scene.camera = camera_control::apply(&before, self.navigation, &input, size);
+        }
+        for action in &output.actions {
+            match action {
+                Action::Frame => self.frame_scene(),
+                Action::Reset => self.reset_camera(),
+                Action::Screenshot => {
+                    let seconds =
+                        std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+                    self.screenshot = Some(PathBuf::from(format!("mirador-{seconds}.png")));
+                }
+                Action::DismissError => self.scene.error = None,
+            }
+        }
+        for assignment in &output.settings {
+            self.set(assignment);
+        }
+        if output.material_edited {
+            self.scene.touch();
+        }
+        if let Some(pixel) = output.pick {
+            self.pick(pixel);
+        }
+        if self.scene.scene.camera != before || output.camera_edited {
+            self.moving_until = Some(now + SETTLE);
+        }
+    }
+
+    fn set(&mut self, assignment: &str) {
+        match self.settings.set(assignment) {
+            Ok(()) => {
+                if self.settings.sphere_segments != self.scene.scene.settings.sphere_segments {
+                    self.scene.touch();
+                }
+                self.scene.scene.settings = self.settings.clone();
+            }
+            Err(e) => self.notice(format!("setting refused: {e}")),
+        }
+    }
+
+    fn frame_scene(&mut self) {
+        if let Some(bounds) = self.scene.bounds {
+            self.scene.scene.camera = camera_control::frame_bounds(&self.scene.scene.camera, bounds);
+        }
+    }
+
+    fn reset_camera(&mut self) {
+        let camera = &mut self.scene.scene.camera;
+        *camera = Camera { width: camera.width, height: camera.height, ..self.scene.seed_camera.clone() };
+        self.camera_error = None;
+    }
+
+    /// Picks at `pixel` of the full-resolution image.
+    fn pick(&mut self, pixel: Vec2) {
+        let Some((_, _, width, height)) = self.view_pixels else { return };
+        let mut camera = self.scene.scene.camera.clone();
+        (camera.width, camera.height) = (width, height);
+        let rendered = std::mem::replace(&mut self.scene.scene.camera, camera);
+        let picked = self.scene.pick(pixel);
+        self.scene.scene.camera = rendered;
+        match picked.and_then(|p| self.scene.scene.objects.get(p.object)) {
+            Some(object) => {
+                let message = format!("picked `{}`", object.name);
+                self.notice(message);
+            }
+            None => self.notice("nothing there to pick".into()),
+        }
+    }
+
+    /// Starts (or keeps) the traced request for the current view at its full size; in the
+    /// difference view, hands over the raster image once it is at full resolution.
+    fn request_traced(&mut self, full_size: (u32, u32), full_resolution: bool, screen: &Screen) {
+        let mut camera = self.scene.scene.camera.clone();
+        (camera.width, camera.height) = full_size;
+        let inputs = (camera, self.settings.clone(), self.scene.revision, self.scene.scene.lights.clone());
+        if self.request.as_ref() != Some(&inputs) {
+            self.key += 1;
+            self.request = Some(inputs);
+        }
+        if !self.view.mode.needs_traced() {
+            self.traced.worker.stop();
+            return;
+        }
+        let (camera, settings, _, _) = self.request.as_ref().expect("set just above");
+        let mut scene = self.scene.scene.clone();
+        scene.camera = camera.clone();
+        self.traced.worker.trace(self.key, &scene, settings);
+        if self.view.mode == ViewMode::Difference
+            && full_resolution
+            && !self.traced.worker.compared(self.key)
+            && let Some(image) = self.raster.read_back(&screen.gpu)
+        {
+            self.traced.worker.compare(self.key, image);
+        }
+    }
+
+    /// Runs the next scripted step, or goes on waiting.
+    fn run_script(&mut self, input: &mut CameraInput) -> anyhow::Result<()> {
+        if self.script.wait_frames > 0 {
+            self.script.wait_frames -= 1;
+            return Ok(());
+        }
+        if let Some(since) = self.script.wait_traced_since {
+            let difference = self.view.mode == ViewMode::Difference;
+            if self.request.is_some() && self.traced.complete(self.key, difference) {
+                self.script.wait_traced_since = None;
+            } else if since.elapsed() > TRACE_TIMEOUT {
+                bail!("`wait traced`: the traced image was not complete after {} s", TRACE_TIMEOUT.as_secs());
+            } else if !self.view.mode.needs_traced() {
+                bail!("`wait traced` in the raster view: switch to traced, split or difference first");
+            } else {
+                return Ok(());
+            }
+        }
+        let Some(step) = self.script.steps.pop_front() else { return Ok(()) };
+        log::info!("step: {step:?}");
+        match step {
+            Step::Set(assignment) => {
+                self.settings.set(&assignment).with_context(|| format!("step `set {assignment}`"))?;
+                self.set(&assignment);
+            }
+            Step::View(mode) => self.view.mode = mode,
+            Step::Split(x) => self.view.split = x,
+            Step::Orbit(v) => input.rotate += v,
+            Step::Pan(v) => input.pan += v,
+            Step::Zoom(steps) => input.zoom += steps,
+            Step::Walk(v) => {
+                let camera = &self.scene.scene.camera;
+                self.scene.scene.camera = camera_control::fly(camera, v);
+                self.moving_until = Some(Instant::now() + SETTLE);
+            }
+            Step::Frame => self.frame_scene(),
+            Step::Reset => self.reset_camera(),
+            Step::Navigate(navigation) => self.navigation = navigation,
+            Step::Pick(pixel) if self.view_pixels.is_none() => {
+                // The view has no size before its first frame: pick on the next one.
+                self.script.steps.push_front(Step::Pick(pixel));
+            }
+            Step::Pick(pixel) => {
+                self.pick(pixel);
+                if self.scene.picked.is_none() {
+                    bail!("step `pick {} {}`: no object under that pixel", pixel.x, pixel.y);
+                }
+            }
+            Step::Material(assignment) => {
+                let picked = self.scene.picked.context("step `material`: pick an object first")?;
+                let material = &mut self.scene.scene.materials[picked.material];
+                scene_panel::set_material(material, &assignment)
+                    .map_err(|e| anyhow::anyhow!("step `material {assignment}`: {e}"))?;
+                self.scene.touch();
+            }
+            Step::Load(path) => self.open(&path),
+            Step::Scale(scale) => self.view.motion_scale = scale,
+            Step::Help(on) => self.view.help_open = on,
+            Step::Panel(on) => self.view.panel_open = on,
+            Step::Overlay(on) => self.view.overlay_open = on,
+            Step::Wait(frames) => self.script.wait_frames = frames,
+            Step::WaitTraced => self.script.wait_traced_since = Some(Instant::now()),
+            Step::Screenshot(path) => self.screenshot = Some(path),
+        }
+        Ok(())
+    }
+}

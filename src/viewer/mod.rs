@@ -1,0 +1,253 @@
+//! The interactive viewer (`mirador`, `mirador view [SCENE]`): a winit window with an egui side
+//! panel, showing the rasterizer's image, the ray tracer's, both split by a divider, or their
+//! FLIP difference, of a scene you can orbit, fly through, pick and edit.
+//!
+//! - [`frame`]: one frame, top to bottom, and the state it works on ([`frame::Viewer`]).
+//! - [`screen`]: the window, the device and surface, egui's input and painter, screenshots.
+//! - [`ui`]: the layout; [`panel`] the settings sections generated from `RenderSettings`;
+//!   [`scene_panel`] the camera, light and material editors; [`hud`] frame times and help.
+//! - [`camera_control`]: orbit, pan, zoom, fly and frame as pure functions on the camera.
+//! - [`raster_view`]: the one place the rasterizer is called; [`traced`]: the background tracer.
+//! - [`scene_state`] and [`picking`]: the scene, reloading, the picked object.
+//! - [`config`]: what is remembered between runs; [`script`]: scripted steps for tests.
+//!
+//! This module holds the winit `ApplicationHandler`: it opens the window when the event loop
+//! resumes, forwards events to egui, and asks for frames.
+
+pub mod camera_control;
+pub mod config;
+pub mod frame;
+pub mod hud;
+pub mod panel;
+pub mod picking;
+pub mod raster_view;
+pub mod scene_panel;
+pub mod scene_state;
+pub mod screen;
+pub mod script;
+pub mod traced;
+pub mod ui;
+pub mod view_mode;
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Context as _;
+use winit::application::ApplicationHandler;
+use winit::event::{StartCause, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
+use winit::window::WindowId;
+
+use config::ViewerConfig;
+use frame::Viewer;
+use screen::Screen;
+use script::Step;
+
+/// How the viewer was started.
+#[derive(Clone, Debug, Default)]
+pub struct ViewerOptions {
+    /// A scene file or glTF model; the showcase when `None`.
+    pub scene: Option<PathBuf>,
+    /// `--set key=value` over the scene's settings.
+    pub set: Vec<String>,
+    /// Run this many frames, then exit (scripted runs).
+    pub frames: Option<u64>,
+    /// The window's image after the last frame.
+    pub screenshot: Option<PathBuf>,
+    pub steps: Vec<Step>,
+    /// Print frame statistics at the end.
+    pub stats: bool,
+    /// The window's inner size in logical pixels (default: remembered, else 1280×720).
+    pub size: Option<[u32; 2]>,
+}
+
+impl ViewerOptions {
+    /// Scripted runs neither read nor write the remembered configuration: a test must not
+    /// depend on, or change, what a person last left in the window.
+    fn scripted(&self) -> bool {
+        self.frames.is_some()
+    }
+}
+
+/// Why the viewer cannot start.
+#[derive(Debug, thiserror::Error)]
+pub enum ViewerError {
+    #[error(
+        "no display to open a window on (DISPLAY and WAYLAND_DISPLAY are unset); `mirador render [SCENE] -o \
+         out.png` renders without one"
+    )]
+    NoDisplay,
+}
+
+/// Runs the viewer until its window is closed (or, scripted, until its frames are done).
+pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
+    let has_display = ["DISPLAY", "WAYLAND_DISPLAY"].iter().any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()));
+    if !has_display {
+        return Err(ViewerError::NoDisplay.into());
+    }
+    // Load before opening the window: a bad scene or setting on the command line is an error
+    // message, not an empty window.
+    let mut scene = scene_state::load(options.scene.as_deref())?;
+    for assignment in &options.set {
+        scene.settings.set(assignment).context("--set")?;
+    }
+    let event_loop = EventLoop::<Wake>::with_user_event().build().map_err(|e| {
+        log::info!("no event loop: {e}");
+        ViewerError::NoDisplay
+    })?;
+    let proxy = event_loop.create_proxy();
+    let mut app = App { options, scene: Some(scene), proxy, running: None, outcome: Ok(()), frames: 0, started: None };
+    event_loop.run_app(&mut app).context("the window's event loop failed")?;
+    app.outcome
+}
+
+/// Sent by the background tracer when it has a new image.
+#[derive(Clone, Copy, Debug)]
+struct Wake;
+
+struct App {
+    options: ViewerOptions,
+    /// The scene, until the window opens.
+    scene: Option<crate::Scene>,
+    proxy: EventLoopProxy<Wake>,
+    running: Option<(Screen, Viewer)>,
+    outcome: anyhow::Result<()>,
+    frames: u64,
+    started: Option<Instant>,
+}
+
+impl App {
+    fn config_path(&self) -> Option<PathBuf> {
+        if self.options.scripted() { None } else { config::config_path() }
+    }
+
+    fn open(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<()> {
+        let mut config = ViewerConfig::default();
+        let mut notices = Vec::new();
+        if let Some(path) = self.config_path() {
+            let (loaded, warning) = config::load(&path);
+            config = loaded;
+            if let Some(warning) = warning {
+                eprintln!("warning: {warning}");
+                notices.push(warning);
+            }
+        }
+        let size = self.options.size.unwrap_or(config.window);
+        let vsync = !self.options.scripted();
+        let mut screen = Screen::open(event_loop, "Mirador", size, vsync)?;
+        let scene = self.scene.take().context("the window opens once")?;
+        let proxy = self.proxy.clone();
+        let wake = move || {
+            let _ = proxy.send_event(Wake);
+        };
+        let mut viewer = Viewer::new(&mut screen, scene, &config, self.options.steps.clone(), wake);
+        viewer.notices.extend(notices);
+        if self.options.stats {
+            println!("adapter: {}", screen.gpu.describe());
+        }
+        screen.window.request_redraw();
+        self.running = Some((screen, viewer));
+        self.started = Some(Instant::now());
+        Ok(())
+    }
+
+    /// Ends the run with `result` (the first error wins).
+    fn finish(&mut self, event_loop: &ActiveEventLoop, result: anyhow::Result<()>) {
+        if let Err(e) = result
+            && self.outcome.is_ok()
+        {
+            self.outcome = Err(e);
+        }
+        if let (Some(path), Some((screen, viewer))) = (self.config_path(), &self.running) {
+            let size = screen.window.inner_size().to_logical::<u32>(screen.window.scale_factor());
+            if let Err(e) = config::save(&path, &viewer.remembered([size.width, size.height])) {
+                eprintln!("warning: {}: cannot remember the viewer's settings: {e:#}", path.display());
+            }
+        }
+        if self.options.stats
+            && let Some((_, viewer)) = &self.running
+        {
+            if let Some((_, _, w, h)) = viewer.view_pixels {
+                println!("3D view: {w}x{h} pixels");
+            }
+            println!("{}", viewer.stats.summary());
+        }
+        event_loop.exit();
+    }
+
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) {
+        let Some((screen, viewer)) = &mut self.running else { return };
+        if screen.is_minimised() {
+            return;
+        }
+        let scripted = self.options.frames;
+        let last = scripted.is_some_and(|n| self.frames + 1 >= n) && viewer.script_done();
+        if last && let Some(path) = &self.options.screenshot {
+            viewer.request_screenshot(path.clone());
+        }
+        let was_done = viewer.script_done();
+        let result = viewer.frame(screen);
+        self.frames += 1;
+        // Measure the state the script set up, not the steps getting there nor the first frames
+        // (the driver compiles its pipelines lazily).
+        if (!was_done && viewer.script_done()) || (self.frames == 2 && viewer.script_done()) {
+            viewer.stats.reset();
+        }
+        match result {
+            Err(e) => self.finish(event_loop, Err(e)),
+            Ok(_) if last => self.finish(event_loop, Ok(())),
+            Ok(end) => {
+                if scripted.is_some() {
+                    screen.window.request_redraw();
+                } else if let Some(next) = end.next {
+                    event_loop.set_control_flow(ControlFlow::WaitUntil(next));
+                }
+            }
+        }
+    }
+}
+
+impl ApplicationHandler<Wake> for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.running.is_some() {
+            return;
+        }
+        if let Err(e) = self.open(event_loop) {
+            self.finish(event_loop, Err(e));
+        }
+    }
+
+    fn user_event(&mut self, _: &ActiveEventLoop, _: Wake) {
+        if let Some((screen, _)) = &self.running {
+            screen.window.request_redraw();
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let Some((screen, viewer)) = &mut self.running else { return };
+        let response = screen.input.on_window_event(&screen.window, &event);
+        match event {
+            WindowEvent::CloseRequested => {
+                self.finish(event_loop, Ok(()));
+                return;
+            }
+            WindowEvent::Resized(size) => screen.resize(size),
+            WindowEvent::DroppedFile(path) => viewer.open(&path),
+            WindowEvent::RedrawRequested => {
+                self.redraw(event_loop);
+                return;
+            }
+            _ => {}
+        }
+        if response.repaint {
+            screen.window.request_redraw();
+        }
+    }
+
+    fn new_events(&mut self, _: &ActiveEventLoop, cause: StartCause) {
+        // Timed wake-ups: the camera settling back to full resolution, file polling, animations.
+        if let (StartCause::ResumeTimeReached { .. }, Some((screen, _))) = (cause, &self.running) {
+            screen.window.request_redraw();
+        }
+    }
+}

@@ -1,0 +1,136 @@
+//! The scene the viewer shows: where it came from, the camera it was loaded with (for R), the
+//! picked object, and reloading — from a dropped file, from a script, or because the file changed
+//! on disk (its modification time is polled twice a second). A scene that fails to load leaves
+//! the previous one in place and its error on screen.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant, SystemTime};
+
+use super::picking::{Picked, Picker};
+use crate::scene::Camera;
+use crate::{RenderSettings, Scene};
+
+/// How often the scene file's modification time is checked.
+const WATCH_PERIOD: Duration = Duration::from_millis(500);
+
+pub struct SceneState {
+    pub scene: Scene,
+    /// The camera the scene file gave: what R returns to.
+    pub seed_camera: Camera,
+    /// The settings the scene file gave: what remembered changes are relative to.
+    pub seed_settings: RenderSettings,
+    /// Bumped whenever geometry or materials change, so GPU buffers and the tracer rebuild.
+    pub revision: u64,
+    /// The last load error, shown in the window until the next successful load.
+    pub error: Option<String>,
+    pub picked: Option<Picked>,
+    /// The scene's bounds, computed once (objects do not move in the viewer).
+    pub bounds: Option<(glam::Vec3, glam::Vec3)>,
+    picker: Option<Picker>,
+    watch: Option<Watch>,
+}
+
+struct Watch {
+    path: PathBuf,
+    modified: Option<SystemTime>,
+    checked: Instant,
+}
+
+fn modified(path: &Path) -> Option<SystemTime> {
+    std::fs::metadata(path).and_then(|m| m.modified()).ok()
+}
+
+/// Loads `path`, or the built-in showcase.
+pub fn load(path: Option<&Path>) -> Result<Scene, crate::scene::SceneError> {
+    match path {
+        Some(path) => Scene::load(path),
+        None => Scene::showcase(),
+    }
+}
+
+impl SceneState {
+    pub fn new(scene: Scene) -> SceneState {
+        let watch = scene.source.clone().map(|path| Watch { modified: modified(&path), path, checked: Instant::now() });
+        let bounds = scene.bounds();
+        SceneState {
+            seed_camera: scene.camera.clone(),
+            seed_settings: scene.settings.clone(),
+            scene,
+            revision: 0,
+            error: None,
+            picked: None,
+            bounds,
+            picker: None,
+            watch,
+        }
+    }
+
+    /// Replaces the scene with the one at `path`, keeping `settings` and the window's image size;
+    /// on failure keeps the current scene and records the error.
+    pub fn load(&mut self, path: &Path, settings: &RenderSettings) -> bool {
+        match Scene::load(path) {
+            Ok(scene) => {
+                self.replace(scene, settings);
+                true
+            }
+            Err(e) => {
+                log::warn!("{e}");
+                self.error = Some(e.to_string());
+                if let Some(watch) = &mut self.watch
+                    && watch.path == path
+                {
+                    watch.modified = modified(path);
+                }
+                false
+            }
+        }
+    }
+
+    fn replace(&mut self, scene: Scene, settings: &RenderSettings) {
+        let (width, height) = (self.scene.camera.width, self.scene.camera.height);
+        let revision = self.revision + 1;
+        *self = SceneState::new(scene);
+        self.revision = revision;
+        self.scene.settings = settings.clone();
+        self.scene.camera.width = width;
+        self.scene.camera.height = height;
+    }
+
+    /// Reloads the scene when its file changed on disk since it was loaded (polled, cheap).
+    pub fn reload_if_changed(&mut self, settings: &RenderSettings) -> bool {
+        let Some(watch) = &mut self.watch else { return false };
+        if watch.checked.elapsed() < WATCH_PERIOD {
+            return false;
+        }
+        watch.checked = Instant::now();
+        let now = modified(&watch.path);
+        if now == watch.modified {
+            return false;
+        }
+        watch.modified = now;
+        let path = watch.path.clone();
+        log::info!("{} changed on disk; reloading", path.display());
+        self.load(&path, settings)
+    }
+
+    /// Marks geometry or materials as changed.
+    pub fn touch(&mut self) {
+        self.revision += 1;
+    }
+
+    /// Picks the object under `pixel` of the current camera's image, building the picker once
+    /// per scene.
+    pub fn pick(&mut self, pixel: glam::Vec2) -> Option<Picked> {
+        if self.picker.is_none() {
+            self.picker = Some(Picker::new(&self.scene));
+        }
+        let picker = self.picker.as_ref().expect("built just above");
+        self.picked = picker.pick(&self.scene, pixel);
+        self.picked
+    }
+
+    /// The diagonal of the scene's bounds (1 for an empty scene): the scale of fly speeds.
+    pub fn size(&self) -> f32 {
+        self.bounds.map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-3))
+    }
+}

@@ -1,0 +1,169 @@
+//! Scripted steps: what `--step "…"` and `--script FILE` feed the viewer, one step per frame, so
+//! that a run with `--frames N --screenshot FILE` can be tested under Xvfb like a person at the
+//! window. Each step names something the panel or a key does:
+//!
+//! ```text
+//! set shadows.enabled=false     a render setting, as `--set` takes it
+//! view split                    raster | traced | split | difference
+//! split 0.3                     the divider, as a fraction of the view's width
+//! orbit 40 -10 | pan 20 0       a mouse drag, in pixels
+//! zoom 2                        wheel steps (positive: closer)
+//! frame | reset                 the F and R keys
+//! navigate fly | navigate orbit
+//! walk 0 0 1                    fly by (right, up, forward) scene units
+//! pick 320 200                  click the 3D view at this pixel (selects the object)
+//! material kd=0.2               edit the picked object's material
+//! load FILE                     as if FILE were dropped on the window
+//! scale 0.5                     the render scale while the camera moves
+//! help on | panel off           show or hide the help window, the side panel
+//! overlay off                   hide the frame times over the 3D view
+//! wait 10                       let 10 frames pass
+//! wait traced                   until the ray-traced image (and difference) is complete
+//! screenshot FILE.png           the whole window, written atomically
+//! ```
+//!
+//! Blank lines and lines starting with `#` are skipped in script files.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Vec2, Vec3};
+
+use super::camera_control::Navigation;
+use super::view_mode::ViewMode;
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Step {
+    Set(String),
+    View(ViewMode),
+    Split(f32),
+    Orbit(Vec2),
+    Pan(Vec2),
+    Zoom(f32),
+    Frame,
+    Reset,
+    Navigate(Navigation),
+    Walk(Vec3),
+    Pick(Vec2),
+    Material(String),
+    Load(PathBuf),
+    Scale(f32),
+    Help(bool),
+    Panel(bool),
+    Overlay(bool),
+    Wait(u32),
+    WaitTraced,
+    Screenshot(PathBuf),
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ScriptError {
+    #[error("step `{step}`: {message}")]
+    Step { step: String, message: String },
+    #[error("{path}:{line}: {source}")]
+    Line { path: PathBuf, line: usize, source: Box<ScriptError> },
+    #[error("{path}: cannot read the script: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+}
+
+fn numbers<const N: usize>(args: &str) -> Option<[f32; N]> {
+    let values: Vec<f32> = args.split_whitespace().map(str::parse).collect::<Result<_, _>>().ok()?;
+    let array: [f32; N] = values.try_into().ok()?;
+    array.iter().all(|v| v.is_finite()).then_some(array)
+}
+
+fn switch(args: &str) -> Option<bool> {
+    match args {
+        "on" | "true" | "show" => Some(true),
+        "off" | "false" | "hide" => Some(false),
+        _ => None,
+    }
+}
+
+/// Parses one step.
+pub fn parse(text: &str) -> Result<Step, ScriptError> {
+    let text = text.trim();
+    let (verb, args) = text.split_once(char::is_whitespace).map_or((text, ""), |(v, a)| (v, a.trim()));
+    let fail = |message: &str| ScriptError::Step { step: text.into(), message: message.into() };
+    let assignment = |what: &str| {
+        if args.contains('=') { Ok(args.to_string()) } else { Err(fail(&format!("expected {what} key=value"))) }
+    };
+    Ok(match verb {
+        "set" => Step::Set(assignment("set")?),
+        "material" => Step::Material(assignment("material")?),
+        "view" => {
+            Step::View(ViewMode::parse(args).ok_or_else(|| fail("the view is raster, traced, split or difference"))?)
+        }
+        "split" => {
+            let [x] = numbers(args).ok_or_else(|| fail("expected a fraction of the width"))?;
+            if !(0.0..=1.0).contains(&x) {
+                return Err(fail("the divider lies between 0 and 1"));
+            }
+            Step::Split(x)
+        }
+        "orbit" | "pan" | "pick" => {
+            let [x, y] = numbers(args).ok_or_else(|| fail("expected two numbers: x y in pixels"))?;
+            let v = Vec2::new(x, y);
+            match verb {
+                "orbit" => Step::Orbit(v),
+                "pan" => Step::Pan(v),
+                _ => Step::Pick(v),
+            }
+        }
+        "zoom" => Step::Zoom(numbers::<1>(args).ok_or_else(|| fail("expected wheel steps"))?[0]),
+        "walk" => Step::Walk(Vec3::from(numbers::<3>(args).ok_or_else(|| fail("expected right up forward"))?)),
+        "frame" => Step::Frame,
+        "reset" => Step::Reset,
+        "navigate" => Step::Navigate(match args {
+            "orbit" => Navigation::Orbit,
+            "fly" => Navigation::Fly,
+            _ => return Err(fail("navigate orbit or navigate fly")),
+        }),
+        "load" if !args.is_empty() => Step::Load(PathBuf::from(args)),
+        "scale" => {
+            let [s] = numbers(args).ok_or_else(|| fail("expected a scale"))?;
+            if !(0.1..=1.0).contains(&s) {
+                return Err(fail("the render scale lies between 0.1 and 1"));
+            }
+            Step::Scale(s)
+        }
+        "help" => Step::Help(switch(args).ok_or_else(|| fail("help on or help off"))?),
+        "panel" => Step::Panel(switch(args).ok_or_else(|| fail("panel on or panel off"))?),
+        "overlay" => Step::Overlay(switch(args).ok_or_else(|| fail("overlay on or overlay off"))?),
+        "wait" if args == "traced" => Step::WaitTraced,
+        "wait" => Step::Wait(args.parse().map_err(|_| fail("wait N (frames) or wait traced"))?),
+        "screenshot" if args.to_ascii_lowercase().ends_with(".png") => Step::Screenshot(PathBuf::from(args)),
+        "screenshot" => return Err(fail("the screenshot must be a .png file")),
+        _ => return Err(fail("unknown step (see `mirador view --help`)")),
+    })
+}
+
+/// Parses a script file: one step a line, `#` comments and blank lines skipped.
+pub fn parse_file(path: &Path) -> Result<Vec<Step>, ScriptError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ScriptError::Io { path: path.into(), source })?;
+    text.lines()
+        .enumerate()
+        .filter(|(_, line)| !line.trim().is_empty() && !line.trim_start().starts_with('#'))
+        .map(|(number, line)| {
+            parse(line).map_err(|e| ScriptError::Line { path: path.into(), line: number + 1, source: Box::new(e) })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn steps_parse_and_bad_ones_are_explained() {
+        assert_eq!(parse("set shadows.enabled=false").unwrap(), Step::Set("shadows.enabled=false".into()));
+        assert_eq!(parse("  view   split ").unwrap(), Step::View(ViewMode::Split));
+        assert_eq!(parse("orbit 40 -10").unwrap(), Step::Orbit(Vec2::new(40.0, -10.0)));
+        assert_eq!(parse("wait traced").unwrap(), Step::WaitTraced);
+        assert_eq!(parse("wait 3").unwrap(), Step::Wait(3));
+        assert_eq!(parse("screenshot out.png").unwrap(), Step::Screenshot("out.png".into()));
+        for bad in ["view sideways", "orbit 1", "split 2", "set shadows", "screenshot a.jpg", "dance", "pick nan 1"] {
+            let error = parse(bad).unwrap_err().to_string();
+            assert!(error.contains(bad.split_whitespace().next().unwrap()), "{bad}: {error}");
+        }
+    }
+}

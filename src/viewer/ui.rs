@@ -1,0 +1,361 @@
+//! The window's layout, drawn with egui each frame: the side panel (view mode, camera, one
+//! section per technique, lights, the picked material, the scene), and the 3D view, which shows
+//! the raster image, the traced one, both split by a draggable divider, or their difference, and
+//! turns mouse and keys over it into camera input. Nothing here changes the scene or the
+//! settings directly except the editors of `scene_panel`; the rest is returned as [`UiOutput`]
+//! and applied by the frame.
+
+use egui::{Color32, Pos2, Rect, Sense};
+use glam::{Vec2, Vec3};
+
+use super::camera_control::{CameraInput, Navigation};
+use super::hud::{self, FrameStats};
+use super::panel;
+use super::scene_panel;
+use super::scene_state::SceneState;
+use super::traced::TracedView;
+use super::view_mode::{ViewMode, ViewState};
+use crate::RenderSettings;
+
+/// What the frame reads from and edits through the UI.
+pub struct UiModel<'a> {
+    pub settings: &'a RenderSettings,
+    pub scene: &'a mut SceneState,
+    pub view: &'a mut ViewState,
+    pub navigation: &'a mut Navigation,
+    pub raster: egui::TextureId,
+    pub traced: &'a TracedView,
+    /// The key of the request the current view shows (to tell stale traced images).
+    pub key: u64,
+    pub stats: &'a FrameStats,
+    /// The rasterizer's passes and their times in the last frame.
+    pub passes: &'a [(&'static str, std::time::Duration)],
+    /// The render scale of this frame's raster image.
+    pub scale: f32,
+    pub camera_error: &'a mut Option<String>,
+    /// Messages for the user (settings refused, screenshots written), newest last.
+    pub notices: &'a [String],
+}
+
+/// Requests the UI makes of the frame.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Action {
+    Frame,
+    Reset,
+    Screenshot,
+    DismissError,
+}
+
+/// What the UI gathered this frame.
+#[derive(Clone, Debug, Default)]
+pub struct UiOutput {
+    /// The 3D view, in points, rounded to whole pixels.
+    pub view_rect: Option<Rect>,
+    pub camera: CameraInput,
+    /// `key=value` assignments for `RenderSettings::set`.
+    pub settings: Vec<String>,
+    /// A click in the 3D view, in pixels of the full-resolution image.
+    pub pick: Option<Vec2>,
+    pub actions: Vec<Action>,
+    /// The camera, a light or a material was edited in place.
+    pub camera_edited: bool,
+    pub lights_edited: bool,
+    pub material_edited: bool,
+}
+
+/// Draws the whole window.
+pub fn draw(ui: &mut egui::Ui, model: &mut UiModel) -> UiOutput {
+    let mut output = UiOutput::default();
+    keys(ui.ctx(), model, &mut output);
+    if model.view.panel_open {
+        egui::Panel::left("side_panel").resizable(true).default_size(330.0).show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| side_panel(ui, model, &mut output));
+        });
+    }
+    egui::CentralPanel::no_frame().show(ui, |ui| view(ui, model, &mut output));
+    hud::help_window(ui.ctx(), &mut model.view.help_open);
+    output
+}
+
+/// Keys act only when no text field has the keyboard.
+fn keys(ctx: &egui::Context, model: &mut UiModel, output: &mut UiOutput) {
+    if ctx.egui_wants_keyboard_input() {
+        return;
+    }
+    ctx.input(|input| {
+        use egui::Key;
+        let pressed = |key| input.key_pressed(key);
+        if pressed(Key::F) {
+            output.actions.push(Action::Frame);
+        }
+        if pressed(Key::R) {
+            output.actions.push(Action::Reset);
+        }
+        if pressed(Key::F12) {
+            output.actions.push(Action::Screenshot);
+        }
+        if pressed(Key::F1) || pressed(Key::H) {
+            model.view.help_open = !model.view.help_open;
+        }
+        if pressed(Key::O) {
+            model.view.overlay_open = !model.view.overlay_open;
+        }
+        if pressed(Key::P) {
+            model.view.panel_open = !model.view.panel_open;
+        }
+        if pressed(Key::G) {
+            *model.navigation = match model.navigation {
+                Navigation::Orbit => Navigation::Fly,
+                Navigation::Fly => Navigation::Orbit,
+            };
+        }
+        for (key, mode) in [Key::Num1, Key::Num2, Key::Num3, Key::Num4].into_iter().zip(ViewMode::ALL) {
+            if pressed(key) {
+                model.view.mode = mode;
+            }
+        }
+        if *model.navigation == Navigation::Fly {
+            let axis =
+                |plus, minus| f32::from(u8::from(input.key_down(plus))) - f32::from(u8::from(input.key_down(minus)));
+            output.camera.walk = Vec3::new(axis(Key::D, Key::A), axis(Key::E, Key::Q), axis(Key::W, Key::S));
+            output.camera.fast = input.modifiers.shift;
+        }
+    });
+}
+
+fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
+    ui.heading("Mirador");
+    ui.horizontal_wrapped(|ui| {
+        for mode in ViewMode::ALL {
+            ui.selectable_value(&mut model.view.mode, mode, mode.label()).on_hover_text(match mode {
+                ViewMode::Raster => "The z-buffer rasterizer, every frame.",
+                ViewMode::Traced => "The Whitted ray tracer, refined in the background.",
+                ViewMode::Split => "Raster left, ray traced right of a divider you can drag: the same pixels.",
+                ViewMode::Difference => "The FLIP error map between the two (black: identical).",
+            });
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.selectable_value(model.navigation, Navigation::Orbit, "orbit")
+            .on_hover_text("Drag to turn around the target (G).");
+        ui.selectable_value(model.navigation, Navigation::Fly, "fly").on_hover_text("WASD to walk, drag to look (G).");
+        if ui.button("help").clicked() {
+            model.view.help_open = true;
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.add(egui::Slider::new(&mut model.view.motion_scale, 0.25..=1.0).step_by(0.05)).on_hover_text(
+            "The render scale while the camera moves: fewer pixels, more frames; full resolution again when it stops.",
+        );
+        ui.label("scale when moving");
+    });
+    ui.separator();
+
+    egui::CollapsingHeader::new(egui::RichText::new("camera").strong()).id_salt("camera").show(ui, |ui| {
+        output.camera_edited |= scene_panel::camera_ui(ui, &mut model.scene.scene.camera, model.camera_error);
+        if let Some(error) = model.camera_error.as_deref() {
+            ui.colored_label(ui.visuals().error_fg_color, error);
+        }
+        ui.horizontal(|ui| {
+            if ui.button("frame the scene (F)").clicked() {
+                output.actions.push(Action::Frame);
+            }
+            if ui.button("reset (R)").clicked() {
+                output.actions.push(Action::Reset);
+            }
+        });
+    });
+    output.settings = panel::settings_ui(ui, model.settings);
+    egui::CollapsingHeader::new(egui::RichText::new("lights").strong()).id_salt("lights").show(ui, |ui| {
+        output.lights_edited |= scene_panel::lights_ui(ui, &mut model.scene.scene.lights);
+    });
+    let picked = model.scene.picked;
+    egui::CollapsingHeader::new(egui::RichText::new("material").strong()).id_salt("material").default_open(true).show(
+        ui,
+        |ui| match picked {
+            Some(picked) => {
+                let object = model.scene.scene.objects.get(picked.object).map_or("?", |o| o.name.as_str()).to_string();
+                if let Some(material) = model.scene.scene.materials.get_mut(picked.material) {
+                    ui.label(format!("object `{object}`, material `{}`", material.name));
+                    output.material_edited |= scene_panel::material_ui(ui, material);
+                }
+            }
+            None => {
+                ui.label("Click an object in the view to edit its material.");
+            }
+        },
+    );
+    ui.separator();
+    let source = model.scene.scene.source.as_ref().map_or("(built in)".to_string(), |p| p.display().to_string());
+    ui.label(format!("scene: {source}")).on_hover_text(
+        "Drop a .toml scene or a .gltf/.glb model on the window to open it; the file is reloaded when it changes.",
+    );
+    for notice in model.notices.iter().rev().take(3) {
+        ui.small(notice);
+    }
+}
+
+/// Rounds a rectangle to whole physical pixels, so images drawn into it are pixel-aligned.
+fn snap(rect: Rect, pixels_per_point: f32) -> Rect {
+    let round =
+        |p: Pos2| Pos2::new((p.x * pixels_per_point).round(), (p.y * pixels_per_point).round()) / pixels_per_point;
+    Rect::from_min_max(round(rect.min), round(rect.max))
+}
+
+fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
+    let ppp = ui.ctx().pixels_per_point();
+    let rect = snap(ui.max_rect(), ppp);
+    if rect.width() < 1.0 || rect.height() < 1.0 {
+        return;
+    }
+    output.view_rect = Some(rect);
+    let response = ui.allocate_rect(rect, Sense::click_and_drag());
+    camera_input(ui, &response, rect, ppp, output);
+
+    let painter = ui.painter_at(rect);
+    let full = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
+    let traced = model.traced.image.as_ref();
+    match model.view.mode {
+        ViewMode::Raster => {
+            painter.image(model.raster, rect, full, Color32::WHITE);
+        }
+        ViewMode::Traced => match traced {
+            Some(shown) => {
+                painter.image(shown.texture.id(), rect, full, Color32::WHITE);
+            }
+            None => {
+                painter.image(model.raster, rect, full, Color32::from_gray(90));
+            }
+        },
+        ViewMode::Split => {
+            painter.image(model.raster, rect, full, Color32::WHITE);
+            let x = (rect.min.x + model.view.split * rect.width()) * ppp;
+            let x = x.round() / ppp;
+            if let Some(shown) = traced {
+                let right = Rect::from_min_max(Pos2::new(x, rect.min.y), rect.max);
+                painter.with_clip_rect(right).image(shown.texture.id(), rect, full, Color32::WHITE);
+            }
+            divider(ui, model, rect, x);
+        }
+        ViewMode::Difference => match &model.traced.difference {
+            Some(shown) if shown.key == model.key => {
+                painter.image(shown.texture.id(), rect, full, Color32::WHITE);
+            }
+            _ => {
+                painter.image(model.raster, rect, full, Color32::from_gray(90));
+            }
+        },
+    }
+    if model.view.overlay_open {
+        overlay(ui, model, rect);
+    }
+    if let Some(error) = model.scene.error.clone() {
+        egui::Area::new(egui::Id::unique("mirador::scene_error")).fixed_pos(rect.min + egui::vec2(12.0, 12.0)).show(
+            ui.ctx(),
+            |ui| {
+                egui::Frame::popup(ui.style()).fill(Color32::from_rgb(90, 20, 20)).show(ui, |ui| {
+                    ui.set_max_width(rect.width() - 40.0);
+                    ui.colored_label(
+                        Color32::WHITE,
+                        format!("The scene could not be loaded; the previous one is kept.\n{error}"),
+                    );
+                    if ui.button("dismiss").clicked() {
+                        output.actions.push(Action::DismissError);
+                    }
+                });
+            },
+        );
+    }
+}
+
+/// Mouse over the 3D view: drags, wheel and clicks, in pixels of the full-resolution image.
+fn camera_input(ui: &egui::Ui, response: &egui::Response, rect: Rect, ppp: f32, output: &mut UiOutput) {
+    let delta = response.drag_delta() * ppp;
+    let delta = Vec2::new(delta.x, delta.y);
+    if response.dragged_by(egui::PointerButton::Primary) {
+        output.camera.rotate = delta;
+    }
+    if response.dragged_by(egui::PointerButton::Secondary) || response.dragged_by(egui::PointerButton::Middle) {
+        output.camera.pan = delta;
+    }
+    if response.hovered() {
+        // egui gives a wheel notch as 50 points of scroll.
+        output.camera.zoom = ui.input(|i| i.smooth_scroll_delta.y) / 50.0;
+    }
+    output.camera.dt = ui.input(|i| i.stable_dt).min(0.1);
+    if response.clicked()
+        && let Some(pos) = response.interact_pointer_pos()
+    {
+        let p = (pos - rect.min) * ppp;
+        output.pick = Some(Vec2::new(p.x, p.y));
+    }
+}
+
+/// The split view's divider: a line you can drag.
+fn divider(ui: &mut egui::Ui, model: &mut UiModel, rect: Rect, x: f32) {
+    let handle = Rect::from_min_max(Pos2::new(x - 5.0, rect.min.y), Pos2::new(x + 5.0, rect.max.y));
+    let response = ui
+        .interact(handle, ui.scope_id().with("split_divider"), Sense::drag())
+        .on_hover_cursor(egui::CursorIcon::ResizeHorizontal);
+    if response.dragged()
+        && let Some(pointer) = response.interact_pointer_pos()
+    {
+        model.view.split = ((pointer.x - rect.min.x) / rect.width()).clamp(0.0, 1.0);
+    }
+    let painter = ui.painter_at(rect);
+    let stroke = egui::Stroke::new(if response.hovered() || response.dragged() { 3.0 } else { 1.0 }, Color32::WHITE);
+    painter.vline(x, rect.y_range(), stroke);
+    let font = egui::FontId::proportional(13.0);
+    let shadowed = |pos: Pos2, align, text: &str| {
+        painter.text(pos + egui::vec2(1.0, 1.0), align, text, font.clone(), Color32::BLACK);
+        painter.text(pos, align, text, font.clone(), Color32::WHITE);
+    };
+    shadowed(Pos2::new(x - 8.0, rect.max.y - 8.0), egui::Align2::RIGHT_BOTTOM, "raster");
+    shadowed(Pos2::new(x + 8.0, rect.max.y - 8.0), egui::Align2::LEFT_BOTTOM, "ray traced");
+}
+
+/// Frame times, the traced image's progress and the difference's mean, in the view's top-right
+/// corner.
+fn overlay(ui: &egui::Ui, model: &UiModel, rect: Rect) {
+    let mut text = model.stats.overlay_text(model.scale);
+    for (name, time) in model.passes {
+        text += &format!("\n  {name} {:.1} ms", time.as_secs_f64() * 1e3);
+    }
+    text += &format!(
+        "\nview: {}  ({})",
+        model.view.mode.label(),
+        match model.navigation {
+            Navigation::Orbit => "orbit",
+            Navigation::Fly => "fly",
+        }
+    );
+    if model.view.mode.needs_traced() {
+        text += &match model.traced.image.as_ref() {
+            Some(shown) if shown.key == model.key && shown.complete => {
+                format!("\ntraced: complete in {:.2} s", shown.elapsed.as_secs_f64())
+            }
+            Some(shown) if shown.key == model.key => {
+                format!("\ntraced: 1 ray per {0}×{0} pixels, {1:.2} s", shown.block, shown.elapsed.as_secs_f64())
+            }
+            _ => "\ntraced: starting…".to_string(),
+        };
+    }
+    if model.view.mode == ViewMode::Difference {
+        text += &match &model.traced.difference {
+            Some(d) if d.key == model.key => format!("\nFLIP mean {:.4}", d.flip_mean),
+            _ => "\nFLIP: waiting for the complete traced image".to_string(),
+        };
+    }
+    egui::Area::new(egui::Id::unique("mirador::frame_overlay"))
+        .fixed_pos(Pos2::new(rect.max.x - 8.0, rect.min.y + 8.0))
+        .pivot(egui::Align2::RIGHT_TOP)
+        .interactable(false)
+        .show(ui.ctx(), |ui| {
+            egui::Frame::popup(ui.style()).fill(Color32::from_black_alpha(170)).show(ui, |ui| {
+                ui.add(
+                    egui::Label::new(egui::RichText::new(text).monospace().color(Color32::WHITE).size(12.0))
+                        .wrap_mode(egui::TextWrapMode::Extend),
+                );
+            });
+        });
+}

@@ -1,0 +1,265 @@
+//! The viewer as a person meets it, run under Xvfb (`xvfb-run -a`): it opens the showcase with
+//! every technique on, switches view modes and toggles by scripted steps, writes screenshots and
+//! exits cleanly. The 3D region of a screenshot is compared by FLIP with what the headless
+//! renderers draw at the same size, so the window shows the same pixels as `mirador render` and
+//! `mirador trace`, and the split view's halves line up.
+//!
+//! These tests need an X display: install Xvfb (`apt-get install xvfb`; `.ci/run` does).
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use mirador::Scene;
+
+/// The greatest mean FLIP error between the window's 3D view and the headless image. The same
+/// device draws both (lavapipe); what remains is egui's dithering of its output.
+const MAX_FLIP_MEAN: f32 = 0.01;
+
+fn on_path(program: &str) -> bool {
+    std::env::var_os("PATH").is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
+}
+
+/// The viewer with `args`, under `xvfb-run -a` when it exists, else on the current display.
+fn viewer(args: &[&str], config_home: &Path) -> Output {
+    let binary = env!("CARGO_BIN_EXE_mirador");
+    let mut command = if on_path("xvfb-run") {
+        let mut c = Command::new("xvfb-run");
+        c.args(["-a", "-s", "-screen 0 1920x1080x24", binary]);
+        c
+    } else if std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty()) {
+        Command::new(binary)
+    } else {
+        panic!(
+            "the viewer tests need an X display: install Xvfb (`sudo apt-get install xvfb`, as .ci/run does) \
+             or run them under a desktop session"
+        );
+    };
+    command.arg("view").args(args).env("XDG_CONFIG_HOME", config_home).env_remove("WAYLAND_DISPLAY");
+    let output = command.output().expect("running the viewer");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("panicked"), "the viewer panicked: {stderr}");
+    output
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mirador-viewer-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("creating a scratch directory");
+    dir
+}
+
+/// Where the 3D view sat in each screenshot, from the viewer's `screenshot FILE window WxH view X
+/// Y W H` lines.
+fn views(output: &Output) -> Vec<(PathBuf, [u32; 4])> {
+    String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .filter_map(|line| {
+            let rest = line.strip_prefix("screenshot ")?;
+            let (path, geometry) = rest.split_once(" window ")?;
+            let numbers: Vec<u32> =
+                geometry.split_once(" view ")?.1.split(' ').filter_map(|n| n.parse().ok()).collect();
+            Some((PathBuf::from(path), numbers.try_into().ok()?))
+        })
+        .collect()
+}
+
+fn succeeded(output: &Output) {
+    assert!(
+        output.status.success(),
+        "the viewer failed: {}\n{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+fn crop(image: &image::RgbaImage, [x, y, w, h]: [u32; 4]) -> image::RgbaImage {
+    image::imageops::crop_imm(image, x, y, w, h).to_image()
+}
+
+/// The showcase at `w × h`, as the headless command would draw it.
+fn showcase(w: u32, h: u32) -> Scene {
+    let mut scene = Scene::showcase().expect("the showcase loads");
+    scene.camera.width = w;
+    scene.camera.height = h;
+    scene
+}
+
+fn flip(reference: &image::RgbaImage, test: &image::RgbaImage, what: &str, dir: &Path) -> f32 {
+    let d = mirador::compare::difference(reference, test).unwrap_or_else(|e| panic!("{what}: {e}"));
+    if d.flip_mean > MAX_FLIP_MEAN {
+        let _ = reference.save(dir.join(format!("{what}-expected.png")));
+        let _ = test.save(dir.join(format!("{what}-actual.png")));
+        let _ = d.error_map.save(dir.join(format!("{what}-diff.png")));
+    }
+    d.flip_mean
+}
+
+#[test]
+fn the_showcase_in_the_window_is_the_headless_render() {
+    let dir = scratch("raster");
+    let shot = dir.join("raster.png");
+    let output = viewer(
+        &["--size", "1000x600", "--frames", "3", "--step", "overlay off", "--screenshot", shot.to_str().unwrap()],
+        &dir,
+    );
+    succeeded(&output);
+    let views = views(&output);
+    let [(path, view)] = &views[..] else { panic!("one screenshot line expected: {output:?}") };
+    let view = *view;
+    assert_eq!(path, &shot);
+    let image = image::open(&shot).expect("the screenshot is a PNG").into_rgba8();
+    assert!(view[0] > 100, "the side panel is left of the view: {view:?}");
+    assert_eq!((view[0] + view[2], view[1] + view[3]), image.dimensions(), "the view fills the rest of the window");
+    // The panel is drawn: its pixels are not all one colour.
+    let panel = crop(&image, [0, 0, view[0], view[3]]);
+    let first = panel.get_pixel(0, 0);
+    assert!(panel.pixels().any(|p| p != first), "the side panel has content");
+
+    let scene = showcase(view[2], view[3]);
+    let expected = common::raster(&scene, &scene.settings);
+    let error = flip(&expected, &crop(&image, view), "raster", &dir);
+    assert!(error <= MAX_FLIP_MEAN, "the window's 3D view differs from `render`: mean FLIP {error}");
+    assert!(!dir.join("mirador").exists(), "a scripted run leaves the remembered settings alone");
+}
+
+#[test]
+fn scripted_toggles_and_view_modes_run_and_exit_cleanly() {
+    let dir = scratch("modes");
+    let shots: Vec<PathBuf> =
+        ["toggled", "split", "difference", "traced"].iter().map(|n| dir.join(format!("{n}.png"))).collect();
+    let step = |s: &str| s.to_string();
+    let mut steps = vec![
+        step("overlay off"),
+        step("set shadows.enabled=false"),
+        step("set bump.view=\"normals\""),
+        step("set textures.filter=\"level_colour\""),
+        step("set shadows.show_frusta=true"),
+        format!("screenshot {}", shots[0].display()),
+        step("set bump.view=\"off\""),
+        step("set textures.filter=\"trilinear\""),
+        step("set shadows.show_frusta=false"),
+        step("set shadows.enabled=true"),
+        step("orbit 30 -10"),
+        step("reset"),
+        step("view split"),
+        step("split 0.5"),
+        step("wait traced"),
+        format!("screenshot {}", shots[1].display()),
+        step("view difference"),
+        step("wait traced"),
+        format!("screenshot {}", shots[2].display()),
+        step("view traced"),
+        step("wait traced"),
+        step("help on"),
+        step("pick 200 300"),
+        step("material kd=0.1"),
+        step("view raster"),
+    ];
+    steps.push(format!("screenshot {}", shots[3].display()));
+    let mut args = vec!["--size".to_string(), "640x400".to_string(), "--frames".to_string(), "2".to_string()];
+    for s in &steps {
+        args.push("--step".into());
+        args.push(s.clone());
+    }
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let output = viewer(&args, &dir);
+    succeeded(&output);
+    let views = views(&output);
+    assert_eq!(views.len(), 4, "every screenshot step wrote one: {views:?}");
+    for (path, _) in &views {
+        assert!(image::open(path).is_ok(), "{} is a PNG", path.display());
+    }
+
+    // The split view: raster left of the divider, ray traced right, both pixel-aligned with the
+    // headless images of the same size.
+    let view = views[1].1;
+    let image = image::open(&shots[1]).unwrap().into_rgba8();
+    let scene = showcase(view[2], view[3]);
+    let raster = common::raster(&scene, &scene.settings);
+    let traced = mirador::trace::render_image(&scene, &scene.settings);
+    let half = view[2] / 2;
+    // Keep clear of the divider line and its labels at the bottom.
+    let left = [view[0], view[1], half - 4, view[3] - 30];
+    let right = [view[0] + half + 4, view[1], view[2] - half - 4, view[3] - 30];
+    let in_view = |[x, y, w, h]: [u32; 4]| [x - view[0], y - view[1], w, h];
+    let raster_error = flip(&crop(&raster, in_view(left)), &crop(&image, left), "split-left", &dir);
+    let traced_error = flip(&crop(&traced, in_view(right)), &crop(&image, right), "split-right", &dir);
+    assert!(raster_error <= MAX_FLIP_MEAN, "split, left half: mean FLIP {raster_error} against `render`");
+    assert!(traced_error <= MAX_FLIP_MEAN, "split, right half: mean FLIP {traced_error} against `trace`");
+
+    // The difference view shows the FLIP map of the same two images.
+    let difference = image::open(&shots[2]).unwrap().into_rgba8();
+    let expected = mirador::compare::difference(&traced, &raster).unwrap().error_map;
+    let error = flip(&expected, &crop(&difference, views[2].1), "difference", &dir);
+    assert!(error <= MAX_FLIP_MEAN, "the difference view is the FLIP map of traced and raster: {error}");
+
+    // The toggled frame differs from the default one.
+    let toggled = crop(&image::open(&shots[0]).unwrap().into_rgba8(), views[0].1);
+    assert!(
+        flip(&crop(&raster, [0, 0, views[0].1[2], views[0].1[3]]), &toggled, "toggled", &dir) > 0.02,
+        "toggles change the image"
+    );
+}
+
+#[test]
+fn a_scene_that_fails_to_load_keeps_the_previous_one() {
+    let dir = scratch("bad-scene");
+    let bad = dir.join("broken.toml");
+    std::fs::write(&bad, "[camera\neye = [0, 0, 1]\n").unwrap();
+    let shot = dir.join("after.png");
+    let load = format!("load {}", bad.display());
+    let output =
+        viewer(&["--size", "640x400", "--frames", "2", "--step", &load, "--screenshot", shot.to_str().unwrap()], &dir);
+    succeeded(&output);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("broken.toml"), "the load error names the file: {stderr}");
+    assert!(shot.exists());
+}
+
+#[test]
+fn bad_steps_and_outputs_fail_with_a_message() {
+    let dir = scratch("bad-steps");
+    for args in [
+        vec!["--frames", "1", "--step", "dance"],
+        vec!["--frames", "1", "--step", "set shadows.glow=true"],
+        vec!["--frames", "1", "--screenshot", "out.jpg"],
+        vec!["--frames", "1", "--step", "pick 1 1", "--step", "material glow=2"],
+    ] {
+        let output = viewer(&args, &dir);
+        assert!(!output.status.success(), "{args:?} should fail");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains("error"), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
+fn a_scene_file_changed_on_disk_is_reloaded() {
+    let dir = scratch("reload");
+    let scene = dir.join("scene.toml");
+    let original = std::fs::read_to_string(common::asset("scenes/seed-simple.toml")).expect("the seed scene");
+    std::fs::write(&scene, &original).unwrap();
+    let binary = env!("CARGO_BIN_EXE_mirador");
+    assert!(on_path("xvfb-run"), "install Xvfb (`sudo apt-get install xvfb`) to run the viewer tests");
+    let mut child = Command::new("xvfb-run")
+        .args(["-a", binary, "view", scene.to_str().unwrap(), "--size", "480x320", "--frames", "2"])
+        .args(["--step", "wait 60"])
+        .env("XDG_CONFIG_HOME", &dir)
+        .env("RUST_LOG", "mirador=info")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("starting the viewer");
+    // Touch the file until the viewer is done: it polls the modification time twice a second.
+    let mut edits = 0;
+    while child.try_wait().expect("polling the viewer").is_none() {
+        std::thread::sleep(std::time::Duration::from_millis(300));
+        edits += 1;
+        std::fs::write(&scene, format!("{original}\n# edit {edits}\n")).unwrap();
+    }
+    let output = child.wait_with_output().expect("the viewer's output");
+    succeeded(&output);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.contains("changed on disk"), "the edited scene was reloaded: {stderr}");
+}
