@@ -1,10 +1,11 @@
 //! `RenderSettings`: every toggle in one serde struct. The CLI's `--set key=value`, the scene
 //! file's `[settings]` table, the viewer's panel and the tests all read and write this one type,
 //! so a toggle means the same thing everywhere. Later techniques add their sections here.
+//!
+//! This module depends on nothing else of Mirador: the scene holds its file's settings, and the
+//! renderers read both, so the layers stay one-way (settings ← scene ← renderers).
 
 use serde::{Deserialize, Serialize};
-
-use crate::scene::shading::Terms;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -352,12 +353,6 @@ pub struct TermSettings {
 impl Default for TermSettings {
     fn default() -> Self {
         TermSettings { ambient: true, diffuse: true, specular: true, emission: true }
-    }
-}
-
-impl From<TermSettings> for Terms {
-    fn from(t: TermSettings) -> Terms {
-        Terms { ambient: t.ambient, diffuse: t.diffuse, specular: t.specular, emission: t.emission }
     }
 }
 

@@ -60,6 +60,12 @@ pub struct Terms {
     pub emission: bool,
 }
 
+impl From<crate::settings::TermSettings> for Terms {
+    fn from(t: crate::settings::TermSettings) -> Terms {
+        Terms { ambient: t.ambient, diffuse: t.diffuse, specular: t.specular, emission: t.emission }
+    }
+}
+
 impl Terms {
     pub const ALL: Terms = Terms { ambient: true, diffuse: true, specular: true, emission: true };
 }

@@ -159,7 +159,9 @@ impl App {
             self.outcome = Err(e);
         }
         if let (Some(path), Some((screen, viewer))) = (self.config_path(), &self.running) {
-            let size = screen.window.inner_size().to_logical::<u32>(screen.window.scale_factor());
+            // The surface's size, not the window's: the window may already be gone.
+            let (width, height) = screen.size();
+            let size = winit::dpi::PhysicalSize::new(width, height).to_logical::<u32>(screen.window.scale_factor());
             if let Err(e) = config::save(&path, &viewer.remembered([size.width, size.height])) {
                 eprintln!("warning: {}: cannot remember the viewer's settings: {e:#}", path.display());
             }
@@ -224,6 +226,13 @@ impl ApplicationHandler<Wake> for App {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        // A window destroyed from outside (no close request first) can no longer be asked
+        // anything: end before any handler looks at it.
+        if matches!(event, WindowEvent::Destroyed) {
+            self.finish(event_loop, Ok(()));
+            self.running = None;
+            return;
+        }
         let Some((screen, viewer)) = &mut self.running else { return };
         let response = screen.input.on_window_event(&screen.window, &event);
         match event {
