@@ -16,8 +16,11 @@ fn parse(source: &str) -> naga::Module {
     naga::front::wgsl::parse_str(source).unwrap_or_else(|e| panic!("{}", e.emit_to_string(source)))
 }
 
-/// Each named struct's size and its members' (name, offset), as naga lays them out.
-fn structs(module: &naga::Module) -> Vec<(String, u32, Vec<(String, u32)>)> {
+/// A struct's name, size, and its members' (name, offset).
+type StructLayout = (String, u32, Vec<(String, u32)>);
+
+/// Each named struct's layout, as naga computes it.
+fn structs(module: &naga::Module) -> Vec<StructLayout> {
     module
         .types
         .iter()
@@ -49,7 +52,7 @@ fn constant(module: &naga::Module, name: &str) -> f64 {
 
 /// Compares a WGSL struct with its Rust twin: the size, and the offset of every field that is not
 /// padding (the Rust twin's fields are listed with their offsets by `fields!`).
-fn check_struct(all: &[(String, u32, Vec<(String, u32)>)], name: &str, size: usize, rust: &[(&str, usize)]) {
+fn check_struct(all: &[StructLayout], name: &str, size: usize, rust: &[(&str, usize)]) {
     let (_, span, members) =
         all.iter().find(|(n, _, _)| n == name).unwrap_or_else(|| panic!("no struct {name} in the WGSL"));
     assert_eq!(*span as usize, size, "size of WGSL {name} vs its Rust twin");

@@ -234,15 +234,8 @@ impl Renderer {
         }
         let mut projected_recomputed = false;
         if projected {
-            projected_recomputed = self.projected.record(
-                device,
-                &mut frame.encoder,
-                scene,
-                scene_gpu,
-                &layout,
-                &targets.shadow_mask.view,
-                &targets.depth.view,
-            );
+            projected_recomputed =
+                self.projected.record(device, &mut frame.encoder, scene, scene_gpu, &layout, targets);
             frame.end("projected shadows");
         }
         let scene_targets =

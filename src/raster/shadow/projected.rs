@@ -22,9 +22,9 @@ use wgpu::util::DeviceExt;
 
 use super::views::ShadowLayout;
 use crate::gpu::layout;
-use crate::raster::DEPTH_FORMAT;
 use crate::raster::scene_gpu::{SceneGpu, SceneLayouts};
 use crate::raster::view::ViewSlot;
+use crate::raster::{DEPTH_FORMAT, FrameTargets};
 use crate::scene::{Light, LightKind, Scene, Shape};
 use crate::shaders;
 
@@ -239,7 +239,8 @@ impl ProjectedPass {
     }
 
     /// Computes the polygons if the lights or the geometry changed since the last call, clears
-    /// `mask` and draws them into it, seen from the main view. The mask starts cleared even when
+    /// the frame's shadow mask and draws them into it, seen from the main view and depth-tested
+    /// against the frame's depth prepass. The mask starts cleared even when
     /// there is nothing to draw, since the opaque pass reads it whenever this method is chosen.
     /// Returns whether the polygons were computed anew.
     pub fn record(
@@ -249,9 +250,9 @@ impl ProjectedPass {
         scene: &Scene,
         scene_gpu: &SceneGpu,
         layout: &ShadowLayout,
-        mask: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
+        targets: &FrameTargets,
     ) -> bool {
+        let (mask, depth) = (&targets.shadow_mask.view, &targets.depth.view);
         let inputs = PolygonInputs {
             lights: scene.lights.clone(),
             first_layer: layout.first_layer.clone(),
