@@ -36,7 +36,7 @@ use present::{PresentInput, PresentPass};
 use scene_gpu::{SceneGpu, SceneLayouts};
 use scene_pass::{FrameKey, ScenePass, SceneTargets};
 use shadow::projected::{MASK_FORMAT, ProjectedPass};
-use shadow::views::shadow_layout_in;
+use shadow::views::{ShadowLayout, shadow_layout_in};
 use shadow::{ShadowMaps, ShadowPass};
 use view::{View, ViewSlot};
 
@@ -219,12 +219,11 @@ impl Renderer {
         let frame_key = FrameKey::new(settings, !layout.views.is_empty(), transmission);
         self.scene.prepare(device, frame_key, &scene_gpu.material_keys, prepass);
 
+        // Object precision draws no maps: its light views have no layers to fill.
+        let no_maps = ShadowLayout::default();
+        let map_layout = if projected { &no_maps } else { &layout };
         let mut frame = FrameEncoder::new(gpu, self.profile);
-        let maps = if projected {
-            self.shadow.record(device, queue, &mut frame.encoder, scene_gpu, &Default::default(), shadows)
-        } else {
-            self.shadow.record(device, queue, &mut frame.encoder, scene_gpu, &layout, shadows)
-        };
+        let maps = self.shadow.record(device, queue, &mut frame.encoder, scene_gpu, map_layout, shadows);
         let shadow_layers_drawn = maps.layers_drawn;
         frame.end("shadow maps");
         let lighting = lighting_group(&mut self.lighting, device, &self.layouts, &maps, targets);
@@ -250,7 +249,7 @@ impl Renderer {
             prepass,
         );
         frame.end("opaque");
-        self.overlays.record(device, queue, &mut frame.encoder, shadows, scene_gpu, &layout, &maps, targets);
+        self.overlays.record(device, queue, &mut frame.encoder, shadows, scene_gpu, map_layout, &maps, targets);
         self.present.record(queue, &mut frame.encoder, &targets.present_input, output, settings.exposure);
         frame.end("overlays + present");
         FrameReport {
