@@ -147,3 +147,20 @@ fn a_half_render_scale_is_upscaled_to_the_full_image() {
     assert!(difference.flip_mean < 0.12, "FLIP mean {}", difference.flip_mean);
     assert!(difference.flip_mean > 0.005, "a half-resolution image cannot be the full one");
 }
+
+#[test]
+fn a_gltf_mesh_used_by_two_nodes_is_one_instanced_draw() {
+    // two_nodes.gltf: two nodes draw the same two-primitive mesh.
+    let path = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/gltf/two_nodes.gltf"));
+    let scene = mirador::Scene::load(path).unwrap();
+    assert_eq!(scene.meshes.len(), 2);
+    let gpu = common::gpu();
+    let mut headless = Headless::new(gpu, &scene);
+    headless.render(gpu, &scene, &scene.settings);
+    let geometry = &headless.scene_gpu.geometry;
+    assert_eq!(geometry.mesh_count(), 2, "each primitive uploaded once");
+    let file_batches: Vec<_> =
+        geometry.batches.iter().filter(|b| matches!(b.mesh, mirador::raster::geometry::MeshKey::File(_))).collect();
+    assert_eq!(file_batches.len(), 2, "one draw per primitive: {file_batches:?}");
+    assert!(file_batches.iter().all(|b| b.instances.len() == 2), "each drawn for both nodes: {file_batches:?}");
+}
