@@ -73,6 +73,18 @@ pub fn depth_test(
     })
 }
 
+/// A render pass's depth attachment: loaded or cleared, and stored.
+pub fn depth_attachment(
+    view: &wgpu::TextureView,
+    load: wgpu::LoadOp<f32>,
+) -> wgpu::RenderPassDepthStencilAttachment<'_> {
+    wgpu::RenderPassDepthStencilAttachment {
+        view,
+        depth_ops: Some(wgpu::Operations { load, store: wgpu::StoreOp::Store }),
+        stencil_ops: None,
+    }
+}
+
 /// The pipeline of a pass that runs its fragment shader once per pixel of its targets: one
 /// triangle covering them, no vertex buffers, no depth (the vertex entry point returns
 /// `fullscreen_position(vertex_index)` from `shaders/common/types.wgsl`).

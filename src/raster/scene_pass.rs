@@ -276,7 +276,7 @@ impl ScenePass {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("scene::prepass"),
             color_attachments: &[],
-            depth_stencil_attachment: Some(depth_attachment(depth, wgpu::LoadOp::Clear(1.0))),
+            depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Clear(1.0))),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
@@ -323,7 +323,7 @@ impl ScenePass {
                     store: wgpu::StoreOp::Store,
                 },
             })],
-            depth_stencil_attachment: Some(depth_attachment(targets.depth, depth_load)),
+            depth_stencil_attachment: Some(layout::depth_attachment(targets.depth, depth_load)),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
@@ -343,14 +343,6 @@ impl ScenePass {
             scene.geometry.draw(&mut pass, batch);
         }
         pass.pop_debug_group();
-    }
-}
-
-fn depth_attachment(view: &wgpu::TextureView, load: wgpu::LoadOp<f32>) -> wgpu::RenderPassDepthStencilAttachment<'_> {
-    wgpu::RenderPassDepthStencilAttachment {
-        view,
-        depth_ops: Some(wgpu::Operations { load, store: wgpu::StoreOp::Store }),
-        stencil_ops: None,
     }
 }
 

@@ -358,11 +358,7 @@ impl ShadowPass {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow::depth_pass"),
                 color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
+                depth_stencil_attachment: Some(layout::depth_attachment(depth_view, wgpu::LoadOp::Clear(1.0))),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
@@ -383,11 +379,7 @@ impl ShadowPass {
                         store: wgpu::StoreOp::Store,
                     },
                 })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: depth_view,
-                    depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
-                    stencil_ops: None,
-                }),
+                depth_stencil_attachment: Some(layout::depth_attachment(depth_view, wgpu::LoadOp::Load)),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,

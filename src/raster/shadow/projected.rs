@@ -274,11 +274,7 @@ impl ProjectedPass {
                     store: wgpu::StoreOp::Store,
                 },
             })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: depth,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
+            depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Load)),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
