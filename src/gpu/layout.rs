@@ -73,6 +73,19 @@ pub fn depth_test(
     })
 }
 
+/// A render pass's colour attachment: loaded or cleared, and stored.
+pub fn color_attachment(
+    view: &wgpu::TextureView,
+    load: wgpu::LoadOp<wgpu::Color>,
+) -> wgpu::RenderPassColorAttachment<'_> {
+    wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
+    }
+}
+
 /// A render pass's depth attachment: loaded or cleared, and stored.
 pub fn depth_attachment(
     view: &wgpu::TextureView,

@@ -171,17 +171,7 @@ impl MipmapGenerator {
                 entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&source) }],
             });
             // Every texel is drawn, so the old contents need not be loaded.
-            let attachment = |view| {
-                Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })
-            };
+            let attachment = |view| Some(layout::color_attachment(view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)));
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("mipmap::pass"),
                 color_attachments: &[attachment(&targets[0]), attachment(&targets[1])],

@@ -133,12 +133,7 @@ impl MapView {
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("overlays::map_view_pass"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: hdr,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
-            })],
+            color_attachments: &[Some(layout::color_attachment(hdr, wgpu::LoadOp::Load))],
             depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,
@@ -215,12 +210,7 @@ impl Frusta {
         });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("overlays::frusta_pass"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: hdr,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
-            })],
+            color_attachments: &[Some(layout::color_attachment(hdr, wgpu::LoadOp::Load))],
             depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Load)),
             timestamp_writes: None,
             occlusion_query_set: None,

@@ -83,12 +83,7 @@ impl PresentPass {
         self.uniform.write(queue, &GpuPresent { exposure, _pad: 0.0, scale });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("present::pass"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: output,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
-            })],
+            color_attachments: &[Some(layout::color_attachment(output, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))],
             depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,

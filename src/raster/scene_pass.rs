@@ -314,15 +314,10 @@ impl ScenePass {
         };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("scene::opaque"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: targets.hdr,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r: bg.x, g: bg.y, b: bg.z, a: 1.0 }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
+            color_attachments: &[Some(layout::color_attachment(
+                targets.hdr,
+                wgpu::LoadOp::Clear(wgpu::Color { r: bg.x, g: bg.y, b: bg.z, a: 1.0 }),
+            ))],
             depth_stencil_attachment: Some(layout::depth_attachment(targets.depth, depth_load)),
             timestamp_writes: None,
             occlusion_query_set: None,

@@ -179,12 +179,10 @@ impl Screen {
     ) {
         let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("viewer::ui_pass"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
-            })],
+            color_attachments: &[Some(crate::gpu::layout::color_attachment(
+                target,
+                wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+            ))],
             depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,

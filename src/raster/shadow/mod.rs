@@ -370,15 +370,10 @@ impl ShadowPass {
         if targets.with_transmission {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow::transmission_pass"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &targets.transmission_layers[layer],
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::WHITE),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
+                color_attachments: &[Some(layout::color_attachment(
+                    &targets.transmission_layers[layer],
+                    wgpu::LoadOp::Clear(wgpu::Color::WHITE),
+                ))],
                 depth_stencil_attachment: Some(layout::depth_attachment(depth_view, wgpu::LoadOp::Load)),
                 timestamp_writes: None,
                 occlusion_query_set: None,

@@ -265,15 +265,7 @@ impl ProjectedPass {
         let polygons = self.polygons.as_ref().expect("computed above");
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("shadow_projected::pass"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: mask,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
+            color_attachments: &[Some(layout::color_attachment(mask, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)))],
             depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Load)),
             timestamp_writes: None,
             occlusion_query_set: None,
