@@ -516,6 +516,8 @@ impl<'a> Builder<'a> {
             bump_scale: d.bump_scale.map_or(base.bump_scale, |Finite(x)| x),
             normal_map,
             normal_scale: d.normal_scale.map_or(base.normal_scale, |Finite(x)| x),
+            alpha: base.alpha,
+            alpha_mode: base.alpha_mode,
         })
     }
 

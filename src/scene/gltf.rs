@@ -758,6 +758,8 @@ impl<'d> Importer<'d> {
             bump_scale: 1.0,
             normal_map: normal_map.map(|(id, _)| id),
             normal_scale: normal_map.map_or(1.0, |(_, scale)| scale),
+            alpha: 1.0,
+            alpha_mode: crate::scene::AlphaMode::Opaque,
         })
     }
 

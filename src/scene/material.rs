@@ -69,6 +69,21 @@ pub enum ProceduralHeight {
     Noise { seed: u32, cells: u32, octaves: u32, amplitude: f32 },
 }
 
+/// How a material's coverage `α` is read (glTF's `alphaMode`). `α` is [`Material::alpha`] times
+/// the colour texture's alpha where there is a texture.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum AlphaMode {
+    /// `α` is ignored: the surface covers all of its area.
+    #[default]
+    Opaque,
+    /// The surface exists only where `α ≥ cutoff` (leaves, fences), for the camera and for the
+    /// lights alike.
+    Mask { cutoff: f32 },
+    /// A fraction `α` of the surface covers what lies behind it: `I = α·Im + (1 − α)·I`, the seed's
+    /// transparency (TECHNIQUES.md §5) with `Im` scaled by `α` and `kt·Mt = 1 − α`, grey.
+    Blend,
+}
+
 /// One material of the model
 /// `ME + AG + Σ V·S·(ka·C + kd·C·max(0, n·l) + ks·S·max(0, r·v)^e) + kps·MPS·L(r) + kt·MT·L(t)`.
 #[derive(Clone, Debug, PartialEq)]
@@ -106,12 +121,17 @@ pub struct Material {
     /// (tangent, bitangent, normal), its x and y scaled by `normal_scale`.
     pub normal_map: Option<TextureId>,
     pub normal_scale: f32,
+    /// Coverage: how much of the surface is there (glTF's base colour alpha), read as
+    /// `alpha_mode` says.
+    pub alpha: f32,
+    pub alpha_mode: AlphaMode,
 }
 
 impl Material {
-    /// Whether light passes through (kt > 0): such surfaces tint shadows instead of blocking them.
+    /// Whether light passes through (kt > 0, or alpha blending): such surfaces are drawn after the
+    /// opaque ones, and tint shadows instead of blocking them.
     pub fn is_transparent(&self) -> bool {
-        self.transmission > 0.0
+        self.transmission > 0.0 || self.alpha_mode == AlphaMode::Blend
     }
 }
 
@@ -138,6 +158,8 @@ impl Default for Material {
             bump_scale: 1.0,
             normal_map: None,
             normal_scale: 1.0,
+            alpha: 1.0,
+            alpha_mode: AlphaMode::Opaque,
         }
     }
 }

@@ -21,7 +21,7 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 
 pub use camera::{Camera, Projection, Ray};
 pub use light::{Attenuation, Light, LightKind};
-pub use material::{ColorSpace, Material, MaterialId, ProceduralHeight, Texture, TextureId, Wrap};
+pub use material::{AlphaMode, ColorSpace, Material, MaterialId, ProceduralHeight, Texture, TextureId, Wrap};
 pub use mesh::Mesh;
 
 use crate::settings::RenderSettings;
