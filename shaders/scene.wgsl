@@ -22,6 +22,8 @@ override FLAT_COLOUR: bool = false;
 override COLOR_TEXTURE: bool = false;
 override HEIGHT_KIND: u32 = 0u;
 override NORMAL_MAP: bool = false;
+// ALPHA_* of shaders/common/types.wgsl: whether coverage cuts the surface out or blends it.
+override ALPHA_MODE: u32 = 0u;
 
 const SHADOWS_OFF: u32 = 0u;
 const SHADOWS_MAP: u32 = 1u;
@@ -117,8 +119,11 @@ fn visibility(light: Light, p: vec3f, facing: vec3f, pixel: vec2f) -> vec3f {
         shadow_maps, shadow_sampler, coordinates.xy, coordinates.z, layer, SHADOW_FILTER,
         shadows.map_size,
     ));
-    // A transparent receiver is not tinted by transparent occluders: in this one-layer
-    // approximation it would be tinted by itself.
+    // A transparent receiver is not tinted by transparent occluders: the transmission map holds
+    // one product over every transparent surface in front of the nearest opaque one, the
+    // receiver's own share included, and its nearest depth, with no bias to tell a surface from
+    // itself. (Tried: dividing out the receiver's own share darkened sloped walls by self-tinting
+    // worse than leaving the tint out.)
     if SHADOW_TRANSMISSION && material.transparent == 0u {
         let size = vec2f(textureDimensions(transmission_maps));
         let tint = textureLoad(transmission_maps, vec2i(coordinates.xy * size), layer, 0);
@@ -264,7 +269,31 @@ fn shade(in: VertexOut) -> vec3f {
     return radiance;
 }
 
+// Coverage α: the material's alpha times its colour texture's (glTF's base colour alpha).
+fn coverage(uv: vec2f) -> f32 {
+    if !COLOR_TEXTURE {
+        return material.alpha;
+    }
+    return material.alpha * textureSampleBias(color_texture, color_sampler, uv, frame.lod_bias).a;
+}
+
+// Whether a cut-out surface (ALPHA_MASK) is absent at this fragment.
+fn masked_out(uv: vec2f) -> bool {
+    return ALPHA_MODE == ALPHA_MASK && coverage(uv) < material.alpha_cutoff;
+}
+
 @fragment
 fn fs_scene(in: VertexOut) -> @location(0) vec4f {
+    if masked_out(in.uv) {
+        discard;
+    }
     return vec4f(shade(in), 1.0);
+}
+
+// The depth prepass of a cut-out material: depth only where the surface is.
+@fragment
+fn fs_mask(in: VertexOut) {
+    if masked_out(in.uv) {
+        discard;
+    }
 }

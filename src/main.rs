@@ -322,6 +322,15 @@ fn print_frame_stats(
         "shadow layers drawn: {} in the first frame, {} in the second (kept across frames)",
         first.shadow_layers_drawn, second.shadow_layers_drawn
     );
+    let t = &first.transparency;
+    if t.draws > 0 {
+        println!(
+            "transparency: {} draws{}{}",
+            t.draws,
+            if t.layers > 0 { format!(", {} peeled layers", t.layers) } else { String::new() },
+            if t.sorted { format!(", triangles sorted in {:.3} ms", t.sort_time.as_secs_f64() * 1e3) } else { String::new() },
+        );
+    }
     println!("passes (each submitted and waited for on its own, shadow maps redrawn):");
     for (name, time) in &profiled.passes {
         println!("{name:>20}: {:9.3} ms", time.as_secs_f64() * 1e3);

@@ -23,11 +23,53 @@ pub struct RenderSettings {
     /// Cast shadows: shadow maps or projected polygons in the rasterizer, shadow rays in the
     /// tracer (TECHNIQUES.md §4).
     pub shadows: ShadowSettings,
+    /// Transparent surfaces in sorted Z order (TECHNIQUES.md §5).
+    pub transparency: TransparencySettings,
     /// How the rasterizer spends its time: prepass, tessellation, render scale.
     pub raster: RasterSettings,
     /// The ray tracer's own settings.
     pub trace: TraceSettings,
 }
+
+/// The order the rasterizer draws transparent surfaces in. `I = Im + kt·Mt·I` depends on it:
+/// over two panes it gives `I_z + Mt1·I_y + Mt1·Mt2·I_x` only farthest first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum TransparencySort {
+    /// In the order the scene lists them, each object's triangles in its own order: shows the
+    /// error the formula makes out of order.
+    Unsorted,
+    /// Objects farthest first by their bounds' centre, each drawn back faces then front faces:
+    /// right for separate convex objects, wrong where objects interleave.
+    Object,
+    /// Every transparent triangle farthest first by its centroid, re-sorted when the view moves:
+    /// wrong only for intersecting or cyclically overlapping triangles.
+    Triangle,
+    /// Depth peeling: the exact order at every pixel, `peel_layers` layers from the back.
+    Exact,
+}
+
+/// Transparent surfaces (kt > 0, or alpha-blended) in the rasterizer (TECHNIQUES.md §5).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TransparencySettings {
+    /// Draw them after the opaque surfaces as `I = Im + kt·Mt·I`; off, they are drawn as opaque
+    /// surfaces with their illumination model alone.
+    pub enabled: bool,
+    pub sort: TransparencySort,
+    /// Layers `exact` peels, nearest to the opaque surface first: a pixel behind more
+    /// transparent surfaces than this loses the nearest ones.
+    pub peel_layers: u32,
+}
+
+impl Default for TransparencySettings {
+    fn default() -> Self {
+        TransparencySettings { enabled: true, sort: TransparencySort::Object, peel_layers: 8 }
+    }
+}
+
+/// The most layers `transparency.sort = "exact"` may peel.
+pub const MAX_PEEL_LAYERS: u32 = 32;
 
 /// When the rasterizer draws a depth prepass.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
@@ -365,6 +407,7 @@ impl Default for RenderSettings {
             textures: TextureSettings::default(),
             bump: BumpSettings::default(),
             shadows: ShadowSettings::default(),
+            transparency: TransparencySettings::default(),
             raster: RasterSettings::default(),
             trace: TraceSettings::default(),
         }
@@ -444,6 +487,12 @@ impl RenderSettings {
             return Err(SettingsError::Invalid(format!(
                 "bump.delta_texels must lie in (0, 64], got {}",
                 bump.delta_texels
+            )));
+        }
+        let layers = self.transparency.peel_layers;
+        if !(1..=MAX_PEEL_LAYERS).contains(&layers) {
+            return Err(SettingsError::Invalid(format!(
+                "transparency.peel_layers must lie in 1..={MAX_PEEL_LAYERS}, got {layers}"
             )));
         }
         let scale = self.raster.render_scale;

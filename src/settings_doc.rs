@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use crate::settings::{
     AccelKind, AntiAliasing, BumpView, Prepass, ShadowFilter, ShadowFit, ShadowMethod, ShadowView, TangentSource,
-    TextureFilter, TracerLod,
+    TextureFilter, TracerLod, TransparencySort,
 };
 
 /// One value an enum setting can take.
@@ -190,6 +190,20 @@ pub fn describe(key: &str) -> Option<FieldDoc> {
         "shadows.show_frusta" => {
             doc("Draw each shadowed light's view volume (the frustum pass 1 renders) into the scene.")
         }
+        "transparency" => doc(
+            "Transparent surfaces (TECHNIQUES.md §5): drawn after the opaque ones, farthest first, each pixel updated as I = Im + kt·Mt·I.",
+        ),
+        "transparency.enabled" => doc(
+            "Off: transparent surfaces are drawn as opaque ones with their illumination model alone (the glass pane turns dark).",
+        ),
+        "transparency.sort" => choice::<TransparencySort>(
+            "The drawing order: I = Im + kt·Mt·I is right only farthest first; compare the orders where they fail.",
+        ),
+        "transparency.peel_layers" => number(
+            "Layers the exact order peels at every pixel, from the back; each costs two passes over the transparent surfaces.",
+            1.0,
+            32.0,
+        ),
         "raster" => doc(
             "How the rasterizer spends its time. None of these changes what a technique computes; each trades time for a measured difference.",
         ),

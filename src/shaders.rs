@@ -9,7 +9,13 @@ pub const COMMON: &[(&str, &str)] = &[
     ("common/shadow.wgsl", include_str!("../shaders/common/shadow.wgsl")),
 ];
 
-pub const SCENE: &str = include_str!("../shaders/scene.wgsl");
+/// The scene pass and the transparent surfaces' entry points: one module, so that every variant
+/// computes exactly the same vertex positions (depth peeling tests `Equal` against them).
+pub const SCENE: &str = concat!(
+    include_str!("../shaders/scene.wgsl"),
+    "\n// ---- transparency.wgsl\n",
+    include_str!("../shaders/transparency.wgsl")
+);
 pub const PRESENT: &str = include_str!("../shaders/present.wgsl");
 pub const MIPMAP: &str = include_str!("../shaders/mipmap.wgsl");
 pub const SHADOW: &str = include_str!("../shaders/shadow.wgsl");

@@ -10,6 +10,11 @@ const LIGHT_SPOT: u32 = 2u;
 const ATTENUATION_NONE: u32 = 0u;
 const ATTENUATION_INVERSE_SQUARE: u32 = 1u;
 
+// Material.alpha_mode: how coverage α (glTF's base colour alpha) is read.
+const ALPHA_OPAQUE: u32 = 0u;
+const ALPHA_MASK: u32 = 1u;
+const ALPHA_BLEND: u32 = 2u;
+
 // Bits of Frame.terms: which terms of the illumination model are drawn.
 const TERM_AMBIENT: u32 = 1u;
 const TERM_DIFFUSE: u32 = 2u;
@@ -79,16 +84,26 @@ struct Material {
     bump_scale: f32,
     emission: vec3f,
     normal_scale: f32,
-    // kt·MT: what a transparent surface lets through.
+    // kt·MT: what a transparent surface lets through (see material_transmittance).
     transmission: vec3f,
     height_amplitude: f32,
     height_frequency: vec2f,
     noise_seed: u32,
     noise_cells: u32,
     noise_octaves: u32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
+    // Coverage α before the colour texture's alpha, and the cut-off of ALPHA_MASK.
+    alpha: f32,
+    alpha_cutoff: f32,
+    alpha_mode: u32,
+}
+
+// What a transparent surface lets through, the factor of I = Im + kt·Mt·I (TECHNIQUES.md §5):
+// kt·Mt, and for alpha blending α·kt·Mt + (1 − α), with α the coverage at the fragment.
+fn material_transmittance(m: Material, alpha: f32) -> vec3f {
+    if m.alpha_mode == ALPHA_BLEND {
+        return alpha * m.transmission + vec3f(1.0 - alpha);
+    }
+    return m.transmission;
 }
 
 // Per object, as instance attributes (vertex buffer 1): objects that share a mesh are drawn in one

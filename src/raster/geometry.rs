@@ -12,7 +12,9 @@
 //!   [`SEGMENT_LEVELS`] that does, at most `sphere_segments`, so a far sphere costs tens of
 //!   triangles and a near one what the setting allows.
 //! - **Instanced draws.** Objects are sorted by (transparency, material, mesh), and each run of
-//!   equal keys is one `draw_indexed` over a range of the instance buffer.
+//!   equal keys is one `draw_indexed` over a range of the instance buffer. Transparent objects
+//!   are also listed one by one, in the scene's order: their drawing order is the transparency
+//!   technique's to choose.
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -67,7 +69,7 @@ pub fn instance_of(object: &Object, segments: u32) -> (MeshKey, Mat4) {
 }
 
 /// The triangles of a mesh key, in the mesh's own coordinates.
-fn build_mesh(scene: &Scene, key: MeshKey) -> std::borrow::Cow<'_, Mesh> {
+pub fn build_mesh(scene: &Scene, key: MeshKey) -> std::borrow::Cow<'_, Mesh> {
     use std::borrow::Cow;
     let f = f32::from_bits;
     match key {
@@ -126,6 +128,8 @@ pub struct GpuMesh {
     pub vertices: wgpu::Buffer,
     pub indices: wgpu::Buffer,
     pub index_count: u32,
+    /// The centre of the mesh's bounding box, in its own coordinates.
+    pub centre: Vec3,
 }
 
 impl GpuMesh {
@@ -154,6 +158,7 @@ impl GpuMesh {
                 usage: wgpu::BufferUsages::INDEX,
             }),
             index_count: mesh.indices.len() as u32,
+            centre: mesh_centre(mesh),
         }
     }
 }
@@ -166,6 +171,22 @@ pub struct Batch {
     /// The material lets light through (kt > 0): it tints shadows rather than casting them.
     pub transparent: bool,
     pub instances: Range<u32>,
+}
+
+/// A transparent object, as the transparency pass draws it: alone, in an order of its choosing.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TransparentObject {
+    /// Index into `Scene::objects`.
+    pub object: usize,
+    pub mesh: MeshKey,
+    pub material: usize,
+    /// Its slot in the instance buffer.
+    pub instance: u32,
+    pub world_from_mesh: Mat4,
+    /// The world-space centre of its bounding box, the key of sorting by object.
+    pub centre: Vec3,
+    /// Its transform mirrors (negative determinant): its triangles' winding flips.
+    pub flipped: bool,
 }
 
 /// Per object, what does not change while the scene stays: its material, and for curved shapes
@@ -185,6 +206,8 @@ pub struct SceneGeometry {
     /// rebuilt only when one of them changes.
     segments: Vec<u32>,
     pub batches: Vec<Batch>,
+    /// The transparent objects in the scene's order.
+    pub transparent: Vec<TransparentObject>,
     /// A world-space box around everything, computed once.
     pub bounds: Option<(Vec3, Vec3)>,
     /// Names this draw list among all the draw lists ever made: what is drawn from it (shadow
@@ -215,6 +238,7 @@ impl SceneGeometry {
             instances: None,
             segments: Vec::new(),
             batches: Vec::new(),
+            transparent: Vec::new(),
             bounds: scene.bounds(),
             version: next_version(),
         }
@@ -248,26 +272,28 @@ impl SceneGeometry {
         if segments == self.segments && self.instances.is_some() {
             return false;
         }
-        let mut entries: Vec<(bool, usize, MeshKey, GpuInstance)> = scene
+        let mut entries: Vec<(bool, usize, MeshKey, GpuInstance, usize, Mat4)> = scene
             .objects
             .iter()
             .zip(&self.objects)
             .zip(&segments)
-            .map(|((object, info), &n)| {
+            .enumerate()
+            .map(|(index, ((object, info), &n))| {
                 let (key, world_from_mesh) = instance_of(object, n);
-                (info.transparent, info.material, key, GpuInstance::new(world_from_mesh))
+                (info.transparent, info.material, key, GpuInstance::new(world_from_mesh), index, world_from_mesh)
             })
             .collect();
         // Opaque first, then by material and mesh: runs of equal keys become one draw.
         entries.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)).then_with(|| mesh_order(&a.2).cmp(&mesh_order(&b.2))));
-        for (_, _, key, _) in &entries {
+        for (_, _, key, ..) in &entries {
             if !self.meshes.contains_key(key) {
                 let mesh = build_mesh(scene, *key);
                 self.meshes.insert(*key, GpuMesh::upload(device, &format!("{key:?}"), &mesh));
             }
         }
         self.batches.clear();
-        for (index, (transparent, material, key, _)) in entries.iter().enumerate() {
+        self.transparent.clear();
+        for (index, (transparent, material, key, ..)) in entries.iter().enumerate() {
             let index = index as u32;
             match self.batches.last_mut() {
                 Some(b) if b.transparent == *transparent && b.material == *material && b.mesh == *key => {
@@ -281,6 +307,20 @@ impl SceneGeometry {
                 }),
             }
         }
+        for (instance, &(_, material, mesh, _, object, world_from_mesh)) in entries.iter().enumerate() {
+            if entries[instance].0 {
+                self.transparent.push(TransparentObject {
+                    object,
+                    mesh,
+                    material,
+                    instance: instance as u32,
+                    world_from_mesh,
+                    centre: world_from_mesh.transform_point3(self.meshes[&mesh].centre),
+                    flipped: world_from_mesh.determinant() < 0.0,
+                });
+            }
+        }
+        self.transparent.sort_by_key(|t| t.object);
         let data: Vec<GpuInstance> = entries.iter().map(|e| e.3).collect();
         let size = std::mem::size_of_val(data.as_slice()) as u64;
         match &self.instances {
@@ -307,13 +347,18 @@ impl SceneGeometry {
     /// Records `batch`: binds its mesh and instances and draws them (the pipeline and material
     /// group are the caller's).
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, batch: &Batch) {
-        let mesh = &self.meshes[&batch.mesh];
-        let instances = self.instances.as_ref().expect("prepare() made the instance buffer for this batch");
+        self.draw_instances(pass, batch.mesh, batch.instances.clone());
+    }
+
+    /// Records `instances` of `mesh` (the pipeline and material group are the caller's).
+    pub fn draw_instances(&self, pass: &mut wgpu::RenderPass<'_>, mesh: MeshKey, instances: Range<u32>) {
+        let mesh = &self.meshes[&mesh];
+        let buffer = self.instances.as_ref().expect("prepare() made the instance buffer for these instances");
         let stride = std::mem::size_of::<GpuInstance>() as u64;
         pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-        pass.set_vertex_buffer(1, instances.slice(u64::from(batch.instances.start) * stride..));
+        pass.set_vertex_buffer(1, buffer.slice(u64::from(instances.start) * stride..));
         pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..mesh.index_count, 0, 0..batch.instances.len() as u32);
+        pass.draw_indexed(0..mesh.index_count, 0, 0..instances.len() as u32);
     }
 
     /// Triangles drawn per view with the current draw list.
@@ -328,6 +373,15 @@ impl SceneGeometry {
     pub fn has_transparent(&self) -> bool {
         self.objects.iter().any(|o| o.transparent)
     }
+}
+
+/// The centre of a mesh's bounding box.
+fn mesh_centre(mesh: &Mesh) -> Vec3 {
+    let (min, max) = mesh
+        .positions
+        .iter()
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    if mesh.positions.is_empty() { Vec3::ZERO } else { (min + max) / 2.0 }
 }
 
 /// A total order on mesh keys for sorting (their parameters are bit patterns, so any order will

@@ -8,12 +8,12 @@
 //!                                                                 ├→ lighting inputs (group 2)
 //! depth prepass → projected shadow polygons (object precision) ───┘
 //!               → opaque (z-buffer + illumination model + pass 2 of §4)
+//!               → transparent surfaces in Z order (§5: I = Im + kt·Mt·I, depth tested, not written)
 //!               → teaching overlays → present (output transform, upscale)
 //! ```
 //!
 //! Later techniques slot in where DESIGN.md puts them: environment captures and mirror views
-//! (more views, drawn by the same scene pass) before `opaque`; the sky and sorted transparent
-//! surfaces after it.
+//! (more views, drawn by the same scene pass) before `opaque`; the sky after it.
 
 pub mod geometry;
 pub mod overlays;
@@ -21,6 +21,7 @@ pub mod present;
 pub mod scene_gpu;
 pub mod scene_pass;
 pub mod shadow;
+pub mod transparency;
 pub mod uniforms;
 pub mod view;
 
@@ -38,6 +39,7 @@ use scene_pass::{FrameKey, ScenePass, SceneTargets};
 use shadow::projected::{MASK_FORMAT, ProjectedPass};
 use shadow::views::{ShadowLayout, shadow_layout_in};
 use shadow::{ShadowMaps, ShadowPass};
+use transparency::{TransparencyPass, TransparencyReport};
 use view::{View, ViewSlot};
 
 /// Linear radiance, before the output transform.
@@ -53,6 +55,7 @@ pub struct Renderer {
     shadow: ShadowPass,
     projected: ProjectedPass,
     scene: ScenePass,
+    transparency: TransparencyPass,
     overlays: Overlays,
     present: PresentPass,
     /// The lighting inputs (group 2), and the (shadow maps, frame targets) generations they were
@@ -89,6 +92,8 @@ pub struct FrameReport {
     pub triangles: u64,
     /// The size the frame was drawn at, before the present pass upscaled it.
     pub drawn_size: (u32, u32),
+    /// What the transparency pass drew, and its CPU sort.
+    pub transparency: TransparencyReport,
 }
 
 /// The frame's command encoder. When profiling, each pass is submitted and waited for on its
@@ -141,6 +146,7 @@ impl Renderer {
             shadow: ShadowPass::new(device, &layouts),
             projected: ProjectedPass::new(device, &layouts),
             scene: ScenePass::new(device, &layouts),
+            transparency: TransparencyPass::new(device, &layouts),
             overlays: Overlays::new(device, &layouts),
             present: PresentPass::new(device, output_format),
             layouts,
@@ -205,7 +211,8 @@ impl Renderer {
         let scene_gpu = &*scene_gpu;
         let shadows = &settings.shadows;
         let layout = shadow_layout_in(scene, scene_gpu.geometry.bounds, shadows);
-        scene_gpu.views.write(queue, ViewSlot::Main, &View::of_camera(&scene.camera));
+        let main_view = View::of_camera(&scene.camera);
+        scene_gpu.views.write(queue, ViewSlot::Main, &main_view);
         scene_gpu.update_frame(queue, scene, &layout.first_layer, settings);
 
         let projected = shadows.enabled && shadows.method == ShadowMethod::Projected;
@@ -217,6 +224,9 @@ impl Renderer {
             };
         let transmission = shadows.transmission && scene_gpu.geometry.has_transparent();
         let frame_key = FrameKey::new(settings, !layout.views.is_empty(), transmission);
+        // Transparent surfaces are drawn after the opaque ones, or as opaque ones when the
+        // technique is off.
+        let sorted_transparency = settings.transparency.enabled && scene_gpu.geometry.has_transparent();
         self.scene.prepare(device, frame_key, &scene_gpu.material_keys, prepass);
 
         // Object precision draws no maps: its light views have no layers to fill.
@@ -228,7 +238,14 @@ impl Renderer {
         frame.end("shadow maps");
         let lighting = lighting_group(&mut self.lighting, device, &self.layouts, &maps, targets);
         if prepass {
-            self.scene.record_prepass(&mut frame.encoder, scene_gpu, lighting, ViewSlot::Main, &targets.depth.view);
+            self.scene.record_prepass(
+                &mut frame.encoder,
+                scene_gpu,
+                lighting,
+                ViewSlot::Main,
+                &targets.depth.view,
+                sorted_transparency,
+            );
             frame.end("depth prepass");
         }
         let mut projected_recomputed = false;
@@ -247,8 +264,26 @@ impl Renderer {
             frame_key,
             &scene_targets,
             prepass,
+            sorted_transparency,
         );
         frame.end("opaque");
+        let mut transparency = TransparencyReport::default();
+        if sorted_transparency {
+            transparency = self.transparency.record(
+                device,
+                queue,
+                &mut frame.encoder,
+                &self.scene,
+                scene,
+                scene_gpu,
+                lighting,
+                frame_key,
+                (ViewSlot::Main, &main_view),
+                targets,
+                &settings.transparency,
+            );
+            frame.end("transparency");
+        }
         self.overlays.record(device, queue, &mut frame.encoder, shadows, scene_gpu, map_layout, &maps, targets);
         self.present.record(queue, &mut frame.encoder, &targets.present_input, output, settings.exposure);
         frame.end("overlays + present");
@@ -258,6 +293,7 @@ impl Renderer {
             projected_recomputed,
             triangles: scene_gpu.geometry.triangles(),
             drawn_size: size,
+            transparency,
         }
     }
 }

@@ -78,6 +78,8 @@ pub struct SceneGpu {
     active: usize,
     /// Per material: which shader variant draws it.
     pub material_keys: Vec<MaterialKey>,
+    /// Per material: what it lets through, the blend constant `kt·Mt` of the transparency pass.
+    pub transmittance: Vec<glam::Vec3>,
     pub geometry: SceneGeometry,
 }
 
@@ -153,6 +155,7 @@ impl SceneGpu {
             material_groups: Vec::new(),
             active: 0,
             material_keys: scene.materials.iter().map(MaterialKey::of).collect(),
+            transmittance: scene.materials.iter().map(super::uniforms::transmittance).collect(),
             geometry: SceneGeometry::new(scene),
         }
     }

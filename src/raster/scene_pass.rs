@@ -19,7 +19,7 @@
 use std::collections::HashMap;
 
 use super::scene_gpu::{SceneGpu, SceneLayouts};
-use super::uniforms::{GpuInstance, Vertex};
+use super::uniforms::{ALPHA_MASK, GpuInstance, Vertex, alpha_mode_code};
 use super::view::ViewSlot;
 use super::{DEPTH_FORMAT, HDR_FORMAT};
 use crate::gpu::layout;
@@ -103,6 +103,8 @@ pub struct MaterialKey {
     /// `HEIGHT_*` of `shaders/scene.wgsl`: 0 none, 1 a height map, 2 a sine field, 3 value noise.
     pub height_kind: u32,
     pub normal_map: bool,
+    /// `ALPHA_*` of `shaders/common/types.wgsl`.
+    pub alpha_mode: u32,
 }
 
 impl MaterialKey {
@@ -116,6 +118,7 @@ impl MaterialKey {
                 (None, None) => HEIGHT_NONE,
             },
             normal_map: material.normal_map.is_some(),
+            alpha_mode: alpha_mode_code(material.alpha_mode),
         }
     }
 }
@@ -130,7 +133,7 @@ pub const HEIGHT_SINE: u32 = 2;
 pub const HEIGHT_NOISE: u32 = 3;
 
 /// The names of the pipeline constants, in the order [`constants`] gives their values.
-pub const CONSTANT_NAMES: [&str; 13] = [
+pub const CONSTANT_NAMES: [&str; 14] = [
     "SHADOW_METHOD",
     "SHADOW_FILTER",
     "SHADOW_TRANSMISSION",
@@ -144,10 +147,11 @@ pub const CONSTANT_NAMES: [&str; 13] = [
     "COLOR_TEXTURE",
     "HEIGHT_KIND",
     "NORMAL_MAP",
+    "ALPHA_MODE",
 ];
 
 /// The pipeline constants of one variant.
-fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f64); 13] {
+pub fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f64); 14] {
     let flag = |b: bool| f64::from(u8::from(b));
     let values = [
         f64::from(frame.shadow_method),
@@ -163,6 +167,7 @@ fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f64); 
         flag(material.color_texture),
         f64::from(material.height_kind),
         flag(material.normal_map),
+        f64::from(material.alpha_mode),
     ];
     std::array::from_fn(|i| (CONSTANT_NAMES[i], values[i]))
 }
@@ -180,6 +185,8 @@ pub struct ScenePass {
     module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
     prepass: wgpu::RenderPipeline,
+    /// The prepass of cut-out materials (`ALPHA_MASK`): depth only where the surface is.
+    prepass_masked: wgpu::RenderPipeline,
     shading: HashMap<(DepthMode, FrameKey, MaterialKey), wgpu::RenderPipeline>,
 }
 
@@ -203,18 +210,35 @@ impl ScenePass {
             bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.material), Some(&layouts.lighting)],
             immediate_size: 0,
         });
-        let prepass = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("scene::prepass_pipeline"),
-            layout: Some(&layout),
-            vertex: vertex_state(&module),
-            primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
-            depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less, true),
-            multisample: Default::default(),
-            fragment: None,
-            multiview_mask: None,
-            cache: None,
-        });
-        ScenePass { module, layout, prepass, shading: HashMap::new() }
+        let prepass_pipeline = |label, fragment| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&layout),
+                vertex: vertex_state(&module),
+                primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
+                depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less, true),
+                multisample: Default::default(),
+                fragment,
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let prepass = prepass_pipeline("scene::prepass_pipeline", None);
+        // Untextured materials bind a white texture: the coverage is then the material's alpha.
+        let mask_constants = [("COLOR_TEXTURE", 1.0), ("ALPHA_MODE", f64::from(ALPHA_MASK))];
+        let prepass_masked = prepass_pipeline(
+            "scene::prepass_masked_pipeline",
+            Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_mask"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &mask_constants,
+                    ..Default::default()
+                },
+                targets: &[],
+            }),
+        );
+        ScenePass { module, layout, prepass, prepass_masked, shading: HashMap::new() }
     }
 
     /// Compiles the shading variants this frame needs that were not compiled before.
@@ -264,7 +288,18 @@ impl ScenePass {
         self.shading.len()
     }
 
-    /// The depth of the nearest surface at every pixel of `view`, and nothing else.
+    /// The shading module every scene pipeline is made from, and its pipeline layout (groups 0
+    /// to 2): the transparency pass builds its variants from them.
+    pub fn module(&self) -> &wgpu::ShaderModule {
+        &self.module
+    }
+
+    pub fn layout(&self) -> &wgpu::PipelineLayout {
+        &self.layout
+    }
+
+    /// The depth of the nearest surface at every pixel of `view`, and nothing else; transparent
+    /// surfaces are left out when `opaque_only` (the transparency pass draws them later).
     pub fn record_prepass(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -272,6 +307,7 @@ impl ScenePass {
         lighting: &wgpu::BindGroup,
         view: ViewSlot,
         depth: &wgpu::TextureView,
+        opaque_only: bool,
     ) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("scene::prepass"),
@@ -282,19 +318,21 @@ impl ScenePass {
             multiview_mask: None,
         });
         pass.push_debug_group("depth prepass");
-        pass.set_pipeline(&self.prepass);
         pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view)]);
         pass.set_bind_group(2, lighting, &[]);
-        for batch in &scene.geometry.batches {
+        for batch in scene.geometry.batches.iter().filter(|b| !(opaque_only && b.transparent)) {
+            let masked = scene.material_keys[batch.material].alpha_mode == ALPHA_MASK;
+            pass.set_pipeline(if masked { &self.prepass_masked } else { &self.prepass });
             pass.set_bind_group(1, &scene.materials()[batch.material], &[]);
             scene.geometry.draw(&mut pass, batch);
         }
         pass.pop_debug_group();
     }
 
-    /// Shades every surface seen from `view` (transparent ones too, as opaque surfaces with
-    /// their illumination model, until the transparency technique draws them); `frame` must have been prepared, and
-    /// `after_prepass` must match that preparation.
+    /// Shades every surface seen from `view`; transparent ones are left out when `opaque_only`
+    /// (the transparency pass draws them next), else drawn as opaque surfaces with their
+    /// illumination model alone. `frame` must have been prepared, and `after_prepass` must match
+    /// that preparation.
     #[allow(clippy::too_many_arguments)]
     pub fn record_opaque(
         &self,
@@ -305,6 +343,7 @@ impl ScenePass {
         frame: FrameKey,
         targets: &SceneTargets,
         after_prepass: bool,
+        opaque_only: bool,
     ) {
         let bg = targets.background.as_dvec3();
         let (depth_mode, depth_load) = if after_prepass {
@@ -328,7 +367,7 @@ impl ScenePass {
         pass.set_bind_group(2, lighting, &[]);
         // Batches come sorted by material: the pipeline changes only where the variant does.
         let mut current = None;
-        for batch in &scene.geometry.batches {
+        for batch in scene.geometry.batches.iter().filter(|b| !(opaque_only && b.transparent)) {
             let key = scene.material_keys[batch.material];
             if current != Some(key) {
                 pass.set_pipeline(&self.shading[&(depth_mode, frame, key)]);

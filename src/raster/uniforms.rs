@@ -5,7 +5,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat3, Mat4, Vec3};
 
-use crate::scene::{Attenuation, Light, LightKind, Material, ProceduralHeight};
+use crate::scene::{AlphaMode, Attenuation, Light, LightKind, Material, ProceduralHeight};
 use crate::settings::RenderSettings;
 
 pub const MAX_LIGHTS: usize = 16;
@@ -129,7 +129,35 @@ pub struct GpuMaterial {
     pub noise_seed: u32,
     pub noise_cells: u32,
     pub noise_octaves: u32,
-    pub _pad: [f32; 3],
+    /// Coverage `α` (before the colour texture's alpha) and the cut-off of `ALPHA_MASK`.
+    pub alpha: f32,
+    pub alpha_cutoff: f32,
+    /// `ALPHA_*` of `shaders/common/types.wgsl`.
+    pub alpha_mode: u32,
+}
+
+/// `ALPHA_*` codes: how a material's coverage is read.
+pub const ALPHA_OPAQUE: u32 = 0;
+pub const ALPHA_MASK: u32 = 1;
+pub const ALPHA_BLEND: u32 = 2;
+
+pub fn alpha_mode_code(mode: AlphaMode) -> u32 {
+    match mode {
+        AlphaMode::Opaque => ALPHA_OPAQUE,
+        AlphaMode::Mask { .. } => ALPHA_MASK,
+        AlphaMode::Blend => ALPHA_BLEND,
+    }
+}
+
+/// What a transparent surface lets through, the factor of `I = Im + kt·Mt·I`: `kt·Mt`, and for
+/// alpha blending `α·kt·Mt + (1 − α)` with the material's `α` (the texture's alpha, where there is
+/// one, is applied per pixel instead; see `src/raster/transparency.rs`).
+pub fn transmittance(material: &Material) -> Vec3 {
+    let through = material.transmission * material.transmission_color;
+    match material.alpha_mode {
+        AlphaMode::Blend => material.alpha * through + Vec3::splat(1.0 - material.alpha),
+        _ => through,
+    }
 }
 
 impl Material {
@@ -158,7 +186,12 @@ impl Material {
             noise_seed: seed,
             noise_cells: cells,
             noise_octaves: octaves,
-            _pad: [0.0; 3],
+            alpha: self.alpha,
+            alpha_cutoff: match self.alpha_mode {
+                AlphaMode::Mask { cutoff } => cutoff,
+                _ => 0.0,
+            },
+            alpha_mode: alpha_mode_code(self.alpha_mode),
         }
     }
 }

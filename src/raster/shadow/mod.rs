@@ -35,6 +35,7 @@ use bytemuck::{Pod, Zeroable};
 use super::DEPTH_FORMAT;
 use super::scene_gpu::{SceneGpu, SceneLayouts};
 use super::scene_pass::VERTEX_BUFFERS;
+use super::uniforms::ALPHA_MASK;
 use super::view::{View, ViewSlot};
 use crate::gpu::layout;
 use crate::gpu::uniform::UniformBuffer;
@@ -185,7 +186,8 @@ pub struct ShadowMaps<'a> {
 pub struct ShadowPass {
     module: wgpu::ShaderModule,
     pipeline_layout: wgpu::PipelineLayout,
-    depth_pipeline: Option<(Bias, wgpu::RenderPipeline)>,
+    /// The depth pipelines for the current bias: plain, and for cut-out casters.
+    depth_pipeline: Option<(Bias, [wgpu::RenderPipeline; 2])>,
     transmission_pipeline: wgpu::RenderPipeline,
     targets: Option<ShadowTargets>,
     /// What each layer was last drawn from.
@@ -258,7 +260,15 @@ impl ShadowPass {
         }
     }
 
-    fn depth_pipeline(&self, device: &wgpu::Device, bias: Bias) -> wgpu::RenderPipeline {
+    /// Pass 1's depth pipeline; with `masked`, a fragment stage drops what a cut-out caster's
+    /// coverage removes.
+    fn depth_pipeline(&self, device: &wgpu::Device, bias: Bias, masked: bool) -> wgpu::RenderPipeline {
+        let fragment = masked.then(|| wgpu::FragmentState {
+            module: &self.module,
+            entry_point: Some("fs_shadow_mask"),
+            compilation_options: Default::default(),
+            targets: &[],
+        });
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("shadow::depth_pipeline"),
             layout: Some(&self.pipeline_layout),
@@ -272,7 +282,7 @@ impl ShadowPass {
                 }
             }),
             multisample: Default::default(),
-            fragment: None,
+            fragment,
             multiview_mask: None,
             cache: None,
         })
@@ -311,7 +321,8 @@ impl ShadowPass {
         }
         let bias = Bias { constant: settings.depth_bias, slope: settings.slope_bias };
         if self.depth_pipeline.as_ref().is_none_or(|(b, _)| *b != bias) {
-            self.depth_pipeline = Some((bias, self.depth_pipeline(device, bias)));
+            let pipelines = [false, true].map(|masked| self.depth_pipeline(device, bias, masked));
+            self.depth_pipeline = Some((bias, pipelines));
         }
         self.uniform.write(queue, &GpuShadows::new(layout, settings));
         self.drawn.resize(layout.views.len(), None);
@@ -351,7 +362,7 @@ impl ShadowPass {
 
     fn record_layer(&self, encoder: &mut wgpu::CommandEncoder, scene: &SceneGpu, layer: usize, slot: ViewSlot) {
         let targets = self.targets.as_ref().expect("record() makes the targets first");
-        let (_, depth_pipeline) = self.depth_pipeline.as_ref().expect("record() builds the depth pipeline first");
+        let (_, depth_pipelines) = self.depth_pipeline.as_ref().expect("record() builds the depth pipelines first");
         let depth_view = &targets.depth_layers[layer];
         let view_offset = [scene.views.offset(slot)];
         {
@@ -363,9 +374,13 @@ impl ShadowPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(depth_pipeline);
             pass.set_bind_group(0, scene.frame_group(), &view_offset);
-            draw(&mut pass, scene, false);
+            for batch in scene.geometry.batches.iter().filter(|b| !b.transparent) {
+                let masked = scene.material_keys[batch.material].alpha_mode == ALPHA_MASK;
+                pass.set_pipeline(&depth_pipelines[usize::from(masked)]);
+                pass.set_bind_group(1, &scene.materials()[batch.material], &[]);
+                scene.geometry.draw(&mut pass, batch);
+            }
         }
         if targets.with_transmission {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -381,7 +396,10 @@ impl ShadowPass {
             });
             pass.set_pipeline(&self.transmission_pipeline);
             pass.set_bind_group(0, scene.frame_group(), &view_offset);
-            draw(&mut pass, scene, true);
+            for batch in scene.geometry.batches.iter().filter(|b| b.transparent) {
+                pass.set_bind_group(1, &scene.materials()[batch.material], &[]);
+                scene.geometry.draw(&mut pass, batch);
+            }
         }
     }
 }
@@ -395,10 +413,3 @@ fn vertex_state(module: &wgpu::ShaderModule) -> wgpu::VertexState<'_> {
     }
 }
 
-/// Draws the opaque (or the transparent) batches.
-fn draw(pass: &mut wgpu::RenderPass<'_>, scene: &SceneGpu, transparent: bool) {
-    for batch in scene.geometry.batches.iter().filter(|b| b.transparent == transparent) {
-        pass.set_bind_group(1, &scene.materials()[batch.material], &[]);
-        scene.geometry.draw(pass, batch);
-    }
-}
