@@ -10,7 +10,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::{Vec2, Vec3};
 use mirador::scene::file::parse;
-use mirador::scene::{Attenuation, ColorSpace, LightKind, Material, Projection, SceneError, Shape};
+use mirador::scene::{AlphaMode, Attenuation, ColorSpace, LightKind, Material, Projection, SceneError, Shape};
 use mirador::{RenderSettings, Scene};
 
 // ---------------------------------------------------------------------------------------------
@@ -261,6 +261,50 @@ fn a_negative_coefficient_is_rejected_at_the_value() {
     assert_error_at(&text, 5, 6, &["expected a number ≥ 0", "-0.5"]);
     let text = with_camera(&["[[lights]]", "type = \"point\"", "position = [0, 1, 0]", "intensity = -2"]);
     assert_error_at(&text, 7, 13, &["expected a number ≥ 0", "-2"]);
+}
+
+#[test]
+fn a_negative_transmission_or_emission_colour_is_rejected_at_the_value() {
+    // `transmission_color = [0, -1, 0]`: the array starts in column 22.
+    let text = with_camera(&["[materials.glass]", "transmission = 0.5", "transmission_color = [0, -1, 0]"]);
+    assert_error_at(&text, 6, 22, &["colour components must be ≥ 0", "[0, -1, 0]"]);
+    let text = with_camera(&["[materials.lamp]", "emission = [-2, 0, 0]"]);
+    assert_error_at(&text, 5, 12, &["colour components must be ≥ 0"]);
+}
+
+#[test]
+fn fractions_outside_0_to_1_are_rejected_at_the_value() {
+    // kt and kps are the fractions of light transmitted and mirrored.
+    let text = with_camera(&["[materials.glass]", "transmission = 1.5"]);
+    assert_error_at(&text, 5, 16, &["expected a number in [0, 1]", "got 1.5"]);
+    let text = with_camera(&["[materials.glass]", "transmission = -0.25"]);
+    assert_error_at(&text, 5, 16, &["expected a number in [0, 1]", "got -0.25"]);
+    let text = with_camera(&["[materials.chrome]", "mirror = 2"]);
+    assert_error_at(&text, 5, 10, &["expected a number in [0, 1]", "got 2"]);
+    let text = with_camera(&["[materials.leaf]", "alpha = 1.2"]);
+    assert_error_at(&text, 5, 9, &["expected a number in [0, 1]", "got 1.2"]);
+    let text = with_camera(&["[materials.leaf]", "alpha_mode = \"mask\"", "alpha_cutoff = -0.5"]);
+    assert_error_at(&text, 6, 16, &["expected a number in [0, 1]", "got -0.5"]);
+    let text = with_camera(&["[materials.leaf]", "alpha = nan"]);
+    assert_error_at(&text, 5, 9, &["expected a finite number", "NaN"]);
+    let text = with_camera(&["[materials.leaf]", "alpha_mode = \"mask\"", "alpha_cutoff = inf"]);
+    assert_error_at(&text, 6, 16, &["expected a finite number", "inf"]);
+}
+
+#[test]
+fn an_unknown_alpha_mode_is_rejected_at_the_value() {
+    // `alpha_mode = "glass"`: the value starts in column 14.
+    let text = with_camera(&["[materials.leaf]", "alpha_mode = \"glass\""]);
+    assert_error_at(&text, 5, 14, &["unknown variant `glass`", "`opaque`", "`mask`", "`blend`"]);
+}
+
+#[test]
+fn an_alpha_cutoff_without_mask_mode_is_rejected_at_the_value() {
+    let text = with_camera(&["[materials.leaf]", "alpha_mode = \"blend\"", "alpha_cutoff = 0.3"]);
+    assert_error_at(&text, 6, 16, &["`alpha_cutoff` applies only to alpha_mode = \"mask\"", "\"blend\""]);
+    // Without `alpha_mode` the material is opaque.
+    let text = with_camera(&["[materials.leaf]", "alpha = 0.5", "alpha_cutoff = 0.3"]);
+    assert_error_at(&text, 6, 16, &["`alpha_cutoff` applies only", "\"opaque\""]);
 }
 
 #[test]
@@ -735,6 +779,40 @@ fn material_and_light_defaults_fill_in() {
     assert_eq!((inner, outer), (20f32.to_radians(), 30f32.to_radians()), "degrees in the file, radians loaded");
     assert_eq!(scene.lights[1].name, "light 1");
     assert_eq!(scene.lights[1].attenuation, Attenuation::InverseSquare);
+}
+
+#[test]
+fn alpha_modes_load_with_their_cutoff_and_coverage() {
+    let scene = load_ok(&with_camera(&[
+        "[materials.plain]",
+        "alpha = 0.4",
+        "[materials.leaf]",
+        "alpha_mode = \"mask\"",
+        "[materials.fence]",
+        "alpha_mode = \"mask\"",
+        "alpha_cutoff = 0.25",
+        "alpha = 0.9",
+        "[materials.veil]",
+        "alpha_mode = \"blend\"",
+        "alpha = 0.3",
+        "transmission = 1",
+        "mirror = 0",
+        "[materials.solid]",
+        "alpha_mode = \"opaque\"",
+    ]));
+    // Opaque is the default; its alpha is kept (a viewer may switch the mode) but not used.
+    let plain = material(&scene, "plain");
+    assert_eq!((plain.alpha, plain.alpha_mode), (0.4, AlphaMode::Opaque));
+    assert!(!plain.is_transparent());
+    let leaf = material(&scene, "leaf");
+    assert_eq!((leaf.alpha, leaf.alpha_mode), (1.0, AlphaMode::Mask { cutoff: 0.5 }), "glTF's default cutoff");
+    assert!(!leaf.is_transparent(), "a mask is drawn with the opaque surfaces");
+    let fence = material(&scene, "fence");
+    assert_eq!((fence.alpha, fence.alpha_mode), (0.9, AlphaMode::Mask { cutoff: 0.25 }));
+    let veil = material(&scene, "veil");
+    assert_eq!((veil.alpha, veil.alpha_mode, veil.transmission), (0.3, AlphaMode::Blend, 1.0));
+    assert!(veil.is_transparent());
+    assert_eq!(*material(&scene, "solid"), Material { name: "solid".into(), ..Material::default() });
 }
 
 #[test]

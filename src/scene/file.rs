@@ -18,7 +18,7 @@ use toml::Spanned;
 use super::camera::{Camera, Projection};
 use super::gltf::{GltfCamera, GltfImport, GltfProjection};
 use super::light::{Attenuation, Light, LightKind};
-use super::material::{ColorSpace, Material, MaterialId, ProceduralHeight, TextureId, Wrap};
+use super::material::{AlphaMode, ColorSpace, Material, MaterialId, ProceduralHeight, TextureId, Wrap};
 use super::{Object, Scene, SceneError, Shape, texture};
 use crate::settings::RenderSettings;
 
@@ -78,6 +78,20 @@ impl<'de> Deserialize<'de> for NonNegative {
             return Err(de::Error::custom(format!("expected a number ≥ 0, got {x}")));
         }
         Ok(NonNegative(x))
+    }
+}
+
+/// A fraction: a number in [0, 1] (`kt`, `kps`, coverage).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Fraction(f32);
+
+impl<'de> Deserialize<'de> for Fraction {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let Finite(x) = Finite::deserialize(d)?;
+        if !(0.0..=1.0).contains(&x) {
+            return Err(de::Error::custom(format!("expected a number in [0, 1], got {x}")));
+        }
+        Ok(Fraction(x))
     }
 }
 
@@ -220,9 +234,9 @@ struct MaterialDesc {
     specular_color: Option<Rgb>,
     shininess: Option<NonNegative>,
     emission: Option<Rgb>,
-    mirror: Option<NonNegative>,
+    mirror: Option<Fraction>,
     mirror_color: Option<Rgb>,
-    transmission: Option<NonNegative>,
+    transmission: Option<Fraction>,
     transmission_color: Option<Rgb>,
     ior: Option<Positive>,
     height_map: Option<String>,
@@ -230,6 +244,29 @@ struct MaterialDesc {
     bump_scale: Option<Finite>,
     normal_map: Option<String>,
     normal_scale: Option<Finite>,
+    alpha: Option<Fraction>,
+    alpha_mode: Option<AlphaModeName>,
+    alpha_cutoff: Option<Spanned<Fraction>>,
+}
+
+/// `alpha_mode = "opaque" | "mask" | "blend"`, glTF's `alphaMode`.
+#[derive(Deserialize, Clone, Copy, PartialEq, Eq, Debug)]
+#[serde(rename_all = "snake_case")]
+enum AlphaModeName {
+    Opaque,
+    Mask,
+    Blend,
+}
+
+impl AlphaModeName {
+    /// The name the file uses for this mode, for messages.
+    fn name(self) -> &'static str {
+        match self {
+            AlphaModeName::Opaque => "opaque",
+            AlphaModeName::Mask => "mask",
+            AlphaModeName::Blend => "blend",
+        }
+    }
 }
 
 /// `wrap = "clamp"` for both axes, or `wrap = ["repeat", "mirror"]` for u and v.
@@ -491,6 +528,21 @@ impl<'a> Builder<'a> {
             }
             None => None,
         };
+        let mode = d.alpha_mode.unwrap_or(AlphaModeName::Opaque);
+        let alpha_mode = match (mode, d.alpha_cutoff) {
+            (AlphaModeName::Mask, cutoff) => {
+                AlphaMode::Mask { cutoff: cutoff.map_or(AlphaMode::DEFAULT_CUTOFF, |c| c.into_inner().0) }
+            }
+            (_, Some(cutoff)) => {
+                let message = format!(
+                    "`alpha_cutoff` applies only to alpha_mode = \"mask\", and this material's is \"{}\"",
+                    mode.name()
+                );
+                return Err(self.error(message, cutoff.span()));
+            }
+            (AlphaModeName::Blend, None) => AlphaMode::Blend,
+            (AlphaModeName::Opaque, None) => AlphaMode::Opaque,
+        };
         Ok(Material {
             name: name.into(),
             color: d.color.map_or(base.color, |Rgb(c)| c),
@@ -506,9 +558,9 @@ impl<'a> Builder<'a> {
             specular_color: d.specular_color.map_or(base.specular_color, |Rgb(c)| c),
             shininess: d.shininess.map_or(base.shininess, |NonNegative(x)| x),
             emission: d.emission.map_or(base.emission, |Rgb(c)| c),
-            mirror: d.mirror.map_or(base.mirror, |NonNegative(x)| x),
+            mirror: d.mirror.map_or(base.mirror, |Fraction(x)| x),
             mirror_color: d.mirror_color.map_or(base.mirror_color, |Rgb(c)| c),
-            transmission: d.transmission.map_or(base.transmission, |NonNegative(x)| x),
+            transmission: d.transmission.map_or(base.transmission, |Fraction(x)| x),
             transmission_color: d.transmission_color.map_or(base.transmission_color, |Rgb(c)| c),
             ior: d.ior.map_or(base.ior, |Positive(x)| x),
             height_map,
@@ -516,8 +568,8 @@ impl<'a> Builder<'a> {
             bump_scale: d.bump_scale.map_or(base.bump_scale, |Finite(x)| x),
             normal_map,
             normal_scale: d.normal_scale.map_or(base.normal_scale, |Finite(x)| x),
-            alpha: base.alpha,
-            alpha_mode: base.alpha_mode,
+            alpha: d.alpha.map_or(base.alpha, |Fraction(x)| x),
+            alpha_mode,
         })
     }
 

@@ -22,13 +22,14 @@
 //!
 //! # Materials: metallic-roughness onto Mirador's Phong-style model
 //!
-//! With `m` = `metallicFactor` and `r` = `roughnessFactor` (both clamped to [0, 1]):
+//! With `m` = `metallicFactor`, `r` = `roughnessFactor` (both clamped to [0, 1]) and `kt` the
+//! `KHR_materials_transmission` factor (clamped to [0, 1]):
 //!
 //! | Mirador              | from glTF                                                          |
 //! |----------------------|--------------------------------------------------------------------|
 //! | `color` (C)          | `baseColorFactor.rgb` (linear) × `baseColorTexture` (sRGB texture) |
 //! | `ka`                 | 0                                                                  |
-//! | `kd`                 | 1 − m                                                              |
+//! | `kd`                 | (1 − m) · (1 − kt)                                                 |
 //! | `ks`                 | (0.04 · (1 − m) + m) · (1 − r)                                     |
 //! | `specular_color` (S) | white · (1 − m) + `baseColorFactor.rgb` · m                        |
 //! | `shininess` (e)      | 2/α² − 2 with α = r², clamped to [1, 2048]                         |
@@ -38,6 +39,8 @@
 //! | `transmission` (kt)  | `KHR_materials_transmission` factor                                |
 //! | `transmission_color` | `baseColorFactor.rgb`                                              |
 //! | `ior`                | `KHR_materials_ior`; else 1.5 when kt > 0, else 1.0                |
+//! | `alpha`              | `baseColorFactor.a` (clamped to [0, 1])                            |
+//! | `alpha_mode`         | `alphaMode`: OPAQUE; MASK with `alphaCutoff` (default 0.5); BLEND  |
 //!
 //! Metals have no diffuse term and reflect in their own colour; dielectrics reflect about 4 %
 //! (the Fresnel reflectance at normal incidence of an index of 1.5) in white. The exponent `e` is
@@ -46,17 +49,29 @@
 //! wider lobe that a Phong lobe of bounded exponent cannot hold. The specular, mirror and
 //! transmission colours use the factor alone: they have no texture slot.
 //!
+//! **Transmission** (`KHR_materials_transmission`) takes its light from the diffuse lobe: the
+//! light a transmissive dielectric lets through is light it no longer scatters diffusely, hence
+//! `kd·(1 − kt)`; the specular and mirror terms stay.
+//!
+//! **Alpha** is coverage (`AlphaMode`): `α = alpha ×` the base colour texture's alpha channel,
+//! which survives decoding (textures are RGBA8) and is linear, as glTF defines it. OPAQUE ignores
+//! `α`; MASK keeps the surface only where `α ≥ alphaCutoff` (a negative cutoff is read as 0, with
+//! a warning; `alphaCutoff` on another mode is ignored, as glTF says); BLEND covers a fraction `α`
+//! of what lies behind. A BLEND material with transmission keeps both, as glTF's transmission
+//! extension defines them: coverage first, then transmission through the covered part, so the
+//! ray tracer computes `α·(local model + kps·MPS·L(r) + kt·MT·L(t)) + (1 − α)·L(straight on)`.
+//!
 //! A primitive without a material gets [`Material::default()`] named `gltf-default`, not the glTF
 //! default material: that one is fully metallic and fully rough, which the rule above makes black.
 //!
 //! # What is ignored
 //!
-//! The metallic-roughness, normal, occlusion and emissive textures (a later issue adds normal
-//! maps), base colour alpha and `alphaMode`, `doubleSided`, samplers (filtering and wrapping are
-//! the renderers'), texture coordinate sets other than 0 and `KHR_texture_transform`, vertex
-//! colours, tangents, skins (meshes are drawn in their bind pose), morph targets, animations,
-//! and light `range`. Files that *require* an extension other than the four material and light
-//! extensions named above and `KHR_mesh_quantization` are refused.
+//! The metallic-roughness, occlusion, emissive and transmission textures, `doubleSided` (Mirador
+//! draws every surface two-sided, its normal turned to the viewer), samplers' filters (filtering
+//! is the renderers'; their wrap modes are read), texture coordinate sets other than 0 and
+//! `KHR_texture_transform`, vertex colours, skins (meshes are drawn in their bind pose), morph
+//! targets, animations, and light `range`. Files that *require* an extension other than the
+//! four material and light extensions named above and `KHR_mesh_quantization` are refused.
 //!
 //! # Errors
 //!
@@ -80,7 +95,7 @@ use gltf::khr_lights_punctual::Kind;
 use gltf::mesh::{Mode, Semantic};
 use gltf::scene::Transform;
 
-use super::material::{ColorSpace, Wrap};
+use super::material::{AlphaMode, ColorSpace, Wrap};
 use super::{Attenuation, Light, LightKind, Material, Mesh, SceneError, Texture, TextureId, texture};
 
 /// What one glTF file contributes to a scene, in the glTF file's own world coordinates.
@@ -702,13 +717,17 @@ impl<'d> Importer<'d> {
     fn convert_material(&mut self, material: &gltf::Material<'d>, index: usize) -> Result<Material, String> {
         let name = material.name().map_or_else(|| format!("material {index}"), str::to_owned);
         let pbr = material.pbr_metallic_roughness();
-        let [r, g, b, _alpha] = pbr.base_color_factor();
+        let [r, g, b, alpha] = pbr.base_color_factor();
         let base = Vec3::new(r, g, b);
         let emission = Vec3::from_array(material.emissive_factor()) * material.emissive_strength().unwrap_or(1.0);
         let transmission = material.transmission().map_or(0.0, |t| t.transmission_factor());
         let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
-        let numbers = [base.x, base.y, base.z, metallic, roughness, emission.x, emission.y, emission.z, transmission];
-        if numbers.iter().any(|x| !x.is_finite()) || material.ior().is_some_and(|x| !x.is_finite()) {
+        let cutoff = material.alpha_cutoff().unwrap_or(AlphaMode::DEFAULT_CUTOFF);
+        let numbers = [r, g, b, alpha, cutoff, metallic, roughness, transmission];
+        if numbers.iter().any(|x| !x.is_finite())
+            || !emission.is_finite()
+            || material.ior().is_some_and(|x| !x.is_finite())
+        {
             return Err(format!("material `{name}` has a factor that is not a finite number"));
         }
         let texture = match pbr.base_color_texture() {
@@ -737,13 +756,24 @@ impl<'d> Importer<'d> {
         let phong = phong_from_metallic_roughness(base, metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
         let transmission = transmission.clamp(0.0, 1.0);
         let default_ior = if transmission > 0.0 { 1.5 } else { 1.0 };
+        let alpha_mode = match material.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => {
+                if cutoff < 0.0 {
+                    self.warn(format!("material `{name}`: alphaCutoff {cutoff} is below 0; read as 0"));
+                }
+                AlphaMode::Mask { cutoff: cutoff.max(0.0) }
+            }
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        };
         Ok(Material {
             name,
             color: base,
             texture,
             wrap,
             ka: 0.0,
-            kd: phong.kd,
+            // glTF's transmission takes its share from the diffuse lobe.
+            kd: phong.kd * (1.0 - transmission),
             ks: phong.ks,
             specular_color: phong.specular_color,
             shininess: phong.shininess,
@@ -758,8 +788,8 @@ impl<'d> Importer<'d> {
             bump_scale: 1.0,
             normal_map: normal_map.map(|(id, _)| id),
             normal_scale: normal_map.map_or(1.0, |(_, scale)| scale),
-            alpha: 1.0,
-            alpha_mode: crate::scene::AlphaMode::Opaque,
+            alpha: alpha.clamp(0.0, 1.0),
+            alpha_mode,
         })
     }
 

@@ -84,6 +84,11 @@ pub enum AlphaMode {
     Blend,
 }
 
+impl AlphaMode {
+    /// The cutoff of a mask that names none (glTF's `alphaCutoff` default).
+    pub const DEFAULT_CUTOFF: f32 = 0.5;
+}
+
 /// One material of the model
 /// `ME + AG + Σ V·S·(ka·C + kd·C·max(0, n·l) + ks·S·max(0, r·v)^e) + kps·MPS·L(r) + kt·MT·L(t)`.
 #[derive(Clone, Debug, PartialEq)]

@@ -30,6 +30,12 @@
 //! level) in place of the textured colour `C`: the material's colour is not multiplied in, as in
 //! the rasterizer. Untextured materials keep their colour.
 //!
+//! **Coverage** ([`SceneTextures::coverage`], for alpha masks and blending, `AlphaMode`):
+//! `α = alpha ×` the colour texture's alpha channel, which is stored linear (never sRGB-decoded)
+//! and read with the same filter at the same level as the colour, so a mask's edge is as sharp or
+//! as soft as the texture it comes from. The level-colour view replaces only the colour: the
+//! alpha is then read trilinearly. Shadow rays carry no cone and read level 0.
+//!
 //! **Against the rasterizer's rule** (`mip_lod` of `dpdx(uv)`, `dpdy(uv)`): the two agree on the
 //! optical axis for a surface facing the camera. Off axis the cone over-estimates: a primary ray
 //! at `α` from the axis meets a frontal plane at `t = z/cos α` and at incidence `α`, so its
@@ -52,7 +58,7 @@
 //! rgb, scale)` with `t` = ∂p/∂u laid in `n`'s plane and the bitangent's sign from ∂p/∂v, the
 //! frame MikkTSpace builds from the same texture coordinates.
 
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec4};
 
 use super::geometry::SurfaceHit;
 use crate::output::srgb_decode;
@@ -210,14 +216,47 @@ impl SceneTextures {
         cone: &RayCone,
         settings: &TextureSettings,
     ) -> Vec3 {
-        let Some(chain) = material.texture.and_then(|id| self.chain(id)) else {
+        let filter = filter_of(settings.filter);
+        let Some(texel) = self.colour_texel(material, hit, direction, Some(cone), filter, settings) else {
             return material.color;
         };
+        if filter == Filter::LevelColour { texel.truncate() } else { material.color * texel.truncate() }
+    }
+
+    /// `α(p)`: the material's `alpha` times its colour texture's alpha at the hit, filtered as the
+    /// colour is (the level-colour view replaces the colour, not the coverage, so there the alpha
+    /// is read trilinearly). Without a cone (shadow rays) the texture is read at level 0.
+    pub fn coverage(
+        &self,
+        material: &Material,
+        hit: &SurfaceHit,
+        direction: Vec3,
+        cone: Option<&RayCone>,
+        settings: &TextureSettings,
+    ) -> f32 {
+        let filter = match filter_of(settings.filter) {
+            Filter::LevelColour => Filter::Trilinear,
+            filter => filter,
+        };
+        let texture_alpha = self.colour_texel(material, hit, direction, cone, filter, settings).map_or(1.0, |t| t.w);
+        material.alpha * texture_alpha
+    }
+
+    /// The material's colour texture at the hit, linear RGBA read by `filter` at the level `cone`
+    /// gives (level 0 without one), or `None` when it has no (usable) colour texture.
+    fn colour_texel(
+        &self,
+        material: &Material,
+        hit: &SurfaceHit,
+        direction: Vec3,
+        cone: Option<&RayCone>,
+        filter: Filter,
+        settings: &TextureSettings,
+    ) -> Option<Vec4> {
+        let chain = self.chain(material.texture?)?;
         let level0 = &chain.levels[0];
-        let lod = level_at(cone, direction, hit, (level0.width, level0.height), settings);
-        let filter = filter_of(settings.filter);
-        let texel = chain.sample_wrapped(hit.uv, lod, filter, material.wrap).truncate();
-        if filter == Filter::LevelColour { texel } else { material.color * texel }
+        let lod = cone.map_or(0.0, |cone| level_at(cone, direction, hit, (level0.width, level0.height), settings));
+        Some(chain.sample_wrapped(hit.uv, lod, filter, material.wrap))
     }
 
     /// The shading normal at the hit, not yet turned to the viewer: bump-mapped where bump

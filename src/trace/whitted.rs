@@ -13,6 +13,22 @@
 //! - **Visibility `V_i`** is a shadow ray towards the light. Opaque occluders block it;
 //!   transparent ones (kt > 0) let `kt·MT` through, so shadows behind glass are partial and
 //!   coloured (seed 003: 0 < s < 1). Occluders are not refracted: a shadow ray goes straight.
+//! - **Alpha (coverage)**, `material.alpha_mode`: `α = alpha ×` the colour texture's alpha at the
+//!   hit (linear, filtered like the colour; `super::texture`). *Opaque* ignores `α`. *Mask*: the
+//!   surface exists only where `α ≥ cutoff`; camera, mirror, refracted and shadow rays alike go on
+//!   from `ε` beyond a hit where `α < cutoff`, along their own direction, as if nothing were there
+//!   (the same ray, not counted again; its cone continued). *Blend* is the seed's
+//!   transparency (TECHNIQUES.md §5) with `Im` scaled by `α` and `kt·Mt = 1 − α`:
+//!
+//!   ```text
+//!   L = α·(ME + AG + Σ V·L_dir + kps·MPS·L(r) + kt·MT·L(t)) + (1 − α)·L(p, u, n + 1)
+//!   ```
+//!
+//!   the ray continued straight past the surface, one level deeper like a refracted ray (at the
+//!   maximum depth the `1 − α` share is dropped, as `kt·MT·L(t)` is). Through a surface covering
+//!   `α`, a shadow ray carries `α·kt·MT + (1 − α)`: grey `1 − α` for a blended surface without
+//!   kt, 1 through a mask's holes. Shadow rays carry no cone, so they read the texture's alpha at
+//!   level 0. A ray gives up after [`MAX_LAYERS`] masked hits (the background) or occluders.
 //! - **Refraction.** The side is read from the geometric normal: a ray against it enters the
 //!   object (`η = 1/ior`), a ray along it leaves (`η = ior`). With `sin²θt = η²(1 − cos²θi) > 1`
 //!   there is total internal reflection: no ray leaves, and the `kt·MT` energy goes to the
@@ -32,9 +48,10 @@
 //!   below shows the same relief as from above, mirrored: a bump from the front is a dent from
 //!   the back. (Where a bump tilts `n'` past the view direction, at grazing angles, the turn
 //!   flips it; both renderers do the same.)
-//! - **Teaching views** (`settings.bump.view`) replace the radiance of primary hits, with no
-//!   lighting or recursion: `normals` shows `0.5 + 0.5·n` for the final shading normal (bumped,
-//!   turned to the viewer), `tangents` shows `0.5 + 0.5·normalize(∂p/∂u)`.
+//! - **Teaching views** (`settings.bump.view`) replace the radiance of primary hits (of the
+//!   nearest surface that is there, blended or not), with no lighting or recursion: `normals`
+//!   shows `0.5 + 0.5·n` for the final shading normal (bumped, turned to the viewer), `tangents`
+//!   shows `0.5 + 0.5·normalize(∂p/∂u)`.
 
 use glam::Vec3;
 
@@ -42,7 +59,7 @@ use super::accel::Accelerator;
 use super::geometry::{Primitive, SurfaceHit};
 use super::texture::SceneTextures;
 use crate::scene::shading::{SurfaceSample, Terms, direct, emitted_and_ambient, facing_viewer};
-use crate::scene::{Ray, Scene};
+use crate::scene::{AlphaMode, Material, Ray, Scene};
 use crate::settings::{BumpSettings, BumpView, TextureSettings};
 use crate::texture::RayCone;
 
@@ -52,6 +69,7 @@ pub struct RayCounts {
     pub primary: u64,
     pub shadow: u64,
     pub reflected: u64,
+    /// Rays through a surface: refracted (kt > 0) and continued past a blended surface.
     pub refracted: u64,
 }
 
@@ -86,6 +104,11 @@ pub struct Whitted<'s> {
     pub bump: BumpSettings,
 }
 
+/// The most surfaces one ray passes (masked-out hits, shadow rays through transparent
+/// occluders) before it gives up: far more layers than a scene has, and a bound on the loop
+/// whatever the geometry.
+pub const MAX_LAYERS: usize = 64;
+
 /// How far a new ray starts off the surface it leaves.
 pub fn surface_offset(p: Vec3) -> f32 {
     1e-4 * p.abs().max_element().max(1.0)
@@ -95,36 +118,87 @@ impl Whitted<'_> {
     /// The radiance arriving at `ray.origin` from `ray.direction` (`RayTracing(o, u, n)`); `cone`
     /// is the ray's footprint, for texture filtering.
     pub fn radiance(&self, ray: &Ray, cone: RayCone, depth: u32, counts: &mut RayCounts) -> Vec3 {
-        let Some(hit) = self.accelerator.closest(&self.primitives, ray, 0.0, f32::INFINITY) else {
-            return self.scene.background;
-        };
-        let surface = self.primitives[hit.primitive as usize].surface(ray, hit.t);
-        self.shade(ray, cone, &surface, depth, counts)
+        match self.nearest_surface(ray, cone) {
+            Some((surface, ray, cone)) => self.shade(&ray, cone, &surface, depth, counts),
+            None => self.scene.background,
+        }
     }
 
     /// The level of detail at which the nearest hit of `ray` (carrying `cone`) reads its colour
     /// texture, or `None` if the ray misses or the surface has no texture: the value the shader
     /// uses, for tests and teaching.
     pub fn texture_lod(&self, ray: &Ray, cone: RayCone) -> Option<f32> {
-        let hit = self.accelerator.closest(&self.primitives, ray, 0.0, f32::INFINITY)?;
-        let surface = self.primitives[hit.primitive as usize].surface(ray, hit.t);
+        let (surface, ray, cone) = self.nearest_surface(ray, cone)?;
         let material = &self.scene.materials[surface.material.0];
         self.textures.lod(material, &surface, ray.direction, &cone, &self.texture_settings)
     }
 
-    /// `EvaluaMILRec`: the local model at the hit plus the mirror and transmission terms.
+    /// The nearest hit of `ray` on a surface that is there: a hit where a mask leaves no surface
+    /// (`α < cutoff`) is passed, the ray going on from just beyond it, its cone continued. Returns
+    /// the hit with the ray and the cone that found it (`hit.t` counts from that ray's origin), or
+    /// `None` if the ray leaves the scene or passes [`MAX_LAYERS`] masked hits.
+    fn nearest_surface(&self, ray: &Ray, cone: RayCone) -> Option<(SurfaceHit, Ray, RayCone)> {
+        let (mut ray, mut cone) = (*ray, cone);
+        for _ in 0..MAX_LAYERS {
+            let hit = self.accelerator.closest(&self.primitives, &ray, 0.0, f32::INFINITY)?;
+            let surface = self.primitives[hit.primitive as usize].surface(&ray, hit.t);
+            let material = &self.scene.materials[surface.material.0];
+            let masked_out = match material.alpha_mode {
+                AlphaMode::Mask { cutoff } => {
+                    self.textures.coverage(material, &surface, ray.direction, Some(&cone), &self.texture_settings)
+                        < cutoff
+                }
+                AlphaMode::Opaque | AlphaMode::Blend => false,
+            };
+            if !masked_out {
+                return Some((surface, ray, cone));
+            }
+            let step = hit.t + surface_offset(surface.point);
+            ray.origin = ray.at(step);
+            cone = cone.continued(step);
+        }
+        None
+    }
+
+    /// The radiance leaving the hit towards the viewer. A blended surface (`AlphaMode::Blend`)
+    /// covers a fraction `α` of the ray: `α·(the surface's own radiance) + (1 − α)·L(the ray
+    /// continued straight through)`, the continuation one level deeper like a refracted ray.
     fn shade(&self, ray: &Ray, cone: RayCone, hit: &SurfaceHit, depth: u32, counts: &mut RayCounts) -> Vec3 {
         let material = &self.scene.materials[hit.material.0];
         let v = -ray.direction;
-        // Bumped on the unturned normal, then turned to the viewer, exactly as the rasterizer.
-        let n = facing_viewer(self.textures.shading_normal(material, hit, &self.bump), v);
+        // The teaching views show the nearest surface itself, blended or not.
         if depth == 0 {
             match self.bump.view {
                 BumpView::Off => {}
-                BumpView::Normals => return 0.5 + 0.5 * n,
+                BumpView::Normals => return 0.5 + 0.5 * self.shading_normal(material, hit, v),
                 BumpView::Tangents => return 0.5 + 0.5 * hit.dpdu.normalize_or_zero(),
             }
         }
+        let alpha = match material.alpha_mode {
+            AlphaMode::Blend => self
+                .textures
+                .coverage(material, hit, ray.direction, Some(&cone), &self.texture_settings)
+                .clamp(0.0, 1.0),
+            AlphaMode::Opaque | AlphaMode::Mask { .. } => 1.0,
+        };
+        let mut rad = Vec3::ZERO;
+        if alpha > 0.0 {
+            rad += alpha * self.shade_surface(ray, cone, hit, depth, counts);
+        }
+        if alpha < 1.0 && depth < self.max_depth {
+            counts.refracted += 1;
+            let origin = hit.point - surface_offset(hit.point) * facing_viewer(hit.geometric_normal, v);
+            let behind = Ray { origin, direction: ray.direction };
+            rad += (1.0 - alpha) * self.radiance(&behind, cone.continued(hit.t), depth + 1, counts);
+        }
+        rad
+    }
+
+    /// `EvaluaMILRec`: the local model at the hit plus the mirror and transmission terms.
+    fn shade_surface(&self, ray: &Ray, cone: RayCone, hit: &SurfaceHit, depth: u32, counts: &mut RayCounts) -> Vec3 {
+        let material = &self.scene.materials[hit.material.0];
+        let v = -ray.direction;
+        let n = self.shading_normal(material, hit, v);
         let color = self.textures.colour(material, hit, ray.direction, &cone, &self.texture_settings);
         let sample = SurfaceSample::new(material, color);
         // The geometric normal on the viewer's side: secondary rays leave along it or against it.
@@ -168,8 +242,17 @@ impl Whitted<'_> {
         rad
     }
 
+    /// The shading normal at the hit: bumped on the unturned normal, then turned to the viewer
+    /// `v`, exactly as the rasterizer does.
+    fn shading_normal(&self, material: &Material, hit: &SurfaceHit, v: Vec3) -> Vec3 {
+        facing_viewer(self.textures.shading_normal(material, hit, &self.bump), v)
+    }
+
     /// `V_i`: the fraction of a light's radiance that reaches `origin` along `l` over `distance`:
-    /// 0 behind an opaque occluder, the product of `kt·MT` over transparent ones (seed 003).
+    /// the product, over the surfaces the shadow ray crosses, of what each lets through. A
+    /// surface covering a fraction `α` of the ray lets `α·kt·MT + (1 − α)` through: 0 for an
+    /// opaque occluder, `kt·MT` for glass (seed 003), 1 where a mask leaves no surface, and
+    /// `1 − α` more through a blended one. Coverage is read at level 0: shadow rays carry no cone.
     pub fn visibility(&self, origin: Vec3, l: Vec3, distance: f32, counts: &mut RayCounts) -> Vec3 {
         if !self.shadows {
             return Vec3::ONE;
@@ -177,23 +260,32 @@ impl Whitted<'_> {
         let mut transmitted = Vec3::ONE;
         let mut ray = Ray { origin, direction: l };
         let mut remaining = distance;
-        // Each transparent surface passed restarts the ray beyond it; 64 is far more layers than a
-        // scene has, and bounds the loop whatever the geometry.
-        for _ in 0..64 {
+        // Each surface passed restarts the ray beyond it.
+        for _ in 0..MAX_LAYERS {
             counts.shadow += 1;
             let Some(hit) = self.accelerator.closest(&self.primitives, &ray, 0.0, remaining) else {
                 return transmitted;
             };
-            let material = &self.scene.materials[self.primitives[hit.primitive as usize].material().0];
-            if material.transmission <= 0.0 {
-                return Vec3::ZERO;
+            let primitive = &self.primitives[hit.primitive as usize];
+            let material = &self.scene.materials[primitive.material().0];
+            let coverage = || {
+                let surface = primitive.surface(&ray, hit.t);
+                self.textures.coverage(material, &surface, ray.direction, None, &self.texture_settings)
+            };
+            let alpha = match material.alpha_mode {
+                AlphaMode::Mask { cutoff } if coverage() < cutoff => 0.0,
+                AlphaMode::Opaque | AlphaMode::Mask { .. } => 1.0,
+                AlphaMode::Blend => coverage().clamp(0.0, 1.0),
+            };
+            transmitted *= alpha * material.transmission * material.transmission_color + Vec3::splat(1.0 - alpha);
+            if transmitted == Vec3::ZERO {
+                return transmitted;
             }
-            transmitted *= material.transmission * material.transmission_color;
             let p = ray.at(hit.t);
             let step = hit.t + surface_offset(p);
             ray.origin = ray.at(step);
             remaining -= step;
-            if remaining <= 0.0 || transmitted == Vec3::ZERO {
+            if remaining <= 0.0 {
                 return transmitted;
             }
         }
