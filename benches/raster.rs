@@ -5,7 +5,11 @@
 //!    least this GPU can do with that geometry), everything off, each technique alone, all on, and
 //!    a camera-only change with the shadow maps kept; each as a ratio to the floor.
 //! 2. What shadows cost for 1, 2 and 4 shadowed lights, and pass 1 alone at two map sizes.
-//! 3. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
+//! 3. Transparency (`assets/scenes/transparency.toml` with more glass spheres, over a thousand
+//!    transparent triangles): each drawing order as a ratio to the frame that draws the same
+//!    surfaces opaque; the CPU sort per frame while the camera moves; the cost of each peeled
+//!    layer.
+//! 4. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
 //!    about a million triangles: upload, frame, triangles, beside `trace` of the same scene.
 //!
 //! Times are wall-clock from submit to the queue being idle (the median of several frames after
@@ -19,7 +23,7 @@ use mirador::gpu::texture::GpuTexture;
 use mirador::raster::{FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer, drawn_size};
 use mirador::scene::sphereflake::{sphere_count, sphereflake_toml};
 use mirador::scene::{Attenuation, Light, LightKind, Mesh, Object, Shape};
-use mirador::settings::{Prepass, ShadowFit};
+use mirador::settings::{Prepass, ShadowFit, TransparencySort};
 use mirador::trace::{RenderControl, Tracer};
 use mirador::{RenderSettings, Scene};
 
@@ -254,11 +258,80 @@ fn growing_scenes(gpu: &Gpu, quick: bool) {
     }
 }
 
+fn transparency_costs(gpu: &Gpu) {
+    let mut scene = Scene::load(&mirador::scene::builtin_path("transparency.toml")).expect("the transparency scene");
+    scene.camera.width = 1280;
+    scene.camera.height = 720;
+    let glass = scene.objects.iter().find(|o| o.name == "glass sphere").expect("a glass sphere").clone();
+    for i in 0..6 {
+        let mut sphere = glass.clone();
+        sphere.name = format!("glass sphere {i}");
+        sphere.shape = Shape::Sphere { center: Vec3::new(-2.5 + i as f32, 0.35, 1.6), radius: 0.3 };
+        scene.objects.push(sphere);
+    }
+    let mut base = scene.settings.clone();
+    // A fixed tessellation: the moving camera below must change the order, not the meshes.
+    base.raster.adaptive_tessellation = false;
+    base.sphere_segments = 32;
+    let mut opaque = base.clone();
+    opaque.transparency.enabled = false;
+    let mut bench = Bench::new(gpu, &scene);
+    let floor = bench.median_frame(&scene, &opaque);
+    bench.frame(&scene, &base);
+    let transparent = bench.scene_gpu.geometry.transparent_triangles();
+    println!(
+        "\ntransparency, 1280×720, {transparent} transparent triangles in {} objects, ratios to drawing them opaque",
+        bench.scene_gpu.geometry.transparent.len()
+    );
+    let row = |name: &str, t: Duration| {
+        println!("{name:>44} {:>9.1} ms {:>7.2}×", ms(t), t.as_secs_f64() / floor.as_secs_f64())
+    };
+    row("drawn opaque (transparency off)", floor);
+    let with = |sort: TransparencySort, layers: u32| {
+        let mut s = base.clone();
+        s.transparency.sort = sort;
+        s.transparency.peel_layers = layers;
+        s
+    };
+    row("unsorted", bench.median_frame(&scene, &with(TransparencySort::Unsorted, 1)));
+    row("per object", bench.median_frame(&scene, &with(TransparencySort::Object, 1)));
+    row("per triangle, still camera (sorted once)", bench.median_frame(&scene, &with(TransparencySort::Triangle, 1)));
+    // A moving camera re-sorts every frame.
+    let settings = with(TransparencySort::Triangle, 1);
+    let mut moving = scene.clone();
+    let (mut times, mut sorts) = (Vec::new(), Vec::new());
+    for step in 0..FRAMES + 2 {
+        moving.camera.eye = glam::Quat::from_rotation_y(0.01 * step as f32) * scene.camera.eye;
+        let (t, report) = bench.frame(&moving, &settings);
+        assert!(report.transparency.sorted, "a moved camera re-sorts");
+        times.push(t);
+        sorts.push(report.transparency.sort_time);
+    }
+    let sort = median(sorts.split_off(2));
+    row("per triangle, moving camera (re-sorted)", median(times.split_off(2)));
+    println!("{:>44} {:>9.3} ms (CPU, median)", "  of which the sort of every triangle", ms(sort));
+    let mut peeled = Vec::new();
+    for layers in [1, 2, 4, 8] {
+        let t = bench.median_frame(&scene, &with(TransparencySort::Exact, layers));
+        row(&format!("exact, {layers} peeled layers"), t);
+        peeled.push((layers, t));
+    }
+    let (first, last) = (peeled[0], peeled[peeled.len() - 1]);
+    let per_layer = (last.1.as_secs_f64() - first.1.as_secs_f64()) / f64::from(last.0 - first.0);
+    println!(
+        "{:>44} {:>9.1} ms {:>7.2}× per layer",
+        "each further peeled layer",
+        per_layer * 1e3,
+        per_layer / floor.as_secs_f64()
+    );
+}
+
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let gpu = Gpu::headless().expect("the benchmark needs a graphics adapter");
     println!("adapter: {}\n", gpu.describe());
     showcase_breakdown(&gpu);
     shadow_costs(&gpu);
+    transparency_costs(&gpu);
     growing_scenes(&gpu, quick);
 }

@@ -29,6 +29,19 @@ fn showcase() {
     common::assert_golden("showcase", &common::raster(&scene, &scene.settings), TOLERANCE);
 }
 
+/// The transparency stage in two orders: per object (the default; its crossing panes are
+/// wrong on one side) and exact (depth peeling).
+#[test]
+fn transparency_stage_per_object_and_exact() {
+    use mirador::settings::TransparencySort;
+    let scene = common::load("scenes/transparency.toml");
+    for (name, sort) in [("transparency-object", TransparencySort::Object), ("transparency-exact", TransparencySort::Exact)] {
+        let mut settings = scene.settings.clone();
+        settings.transparency.sort = sort;
+        common::assert_golden(name, &common::raster(&scene, &settings), TOLERANCE);
+    }
+}
+
 #[test]
 fn shadow_stage_with_shadow_maps() {
     let scene = common::load("scenes/shadows.toml");

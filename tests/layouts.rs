@@ -121,6 +121,9 @@ fn gpu_structs_match_their_wgsl_twins_field_by_field() {
             noise_seed,
             noise_cells,
             noise_octaves,
+            alpha,
+            alpha_cutoff,
+            alpha_mode,
         }),
     );
     check_struct(
@@ -160,7 +163,7 @@ fn instance_attributes_match_the_wgsl_locations() {
 #[test]
 fn codes_shared_by_rust_and_wgsl_agree() {
     let module = parse(&shaders::compose(shaders::SCENE));
-    let codes: [(&str, f64); 21] = [
+    let codes: [(&str, f64); 24] = [
         ("MAX_LIGHTS", uniforms::MAX_LIGHTS as f64),
         ("MAX_SHADOW_LAYERS", MAX_LAYERS as f64),
         ("LIGHT_POINT", uniforms::LIGHT_POINT.into()),
@@ -181,6 +184,9 @@ fn codes_shared_by_rust_and_wgsl_agree() {
         ("HEIGHT_TEXTURE", scene_pass::HEIGHT_TEXTURE.into()),
         ("HEIGHT_SINE", scene_pass::HEIGHT_SINE.into()),
         ("HEIGHT_NOISE", scene_pass::HEIGHT_NOISE.into()),
+        ("ALPHA_OPAQUE", uniforms::ALPHA_OPAQUE.into()),
+        ("ALPHA_MASK", uniforms::ALPHA_MASK.into()),
+        ("ALPHA_BLEND", uniforms::ALPHA_BLEND.into()),
         ("MIP_PALETTE_LAST", (mirador::texture::mipmap::LEVEL_PALETTE.len() - 1) as f64),
     ];
     for (name, rust) in codes {

@@ -223,19 +223,16 @@ fn convex_glass_shows_its_far_walls_through_its_near_ones() {
     for sort in [TransparencySort::Object, TransparencySort::Triangle] {
         let image = common::raster(&scene, &with_sort(&scene, sort));
         let error = flip(&exact, &image);
-        eprintln!("{sort:?} vs exact {error}");
-        assert!(error < 0.002, "{sort:?} vs exact: FLIP {error}");
+        assert!(error < 0.0005, "{sort:?} vs exact: FLIP {error}");
     }
     // The file's order draws near walls before far ones somewhere: visibly wrong.
     let unsorted = common::raster(&scene, &with_sort(&scene, TransparencySort::Unsorted));
     let error = flip(&exact, &unsorted);
-    eprintln!("unsorted vs exact {error}");
-    assert!(error > 0.004, "unsorted vs exact: FLIP {error}");
+    assert!(error > 0.01, "unsorted vs exact: FLIP {error}");
     // The ray tracer, with ior = 1, agrees with the exact order.
     let settings = unshadowed(&scene, TransparencySort::Exact);
     let error = flip(&mirador::trace::render_image(&scene, &settings), &common::raster(&scene, &settings));
-    eprintln!("convex exact vs traced {error}");
-    assert!(error < 0.03, "exact vs traced: FLIP {error}");
+    assert!(error < 0.025, "exact vs traced: FLIP {error}");
 }
 
 #[test]
@@ -251,7 +248,6 @@ fn the_exact_order_agrees_with_the_tracer_at_ior_one_where_sorting_fails() {
     // The crossing panes are wrong per object and per triangle; the file's order is wrong too.
     for sort in [TransparencySort::Unsorted, TransparencySort::Object, TransparencySort::Triangle] {
         let e = error(sort);
-        eprintln!("{sort:?} {e} exact {exact}");
         assert!(e > exact + 0.001, "{sort:?}: FLIP {e}, no worse than exact's {exact}");
     }
 }
@@ -265,4 +261,124 @@ fn turning_transparency_off_draws_the_panes_opaque() {
     // The near pane alone, its illumination model without what lies behind.
     let got = linear_pixel(&image, 32, 32);
     assert!(got.abs_diff_eq(PANES[2].emission, 0.006), "{got}");
+}
+
+// ---- glTF's alpha modes in the rasterizer (the tracer's side is in tests/alpha.rs) ----
+
+/// Parses `text` as if it were `tests/data/alpha.toml`, so `textures/…` resolves there.
+fn alpha_scene(more: &str) -> Scene {
+    let text = format!(
+        "[camera]\neye = [0, 0, 5]\ncenter = [0, 0, 0]\nfovy = 30\nwidth = 64\nheight = 64\n\
+         [world]\nambient = [0, 0, 0]\nbackground = {:?}\n{more}",
+        BACKGROUND.to_array()
+    );
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/alpha.toml");
+    parse(&text, &path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+const E: Vec3 = Vec3::new(0.6, 0.3, 0.15);
+
+/// A 2 × 2 emissive plane facing the camera, with more material lines.
+fn emissive_plane(lines: &str) -> String {
+    format!(
+        "[materials.veil]\ncolor = [0, 0, 0]\nkd = 0\nemission = {:?}\n{lines}\n\
+         [[objects]]\ntype = \"plane\"\nsize = [2, 2]\nrotate = [90, 0, 0]\nmaterial = \"veil\"\n",
+        E.to_array()
+    )
+}
+
+#[test]
+fn alpha_blending_is_the_seeds_formula_with_im_scaled_by_alpha() {
+    // A constant α: I = α·E + (1 − α)·B, the blend constant 1 − α.
+    let constant = alpha_scene(&emissive_plane("alpha_mode = \"blend\"\nalpha = 0.25"));
+    // α from the texture (128/255) times the factor: the blend reads 1 − α from the fragment.
+    let textured =
+        alpha_scene(&emissive_plane("alpha_mode = \"blend\"\nalpha = 0.8\ntexture = \"textures/alpha-128.png\""));
+    // Blending and transmission together: I = α·E + (α·kt·Mt + 1 − α)·B.
+    let both = alpha_scene(&emissive_plane(
+        "alpha_mode = \"blend\"\nalpha = 0.5\ntransmission = 0.6\ntransmission_color = [1, 0.5, 0.25]",
+    ));
+    let through = 0.6 * Vec3::new(1.0, 0.5, 0.25);
+    let cases = [
+        ("constant α", &constant, 0.25 * E + 0.75 * BACKGROUND),
+        ("texture α", &textured, { let a = 0.8 * 128.0 / 255.0; a * E + (1.0 - a) * BACKGROUND }),
+        ("α and kt", &both, 0.5 * E + (0.5 * through + Vec3::splat(0.5)) * BACKGROUND),
+    ];
+    for (what, scene, expected) in cases {
+        for sort in SORTS {
+            let got = linear_pixel(&common::raster(scene, &with_sort(scene, sort)), 32, 32);
+            assert!(got.abs_diff_eq(expected, 0.006), "{what}, {sort:?}: {got} instead of {expected}");
+        }
+        let traced = linear_pixel(&mirador::trace::render_image(scene, &scene.settings), 32, 32);
+        assert!(traced.abs_diff_eq(expected, 0.006), "{what}, traced: {traced} instead of {expected}");
+    }
+}
+
+#[test]
+fn a_mask_cuts_the_surface_out_with_or_without_a_depth_prepass() {
+    // A 2×1 texture: alpha 255 on the left texel, 0 on the right; cut at 0.5.
+    let scene = alpha_scene(&emissive_plane(
+        "alpha_mode = \"mask\"\nalpha_cutoff = 0.5\ntexture = \"textures/alpha-left-opaque.png\"\nwrap = \"clamp\"",
+    ));
+    for prepass in [mirador::settings::Prepass::Always, mirador::settings::Prepass::Never] {
+        let mut settings = scene.settings.clone();
+        settings.raster.depth_prepass = prepass;
+        let image = common::raster(&scene, &settings);
+        let (left, right) = (linear_pixel(&image, 22, 32), linear_pixel(&image, 42, 32));
+        assert!(left.abs_diff_eq(E, 0.006), "{prepass:?}: the kept half shows {left}, not {E}");
+        assert!(right.abs_diff_eq(BACKGROUND, 0.006), "{prepass:?}: the cut half shows {right}, not the background");
+    }
+}
+
+#[test]
+fn a_masked_caster_shadows_only_where_its_surface_is() {
+    // A leaf held over a lit floor: half of it is cut out, so half of its shadow is missing.
+    let text = format!(
+        "[camera]\neye = [0, 4, 4]\ncenter = [0, 0, 0]\nfovy = 45\nwidth = 160\nheight = 120\n\
+         [world]\nambient = [0.05, 0.05, 0.05]\n\
+         [materials.floor]\ncolor = [0.8, 0.8, 0.8]\n\
+         [materials.leaf]\ncolor = [0.2, 0.7, 0.2]\ntexture = \"textures/alpha-left-opaque.png\"\n\
+         wrap = \"clamp\"\nalpha_mode = \"{{mode}}\"\n{{cutoff}}\n\
+         [[lights]]\ntype = \"directional\"\ndirection = [0.3, -1, -0.2]\nintensity = 0.9\n\
+         [[objects]]\ntype = \"plane\"\nsize = [8, 8]\nmaterial = \"floor\"\n\
+         [[objects]]\ntype = \"plane\"\nsize = [1.6, 1.6]\ntranslate = [0, 1.2, 0]\nmaterial = \"leaf\"\n"
+    );
+    let masked = text.replace("{mode}", "mask").replace("{cutoff}", "alpha_cutoff = 0.5");
+    let opaque = text.replace("{mode}", "opaque").replace("{cutoff}", "");
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/alpha.toml");
+    let load = |text: &str| parse(text, &path).unwrap_or_else(|e| panic!("{e}"));
+    let (masked, opaque) = (load(&masked), load(&opaque));
+    let traced = mirador::trace::render_image(&masked, &masked.settings);
+    let agreeing = flip(&traced, &common::raster(&masked, &masked.settings));
+    // The whole leaf drawn and casting: what the test would see if the mask were ignored.
+    let ignoring_the_mask = flip(&traced, &common::raster(&opaque, &opaque.settings));
+    assert!(agreeing < 0.01, "masked leaf vs traced: FLIP {agreeing}");
+    assert!(ignoring_the_mask > 4.0 * agreeing, "an unmasked leaf differs by {ignoring_the_mask} only");
+}
+
+#[test]
+fn an_alpha_blended_gltf_cube_agrees_with_the_tracer_from_every_side() {
+    // tests/data/gltf/blend_cube.gltf: a hand-made unit cube, alphaMode BLEND, baseColorFactor
+    // alpha 0.45, turned 45° about y; before a red post, over a floor, under one light.
+    let text = |eye: [f32; 3]| {
+        format!(
+            "[camera]\neye = {eye:?}\ncenter = [0, 0.6, 0]\nfovy = 40\nwidth = 160\nheight = 120\n\
+             [world]\nambient = [0.1, 0.1, 0.1]\nbackground = [0.3, 0.4, 0.5]\n\
+             [materials.floor]\ncolor = [0.8, 0.78, 0.7]\n[materials.red]\ncolor = [0.8, 0.1, 0.1]\n\
+             [[lights]]\ntype = \"point\"\nposition = [2, 5, 3]\nintensity = 0.9\n\
+             [[objects]]\ntype = \"plane\"\nsize = [12, 12]\nmaterial = \"floor\"\n\
+             [[objects]]\ntype = \"box\"\nmin = [-0.15, 0, -1.3]\nmax = [0.15, 1.6, -1.0]\nmaterial = \"red\"\n\
+             [[objects]]\ntype = \"gltf\"\npath = \"gltf/blend_cube.gltf\"\ntranslate = [0, 0.7, 0]\n\
+             lights = false\ncamera = false\n"
+        )
+    };
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/alpha.toml");
+    for eye in [[0.5, 2.0, 4.0], [-1.0, 1.5, -4.5], [4.0, 3.0, 0.5]] {
+        let scene = parse(&text(eye), &path).unwrap_or_else(|e| panic!("{e}"));
+        let traced = mirador::trace::render_image(&scene, &unshadowed(&scene, TransparencySort::Exact));
+        for sort in [TransparencySort::Object, TransparencySort::Triangle, TransparencySort::Exact] {
+            let error = flip(&traced, &common::raster(&scene, &unshadowed(&scene, sort)));
+            assert!(error < 0.025, "from {eye:?}, {sort:?}: FLIP {error}");
+        }
+    }
 }

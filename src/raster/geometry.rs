@@ -366,6 +366,11 @@ impl SceneGeometry {
         self.batches.iter().map(|b| u64::from(self.meshes[&b.mesh].index_count / 3) * b.instances.len() as u64).sum()
     }
 
+    /// Transparent triangles drawn per view.
+    pub fn transparent_triangles(&self) -> u64 {
+        self.transparent.iter().map(|t| u64::from(self.meshes[&t.mesh].index_count / 3)).sum()
+    }
+
     pub fn mesh_count(&self) -> usize {
         self.meshes.len()
     }
