@@ -1,5 +1,6 @@
 //! Rasterizer benchmark: where a frame's time goes, and how the frame scales with the scene. Run
-//! with `cargo bench --bench raster` (`-- --quick` skips the largest scenes).
+//! with `cargo bench --bench raster` (`-- --quick` skips the largest scenes; `-- transparency`
+//! or any other section's name runs that section alone).
 //!
 //! 1. The showcase at 1280×720: the flat-colour floor (every surface in its material's colour, the
 //!    least this GPU can do with that geometry), everything off, each technique alone, all on, and
@@ -301,7 +302,7 @@ fn transparency_costs(gpu: &Gpu) {
     let mut moving = scene.clone();
     let (mut times, mut sorts) = (Vec::new(), Vec::new());
     for step in 0..FRAMES + 2 {
-        moving.camera.eye = glam::Quat::from_rotation_y(0.01 * step as f32) * scene.camera.eye;
+        moving.camera.eye = glam::Quat::from_rotation_y(0.01 * (step + 1) as f32) * scene.camera.eye;
         let (t, report) = bench.frame(&moving, &settings);
         assert!(report.transparency.sorted, "a moved camera re-sorts");
         times.push(t);
@@ -327,11 +328,25 @@ fn transparency_costs(gpu: &Gpu) {
 }
 
 fn main() {
-    let quick = std::env::args().any(|a| a == "--quick");
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    // Section names on the command line run those sections alone:
+    // `cargo bench --bench raster -- transparency`.
+    const SECTIONS: [&str; 4] = ["showcase", "shadows", "transparency", "growing"];
+    let chosen: Vec<&str> = SECTIONS.into_iter().filter(|s| args.iter().any(|a| a == s)).collect();
+    let run = |section: &str| chosen.is_empty() || chosen.contains(&section);
     let gpu = Gpu::headless().expect("the benchmark needs a graphics adapter");
     println!("adapter: {}\n", gpu.describe());
-    showcase_breakdown(&gpu);
-    shadow_costs(&gpu);
-    transparency_costs(&gpu);
-    growing_scenes(&gpu, quick);
+    if run("showcase") {
+        showcase_breakdown(&gpu);
+    }
+    if run("shadows") {
+        shadow_costs(&gpu);
+    }
+    if run("transparency") {
+        transparency_costs(&gpu);
+    }
+    if run("growing") {
+        growing_scenes(&gpu, quick);
+    }
 }

@@ -24,6 +24,9 @@ override HEIGHT_KIND: u32 = 0u;
 override NORMAL_MAP: bool = false;
 // ALPHA_* of shaders/common/types.wgsl: whether coverage cuts the surface out or blends it.
 override ALPHA_MODE: u32 = 0u;
+// A planar mirror drawn with its reflection (src/raster/mirror): group 3 holds the image the
+// mirrored camera drew.
+override MIRROR: bool = false;
 
 const SHADOWS_OFF: u32 = 0u;
 const SHADOWS_MAP: u32 = 1u;
@@ -57,6 +60,10 @@ const HEIGHT_NOISE: u32 = 3u;
 @group(2) @binding(2) var shadow_sampler: sampler_comparison;
 @group(2) @binding(3) var transmission_maps: texture_2d_array<f32>;
 @group(2) @binding(4) var projected_mask: texture_2d<f32>;
+// Group 3 (mirror variants only): the reflection, drawn by the camera mirrored about this mirror's
+// plane at the same size as this view, so the mirror's own pixel is where its reflection is
+// (the projective lookup of TECHNIQUES.md §6 reduces to the fragment's pixel).
+@group(3) @binding(2) var mirror_image: texture_2d<f32>;
 
 struct VertexIn {
     @location(0) position: vec3f,
@@ -287,7 +294,12 @@ fn fs_scene(in: VertexOut) -> @location(0) vec4f {
     if masked_out(in.uv) {
         discard;
     }
-    return vec4f(shade(in), 1.0);
+    var radiance = shade(in);
+    // The mirror term kps·MPS·L(r), as the tracer adds its reflected ray.
+    if MIRROR && !FLAT_COLOUR && BUMP_VIEW == 0u {
+        radiance += material.reflectance * textureLoad(mirror_image, vec2i(in.clip.xy), 0).rgb;
+    }
+    return vec4f(radiance, 1.0);
 }
 
 // The depth prepass of a cut-out material: depth only where the surface is.

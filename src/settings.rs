@@ -25,6 +25,8 @@ pub struct RenderSettings {
     pub shadows: ShadowSettings,
     /// Transparent surfaces in sorted Z order (TECHNIQUES.md §5).
     pub transparency: TransparencySettings,
+    /// Planar mirrors by a mirrored camera (TECHNIQUES.md §6).
+    pub mirrors: MirrorSettings,
     /// How the rasterizer spends its time: prepass, tessellation, render scale.
     pub raster: RasterSettings,
     /// The ray tracer's own settings.
@@ -67,6 +69,42 @@ impl Default for TransparencySettings {
         TransparencySettings { enabled: true, sort: TransparencySort::Object, peel_layers: 8 }
     }
 }
+
+/// What the mirror technique shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum MirrorView {
+    /// The scene, its mirrors showing their reflections.
+    Off,
+    /// The first mirror camera's own image, full screen: the scene seen from behind the mirror,
+    /// mirrored, with nothing in front of the mirror plane's far side.
+    Image,
+    /// Each mirrored camera's view volume drawn into the scene: its near face lies on the mirror.
+    Camera,
+}
+
+/// Planar mirrors (materials with `kps > 0` on flat objects) in the rasterizer.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MirrorSettings {
+    /// Render each mirror's reflection with the camera mirrored about its plane and add
+    /// `kps·MPS` times it to the mirror's illumination model; off, mirrors show their model alone.
+    pub enabled: bool,
+    /// Reflections of reflections: mirrors that see each other recurse this deep (0: mirrors show
+    /// their plain material), like the tracer's `max_depth` for mirror rays.
+    pub depth: u32,
+    /// Teaching views.
+    pub view: MirrorView,
+}
+
+impl Default for MirrorSettings {
+    fn default() -> Self {
+        MirrorSettings { enabled: true, depth: 3, view: MirrorView::Off }
+    }
+}
+
+/// The deepest `mirrors.depth`.
+pub const MAX_MIRROR_DEPTH: u32 = 8;
 
 /// The most layers `transparency.sort = "exact"` may peel.
 pub const MAX_PEEL_LAYERS: u32 = 32;
@@ -408,6 +446,7 @@ impl Default for RenderSettings {
             bump: BumpSettings::default(),
             shadows: ShadowSettings::default(),
             transparency: TransparencySettings::default(),
+            mirrors: MirrorSettings::default(),
             raster: RasterSettings::default(),
             trace: TraceSettings::default(),
         }
@@ -493,6 +532,12 @@ impl RenderSettings {
         if !(1..=MAX_PEEL_LAYERS).contains(&layers) {
             return Err(SettingsError::Invalid(format!(
                 "transparency.peel_layers must lie in 1..={MAX_PEEL_LAYERS}, got {layers}"
+            )));
+        }
+        if self.mirrors.depth > MAX_MIRROR_DEPTH {
+            return Err(SettingsError::Invalid(format!(
+                "mirrors.depth must lie in 0..={MAX_MIRROR_DEPTH}, got {}",
+                self.mirrors.depth
             )));
         }
         let scale = self.raster.render_scale;

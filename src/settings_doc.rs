@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use crate::settings::{
     AccelKind, AntiAliasing, BumpView, Prepass, ShadowFilter, ShadowFit, ShadowMethod, ShadowView, TangentSource,
-    TextureFilter, TracerLod, TransparencySort,
+    MirrorView, TextureFilter, TracerLod, TransparencySort,
 };
 
 /// One value an enum setting can take.
@@ -203,6 +203,18 @@ pub fn describe(key: &str) -> Option<FieldDoc> {
             "Layers the exact order peels at every pixel, from the back; each costs two passes over the transparent surfaces.",
             1.0,
             32.0,
+        ),
+        "mirrors" => doc(
+            "Planar mirrors (TECHNIQUES.md §6): the scene rendered by the camera mirrored about each mirror's plane, shown in the mirror as kps·MPS·L(r).",
+        ),
+        "mirrors.enabled" => doc("Off: mirrors show their illumination model alone, without the kps·MPS·L(r) term."),
+        "mirrors.depth" => number(
+            "How deep mirrors that see each other recurse; 0 draws every mirror as its plain material (the tracer's max_depth for mirror rays).",
+            0.0,
+            8.0,
+        ),
+        "mirrors.view" => choice::<MirrorView>(
+            "Teaching views: the first mirror camera's own image, or each mirrored camera's view volume drawn in the scene.",
         ),
         "raster" => doc(
             "How the rasterizer spends its time. None of these changes what a technique computes; each trades time for a measured difference.",

@@ -124,6 +124,7 @@ fn gpu_structs_match_their_wgsl_twins_field_by_field() {
             alpha,
             alpha_cutoff,
             alpha_mode,
+            reflectance,
         }),
     );
     check_struct(

@@ -95,6 +95,9 @@ struct Material {
     alpha: f32,
     alpha_cutoff: f32,
     alpha_mode: u32,
+    // kps·MPS: what a mirror reflects.
+    reflectance: vec3f,
+    _pad0: f32,
 }
 
 // What a transparent surface lets through, the factor of I = Im + kt·Mt·I (TECHNIQUES.md §5):

@@ -170,8 +170,14 @@ pub struct Batch {
     pub material: usize,
     /// The material lets light through (kt > 0): it tints shadows rather than casting them.
     pub transparent: bool,
+    /// A planar mirror (its object's index) is a batch of its own: it shows its own reflection.
+    pub mirror: Option<usize>,
     pub instances: Range<u32>,
 }
+
+/// One object in the draw list: (transparent, material, mirror, mesh, instance, object index,
+/// world from mesh).
+type Entry = (bool, usize, Option<usize>, MeshKey, GpuInstance, usize, Mat4);
 
 /// A transparent object, as the transparency pass draws it: alone, in an order of its choosing.
 #[derive(Clone, Debug, PartialEq)]
@@ -194,6 +200,7 @@ pub struct TransparentObject {
 struct ObjectInfo {
     material: usize,
     transparent: bool,
+    mirror: bool,
     curved_bounds: Option<(Vec3, Vec3)>,
 }
 
@@ -222,13 +229,16 @@ fn next_version() -> u64 {
 }
 
 impl SceneGeometry {
-    pub fn new(scene: &Scene) -> SceneGeometry {
+    /// The geometry of `scene`, in which the objects listed in `mirrors` are planar mirrors.
+    pub fn new(scene: &Scene, mirrors: &[usize]) -> SceneGeometry {
         let objects = scene
             .objects
             .iter()
-            .map(|object| ObjectInfo {
+            .enumerate()
+            .map(|(index, object)| ObjectInfo {
                 material: object.material.0,
                 transparent: scene.materials[object.material.0].is_transparent(),
+                mirror: mirrors.contains(&index),
                 curved_bounds: object.shape.curved_bounds(),
             })
             .collect();
@@ -272,7 +282,7 @@ impl SceneGeometry {
         if segments == self.segments && self.instances.is_some() {
             return false;
         }
-        let mut entries: Vec<(bool, usize, MeshKey, GpuInstance, usize, Mat4)> = scene
+        let mut entries: Vec<Entry> = scene
             .objects
             .iter()
             .zip(&self.objects)
@@ -280,12 +290,13 @@ impl SceneGeometry {
             .enumerate()
             .map(|(index, ((object, info), &n))| {
                 let (key, world_from_mesh) = instance_of(object, n);
-                (info.transparent, info.material, key, GpuInstance::new(world_from_mesh), index, world_from_mesh)
+                let mirror = info.mirror.then_some(index);
+                (info.transparent, info.material, mirror, key, GpuInstance::new(world_from_mesh), index, world_from_mesh)
             })
             .collect();
-        // Opaque first, then by material and mesh: runs of equal keys become one draw.
-        entries.sort_by(|a, b| (a.0, a.1).cmp(&(b.0, b.1)).then_with(|| mesh_order(&a.2).cmp(&mesh_order(&b.2))));
-        for (_, _, key, ..) in &entries {
+        // Opaque first, then by material, mirror and mesh: runs of equal keys become one draw.
+        entries.sort_by(|a, b| (a.0, a.1, a.2).cmp(&(b.0, b.1, b.2)).then_with(|| mesh_order(&a.3).cmp(&mesh_order(&b.3))));
+        for (_, _, _, key, ..) in &entries {
             if !self.meshes.contains_key(key) {
                 let mesh = build_mesh(scene, *key);
                 self.meshes.insert(*key, GpuMesh::upload(device, &format!("{key:?}"), &mesh));
@@ -293,21 +304,24 @@ impl SceneGeometry {
         }
         self.batches.clear();
         self.transparent.clear();
-        for (index, (transparent, material, key, ..)) in entries.iter().enumerate() {
+        for (index, (transparent, material, mirror, key, ..)) in entries.iter().enumerate() {
             let index = index as u32;
             match self.batches.last_mut() {
-                Some(b) if b.transparent == *transparent && b.material == *material && b.mesh == *key => {
+                Some(b)
+                    if b.transparent == *transparent && b.material == *material && b.mirror == *mirror && b.mesh == *key =>
+                {
                     b.instances.end = index + 1;
                 }
                 _ => self.batches.push(Batch {
                     mesh: *key,
                     material: *material,
                     transparent: *transparent,
+                    mirror: *mirror,
                     instances: index..index + 1,
                 }),
             }
         }
-        for (instance, &(_, material, mesh, _, object, world_from_mesh)) in entries.iter().enumerate() {
+        for (instance, &(_, material, _, mesh, _, object, world_from_mesh)) in entries.iter().enumerate() {
             if entries[instance].0 {
                 self.transparent.push(TransparentObject {
                     object,
@@ -321,7 +335,7 @@ impl SceneGeometry {
             }
         }
         self.transparent.sort_by_key(|t| t.object);
-        let data: Vec<GpuInstance> = entries.iter().map(|e| e.3).collect();
+        let data: Vec<GpuInstance> = entries.iter().map(|e| e.4).collect();
         let size = std::mem::size_of_val(data.as_slice()) as u64;
         match &self.instances {
             Some(buffer) if buffer.size() >= size => queue.write_buffer(buffer, 0, bytemuck::cast_slice(&data)),

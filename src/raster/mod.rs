@@ -16,6 +16,7 @@
 //! (more views, drawn by the same scene pass) before `opaque`; the sky after it.
 
 pub mod geometry;
+pub mod mirror;
 pub mod overlays;
 pub mod present;
 pub mod scene_gpu;
@@ -31,11 +32,12 @@ use crate::gpu::mipmap::MipmapGenerator;
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::{Gpu, readback};
 use crate::scene::Scene;
-use crate::settings::{Prepass, RenderSettings, ShadowMethod};
+use crate::settings::{MirrorView, Prepass, RenderSettings, ShadowMethod};
 use overlays::Overlays;
 use present::{PresentInput, PresentPass};
 use scene_gpu::{SceneGpu, SceneLayouts};
-use scene_pass::{FrameKey, ScenePass, SceneTargets};
+use mirror::pass::{children, plan, volumes};
+use scene_pass::{FrameKey, MirrorImages, SHADOWS_OFF, ScenePass, SceneTargets};
 use shadow::projected::{MASK_FORMAT, ProjectedPass};
 use shadow::views::{ShadowLayout, shadow_layout_in};
 use shadow::{ShadowMaps, ShadowPass};
@@ -58,6 +60,9 @@ pub struct Renderer {
     transparency: TransparencyPass,
     overlays: Overlays,
     present: PresentPass,
+    /// The targets of the mirrored views (`mirror::pass`), one per view of the largest frame so
+    /// far.
+    mirror_targets: Vec<FrameTargets>,
     /// The lighting inputs (group 2), and the (shadow maps, frame targets) generations they were
     /// made for.
     lighting: Option<((u64, u64), wgpu::BindGroup)>,
@@ -94,6 +99,8 @@ pub struct FrameReport {
     pub drawn_size: (u32, u32),
     /// What the transparency pass drew, and its CPU sort.
     pub transparency: TransparencyReport,
+    /// Mirrored cameras drawn (planar mirrors and their reflections in each other).
+    pub mirror_views: u32,
 }
 
 /// The frame's command encoder. When profiling, each pass is submitted and waited for on its
@@ -149,6 +156,7 @@ impl Renderer {
             transparency: TransparencyPass::new(device, &layouts),
             overlays: Overlays::new(device, &layouts),
             present: PresentPass::new(device, output_format),
+            mirror_targets: Vec::new(),
             layouts,
             lighting: None,
             profile: false,
@@ -227,7 +235,28 @@ impl Renderer {
         // Transparent surfaces are drawn after the opaque ones, or as opaque ones when the
         // technique is off.
         let sorted_transparency = settings.transparency.enabled && scene_gpu.geometry.has_transparent();
-        self.scene.prepare(device, frame_key, &scene_gpu.material_keys, prepass);
+        // Planar mirrors: the tree of mirrored cameras, each with its slot and targets.
+        let mirrors = &settings.mirrors;
+        let (nodes, truncated) = if mirrors.enabled { plan(&main_view, &scene_gpu.mirrors, mirrors.depth) } else { (Vec::new(), false) };
+        if truncated {
+            log::debug!("more than {} mirrored views: the deepest are left out", view::MAX_MIRROR_VIEWS);
+        }
+        for (k, node) in nodes.iter().enumerate() {
+            scene_gpu.views.write(queue, ViewSlot::Mirror(k as u32), &node.view);
+        }
+        if self.mirror_targets.first().is_some_and(|t| t.size != size) {
+            self.mirror_targets.clear();
+        }
+        while self.mirror_targets.len() < nodes.len() {
+            let made = self.targets(device, size);
+            self.mirror_targets.push(made);
+        }
+        // Object-precision shadows are a mask of the main view's pixels: mirrored views go without.
+        let mirror_key = if projected { FrameKey { shadow_method: SHADOWS_OFF, ..frame_key } } else { frame_key };
+        self.scene.prepare(device, frame_key, scene_gpu, prepass, !nodes.is_empty());
+        if !nodes.is_empty() {
+            self.scene.prepare(device, mirror_key, scene_gpu, false, true);
+        }
 
         // Object precision draws no maps: its light views have no layers to fill.
         let no_maps = ShadowLayout::default();
@@ -237,6 +266,48 @@ impl Renderer {
         let shadow_layers_drawn = maps.layers_drawn;
         frame.end("shadow maps");
         let lighting = lighting_group(&mut self.lighting, device, &self.layouts, &maps, targets);
+        // Deepest first: every view's mirrors find their images drawn.
+        let images_of = children(&nodes);
+        for (k, node) in nodes.iter().enumerate().rev() {
+            let node_targets = &self.mirror_targets[k];
+            let mut images = mirror_images(device, &self.scene, scene_gpu, &self.mirror_targets, images_of.get(&Some(k)));
+            images.skip = Some(scene_gpu.mirrors[node.mirror].object);
+            let slot = ViewSlot::Mirror(k as u32);
+            let node_scene_targets = SceneTargets {
+                hdr: &node_targets.hdr.view,
+                depth: &node_targets.depth.view,
+                background: scene.background,
+            };
+            self.scene.record_opaque(
+                &mut frame.encoder,
+                scene_gpu,
+                lighting,
+                slot,
+                mirror_key,
+                &node_scene_targets,
+                false,
+                sorted_transparency,
+                &images,
+            );
+            if sorted_transparency {
+                self.transparency.record(
+                    device,
+                    queue,
+                    &mut frame.encoder,
+                    &self.scene,
+                    scene,
+                    scene_gpu,
+                    lighting,
+                    mirror_key,
+                    (slot, &node.view),
+                    node_targets,
+                    &settings.transparency,
+                );
+            }
+        }
+        if !nodes.is_empty() {
+            frame.end("mirror views");
+        }
         if prepass {
             self.scene.record_prepass(
                 &mut frame.encoder,
@@ -265,6 +336,7 @@ impl Renderer {
             &scene_targets,
             prepass,
             sorted_transparency,
+            &mirror_images(device, &self.scene, scene_gpu, &self.mirror_targets, images_of.get(&None)),
         );
         frame.end("opaque");
         let mut transparency = TransparencyReport::default();
@@ -285,7 +357,15 @@ impl Renderer {
             frame.end("transparency");
         }
         self.overlays.record(device, queue, &mut frame.encoder, shadows, scene_gpu, map_layout, &maps, targets);
-        self.present.record(queue, &mut frame.encoder, &targets.present_input, output, settings.exposure);
+        if mirrors.view == MirrorView::Camera && !nodes.is_empty() {
+            self.overlays.record_volumes(device, &mut frame.encoder, scene_gpu, &volumes(&nodes), targets);
+        }
+        // The first mirror camera's own image, in place of the frame.
+        let shown = match nodes.first() {
+            Some(_) if mirrors.view == MirrorView::Image => &self.mirror_targets[0].present_input,
+            _ => &targets.present_input,
+        };
+        self.present.record(queue, &mut frame.encoder, shown, output, settings.exposure);
         frame.end("overlays + present");
         FrameReport {
             passes: frame.finish(),
@@ -294,8 +374,36 @@ impl Renderer {
             triangles: scene_gpu.geometry.triangles(),
             drawn_size: size,
             transparency,
+            mirror_views: nodes.len() as u32,
         }
     }
+}
+
+/// The reflections the mirrors of one view show: for each `(mirror, node)` child of the view,
+/// the group 3 reading that node's image.
+fn mirror_images(
+    device: &wgpu::Device,
+    scene_pass: &ScenePass,
+    scene_gpu: &SceneGpu,
+    mirror_targets: &[FrameTargets],
+    children: Option<&Vec<(usize, usize)>>,
+) -> MirrorImages {
+    let images = children
+        .into_iter()
+        .flatten()
+        .map(|&(mirror, node)| {
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("frame::mirror_image_group"),
+                layout: &scene_pass.mirror_group_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&mirror_targets[node].hdr.view),
+                }],
+            });
+            (scene_gpu.mirrors[mirror].object, group)
+        })
+        .collect();
+    MirrorImages { images, skip: None }
 }
 
 /// Group 2 of the scene pass, built from the shadow pass's outputs and the frame's projected

@@ -55,8 +55,24 @@ impl Overlays {
             map_view.record(device, queue, encoder, maps.depth, layer, ratio, frame.size, &frame.hdr.view);
         }
         if settings.show_frusta {
-            self.frusta.record(device, encoder, scene, layout, &frame.hdr.view, &frame.depth.view);
+            let volumes: Vec<[Vec3; 8]> = (0..layout.views.len()).map(|layer| layout.corners(layer)).collect();
+            self.frusta.record(device, encoder, scene, &volumes, &frame.hdr.view, &frame.depth.view);
         }
+    }
+}
+
+impl Overlays {
+    /// Draws the edges of each of `volumes` (eight corners, as `view::frustum_corners` orders
+    /// them) into the scene: the mirrored cameras' view volumes (`mirrors.view = "camera"`).
+    pub fn record_volumes(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &SceneGpu,
+        volumes: &[[Vec3; 8]],
+        frame: &FrameTargets,
+    ) {
+        self.frusta.record(device, encoder, scene, volumes, &frame.hdr.view, &frame.depth.view);
     }
 }
 
@@ -190,17 +206,15 @@ impl Frusta {
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         scene: &SceneGpu,
-        layout: &ShadowLayout,
+        volumes: &[[Vec3; 8]],
         hdr: &wgpu::TextureView,
         depth: &wgpu::TextureView,
     ) {
         const EDGES: [(usize, usize); 12] =
             [(0, 1), (2, 3), (0, 2), (1, 3), (4, 5), (6, 7), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)];
-        let lines: Vec<Vec3> = (0..layout.views.len())
-            .flat_map(|layer| {
-                let corners = layout.corners(layer);
-                EDGES.into_iter().flat_map(move |(a, b)| [corners[a], corners[b]])
-            })
+        let lines: Vec<Vec3> = volumes
+            .iter()
+            .flat_map(|corners| EDGES.into_iter().flat_map(move |(a, b)| [corners[a], corners[b]]))
             .collect();
         // A teaching view, drawn only while it is on: a buffer made here costs nothing when off.
         let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

@@ -5,6 +5,7 @@
 //! change, the draw list.
 
 use super::geometry::SceneGeometry;
+use super::mirror::{Mirror, find_mirrors};
 use super::scene_pass::MaterialKey;
 use super::uniforms::{GpuFrame, GpuMaterial};
 use super::view::ViewBuffer;
@@ -80,6 +81,8 @@ pub struct SceneGpu {
     pub material_keys: Vec<MaterialKey>,
     /// Per material: what it lets through, the blend constant `kt·Mt` of the transparency pass.
     pub transmittance: Vec<glam::Vec3>,
+    /// The scene's planar mirrors (`super::mirror`).
+    pub mirrors: Vec<Mirror>,
     pub geometry: SceneGeometry,
 }
 
@@ -111,6 +114,20 @@ impl SceneGpu {
             &GpuFrame::new(scene.ambient, &scene.lights, &[], &scene.settings),
         );
         let views = ViewBuffer::new(device);
+        let (mut mirrors, warnings) = find_mirrors(scene);
+        for warning in warnings {
+            log::warn!("{warning}");
+        }
+        // A transparent mirror would need its reflection in the transparency pass: it is drawn as
+        // glass alone.
+        mirrors.retain(|m| {
+            let object = &scene.objects[m.object];
+            let transparent = scene.materials[object.material.0].is_transparent();
+            if transparent {
+                log::warn!("`{}` is transparent: the rasterizer draws it without its reflection", object.name);
+            }
+            !transparent
+        });
         // Every texture gets its whole mip chain, averaged in linear space (TECHNIQUES.md §2).
         let textures: Vec<GpuTexture> = scene
             .textures
@@ -156,7 +173,8 @@ impl SceneGpu {
             active: 0,
             material_keys: scene.materials.iter().map(MaterialKey::of).collect(),
             transmittance: scene.materials.iter().map(super::uniforms::transmittance).collect(),
-            geometry: SceneGeometry::new(scene),
+            geometry: SceneGeometry::new(scene, &mirrors.iter().map(|m| m.object).collect::<Vec<_>>()),
+            mirrors,
         }
     }
 

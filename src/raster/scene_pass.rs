@@ -133,7 +133,7 @@ pub const HEIGHT_SINE: u32 = 2;
 pub const HEIGHT_NOISE: u32 = 3;
 
 /// The names of the pipeline constants, in the order [`constants`] gives their values.
-pub const CONSTANT_NAMES: [&str; 14] = [
+pub const CONSTANT_NAMES: [&str; 15] = [
     "SHADOW_METHOD",
     "SHADOW_FILTER",
     "SHADOW_TRANSMISSION",
@@ -148,10 +148,12 @@ pub const CONSTANT_NAMES: [&str; 14] = [
     "HEIGHT_KIND",
     "NORMAL_MAP",
     "ALPHA_MODE",
+    "MIRROR",
 ];
 
 /// The pipeline constants of one variant.
-pub fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f64); 14] {
+/// The pipeline constants of one variant; `mirror`: a planar mirror drawn with its reflection.
+pub fn constants(frame: &FrameKey, material: &MaterialKey, mirror: bool) -> [(&'static str, f64); 15] {
     let flag = |b: bool| f64::from(u8::from(b));
     let values = [
         f64::from(frame.shadow_method),
@@ -168,6 +170,7 @@ pub fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f6
         f64::from(material.height_kind),
         flag(material.normal_map),
         f64::from(material.alpha_mode),
+        flag(mirror),
     ];
     std::array::from_fn(|i| (CONSTANT_NAMES[i], values[i]))
 }
@@ -184,10 +187,26 @@ enum DepthMode {
 pub struct ScenePass {
     module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
+    /// Group 3 of the mirror variants: the reflection image.
+    pub mirror_group_layout: wgpu::BindGroupLayout,
+    mirror_layout: wgpu::PipelineLayout,
     prepass: wgpu::RenderPipeline,
     /// The prepass of cut-out materials (`ALPHA_MASK`): depth only where the surface is.
     prepass_masked: wgpu::RenderPipeline,
-    shading: HashMap<(DepthMode, FrameKey, MaterialKey), wgpu::RenderPipeline>,
+    shading: HashMap<ShadingKey, wgpu::RenderPipeline>,
+}
+
+/// What tells shading variants apart: the depth test, the frame's toggles, the material's inputs
+/// and whether it is a mirror drawn with its reflection.
+type ShadingKey = (DepthMode, FrameKey, MaterialKey, bool);
+
+/// The reflections a view's mirrors show: per mirror object, the group 3 holding the image its
+/// mirrored camera drew. `skip` is the mirror a mirrored view looks out of: it lies on the view's
+/// near plane and is not drawn.
+#[derive(Default)]
+pub struct MirrorImages {
+    pub images: HashMap<usize, wgpu::BindGroup>,
+    pub skip: Option<usize>,
 }
 
 /// What the pass draws into.
@@ -238,36 +257,62 @@ impl ScenePass {
                 targets: &[],
             }),
         );
-        ScenePass { module, layout, prepass, prepass_masked, shading: HashMap::new() }
+        let mirror_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene::mirror_group_layout"),
+            entries: &[layout::texture(
+                2,
+                wgpu::TextureSampleType::Float { filterable: false },
+                wgpu::TextureViewDimension::D2,
+            )],
+        });
+        let mirror_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("scene::mirror_layout"),
+            bind_group_layouts: &[
+                Some(&layouts.frame),
+                Some(&layouts.material),
+                Some(&layouts.lighting),
+                Some(&mirror_group_layout),
+            ],
+            immediate_size: 0,
+        });
+        ScenePass {
+            module,
+            layout,
+            mirror_group_layout,
+            mirror_layout,
+            prepass,
+            prepass_masked,
+            shading: HashMap::new(),
+        }
     }
 
-    /// Compiles the shading variants this frame needs that were not compiled before.
-    pub fn prepare(&mut self, device: &wgpu::Device, frame: FrameKey, materials: &[MaterialKey], after_prepass: bool) {
+    /// Compiles the shading variants this frame needs that were not compiled before: every
+    /// batch's material, and its mirror variant for mirror batches when `mirrors` are drawn.
+    pub fn prepare(&mut self, device: &wgpu::Device, frame: FrameKey, scene: &SceneGpu, after_prepass: bool, mirrors: bool) {
         let depth = if after_prepass { DepthMode::Equal } else { DepthMode::Write };
-        for material in materials {
-            let key = (depth, frame, *material);
-            if !self.shading.contains_key(&key) {
-                let pipeline = self.shading_pipeline(device, depth, &frame, material);
-                self.shading.insert(key, pipeline);
+        for batch in &scene.geometry.batches {
+            let material = scene.material_keys[batch.material];
+            let variants: &[bool] = if mirrors && batch.mirror.is_some() { &[false, true] } else { &[false] };
+            for &mirror in variants {
+                let key = (depth, frame, material, mirror);
+                if !self.shading.contains_key(&key) {
+                    let pipeline = self.shading_pipeline(device, key);
+                    self.shading.insert(key, pipeline);
+                }
             }
         }
     }
 
-    fn shading_pipeline(
-        &self,
-        device: &wgpu::Device,
-        depth: DepthMode,
-        frame: &FrameKey,
-        material: &MaterialKey,
-    ) -> wgpu::RenderPipeline {
-        let constants = constants(frame, material);
+    fn shading_pipeline(&self, device: &wgpu::Device, key: ShadingKey) -> wgpu::RenderPipeline {
+        let (depth, frame, material, mirror) = key;
+        let constants = constants(&frame, &material, mirror);
         let depth_state = match depth {
             DepthMode::Write => layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less, true),
             DepthMode::Equal => layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Equal, false),
         };
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("scene::shading_pipeline"),
-            layout: Some(&self.layout),
+            layout: Some(if mirror { &self.mirror_layout } else { &self.layout }),
             vertex: vertex_state(&self.module),
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
             depth_stencil: depth_state,
@@ -344,6 +389,7 @@ impl ScenePass {
         targets: &SceneTargets,
         after_prepass: bool,
         opaque_only: bool,
+        mirrors: &MirrorImages,
     ) {
         let bg = targets.background.as_dvec3();
         let (depth_mode, depth_load) = if after_prepass {
@@ -368,10 +414,17 @@ impl ScenePass {
         // Batches come sorted by material: the pipeline changes only where the variant does.
         let mut current = None;
         for batch in scene.geometry.batches.iter().filter(|b| !(opaque_only && b.transparent)) {
-            let key = scene.material_keys[batch.material];
+            if batch.mirror.is_some() && batch.mirror == mirrors.skip {
+                continue;
+            }
+            let image = batch.mirror.and_then(|object| mirrors.images.get(&object));
+            let key = (depth_mode, frame, scene.material_keys[batch.material], image.is_some());
             if current != Some(key) {
-                pass.set_pipeline(&self.shading[&(depth_mode, frame, key)]);
+                pass.set_pipeline(&self.shading[&key]);
                 current = Some(key);
+            }
+            if let Some(image) = image {
+                pass.set_bind_group(3, image, &[]);
             }
             pass.set_bind_group(1, &scene.materials()[batch.material], &[]);
             scene.geometry.draw(&mut pass, batch);

@@ -113,8 +113,11 @@ pub struct TransparencyPass {
     peel_layout: wgpu::PipelineLayout,
     pipelines: HashMap<PipelineKey, wgpu::RenderPipeline>,
     peel_pipelines: HashMap<MaterialKey, wgpu::RenderPipeline>,
-    peel: Option<PeelTargets>,
+    /// Peel depths for each set of frame targets drawn into (the main view's, mirrored views').
+    peel: Vec<PeelTargets>,
     triangles: Option<TriangleList>,
+    /// The view being drawn is mirrored: its triangles' winding is flipped.
+    mirrored: bool,
 }
 
 impl TransparencyPass {
@@ -139,8 +142,9 @@ impl TransparencyPass {
             peel_layout,
             pipelines: HashMap::new(),
             peel_pipelines: HashMap::new(),
-            peel: None,
+            peel: Vec::new(),
             triangles: None,
+            mirrored: false,
         }
     }
 
@@ -166,6 +170,7 @@ impl TransparencyPass {
             return report;
         }
         let forward = -view.view_axis;
+        self.mirrored = view.mirrored;
         let draws: Vec<Draw> = match settings.sort {
             TransparencySort::Unsorted => {
                 (0..scene_gpu.geometry.transparent.len()).map(|object| Draw::Object { object, faces: Faces::Both }).collect()
@@ -234,7 +239,7 @@ impl TransparencyPass {
         let (material, faces) = match *draw {
             Draw::Object { object, faces } => {
                 let object = &scene_gpu.geometry.transparent[object];
-                (object.material, if object.flipped { faces.swapped() } else { faces })
+                (object.material, if object.flipped != self.mirrored { faces.swapped() } else { faces })
             }
             Draw::Triangles { material, .. } => (material, Faces::Both),
         };
@@ -293,10 +298,18 @@ impl TransparencyPass {
                 self.peel_pipelines.insert(key, pipeline);
             }
         }
-        if self.peel.as_ref().is_none_or(|p| p.for_targets != targets.generation) {
-            self.peel = Some(PeelTargets::new(device, &self.peel_group_layout, targets));
-        }
-        let peel = self.peel.as_ref().expect("made just above");
+        let index = match self.peel.iter().position(|p| p.for_targets == targets.generation) {
+            Some(index) => index,
+            None => {
+                // Targets are remade on resize: forget the peels of targets that are gone.
+                if self.peel.len() > 2 * super::view::MAX_MIRROR_VIEWS as usize {
+                    self.peel.clear();
+                }
+                self.peel.push(PeelTargets::new(device, &self.peel_group_layout, targets));
+                self.peel.len() - 1
+            }
+        };
+        let peel = &self.peel[index];
         let view_offset = [scene_gpu.views.offset(slot)];
         let mut recorded = 0;
         for layer in 0..layers as usize {
@@ -379,7 +392,7 @@ fn blend_state(blend: Blend) -> wgpu::BlendState {
 
 fn shading_pipeline(device: &wgpu::Device, scene_pass: &ScenePass, key: PipelineKey) -> wgpu::RenderPipeline {
     let (blend, faces, depth, frame, material) = key;
-    let constants = constants(&frame, &material);
+    let constants = constants(&frame, &material, false);
     let cull_mode = match faces {
         Faces::Both => None,
         Faces::Back => Some(wgpu::Face::Front),
@@ -419,7 +432,7 @@ fn peel_pipeline(
     frame: FrameKey,
     material: MaterialKey,
 ) -> wgpu::RenderPipeline {
-    let constants = constants(&frame, &material);
+    let constants = constants(&frame, &material, false);
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("transparency::peel_pipeline"),
         layout: Some(peel_layout),

@@ -134,6 +134,9 @@ pub struct GpuMaterial {
     pub alpha_cutoff: f32,
     /// `ALPHA_*` of `shaders/common/types.wgsl`.
     pub alpha_mode: u32,
+    /// `kps·MPS`: what a mirror reflects.
+    pub reflectance: [f32; 3],
+    pub _pad: f32,
 }
 
 /// `ALPHA_*` codes: how a material's coverage is read.
@@ -192,6 +195,8 @@ impl Material {
                 _ => 0.0,
             },
             alpha_mode: alpha_mode_code(self.alpha_mode),
+            reflectance: (self.mirror * self.mirror_color).to_array(),
+            _pad: 0.0,
         }
     }
 }

@@ -71,6 +71,8 @@ pub enum ViewSlot {
     Main,
     /// Layer `n` of the shadow maps.
     ShadowLayer(u32),
+    /// The `n`th mirrored camera of the frame (`super::mirror`).
+    Mirror(u32),
 }
 
 impl ViewSlot {
@@ -78,12 +80,28 @@ impl ViewSlot {
         match self {
             ViewSlot::Main => 0,
             ViewSlot::ShadowLayer(layer) => 1 + u64::from(layer),
+            ViewSlot::Mirror(n) => 1 + super::shadow::views::MAX_LAYERS as u64 + u64::from(n),
         }
     }
 }
 
 /// Slots for every view a frame can hold.
-pub const VIEW_SLOTS: u64 = 1 + super::shadow::views::MAX_LAYERS as u64;
+pub const VIEW_SLOTS: u64 = 1 + super::shadow::views::MAX_LAYERS as u64 + MAX_MIRROR_VIEWS as u64;
+
+/// The most mirrored cameras one frame draws (mirrors that see each other, at every depth).
+pub const MAX_MIRROR_VIEWS: u32 = 32;
+
+/// The eight world-space corners of the volume a `clip_from_world` matrix sees (`x, y` = ±1,
+/// `z` = 0 or 1), corner `k` with bit 0 for `x`, bit 1 for `y`, bit 2 for `z`.
+pub fn frustum_corners(clip_from_world: Mat4) -> [Vec3; 8] {
+    let world_from_clip = clip_from_world.inverse();
+    std::array::from_fn(|k| {
+        let x = if k & 1 == 0 { -1.0 } else { 1.0 };
+        let y = if k & 2 == 0 { -1.0 } else { 1.0 };
+        let z = if k & 4 == 0 { 0.0 } else { 1.0 };
+        world_from_clip.project_point3(Vec3::new(x, y, z))
+    })
+}
 
 /// One uniform buffer holding every view of the frame, a slot each.
 pub struct ViewBuffer {

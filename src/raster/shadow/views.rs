@@ -54,15 +54,7 @@ impl ShadowLayout {
     /// The world-space corners of layer `layer`'s view volume (near face first), for drawing
     /// frusta in teaching views.
     pub fn corners(&self, layer: usize) -> [Vec3; 8] {
-        let world_from_clip = self.views[layer].clip_from_world.inverse();
-        let mut corners = [Vec3::ZERO; 8];
-        for (k, corner) in corners.iter_mut().enumerate() {
-            let x = if k & 1 == 0 { -1.0 } else { 1.0 };
-            let y = if k & 2 == 0 { -1.0 } else { 1.0 };
-            let z = if k & 4 == 0 { 0.0 } else { 1.0 };
-            *corner = world_from_clip.project_point3(Vec3::new(x, y, z));
-        }
-        corners
+        crate::raster::view::frustum_corners(self.views[layer].clip_from_world)
     }
 }
 
