@@ -16,6 +16,7 @@
 //! (more views, drawn by the same scene pass) before `opaque`; the sky after it.
 
 pub mod geometry;
+pub mod mirror;
 pub mod overlays;
 pub mod present;
 pub mod scene_gpu;
