@@ -24,9 +24,6 @@ override HEIGHT_KIND: u32 = 0u;
 override NORMAL_MAP: bool = false;
 // ALPHA_* of shaders/common/types.wgsl: whether coverage cuts the surface out or blends it.
 override ALPHA_MODE: u32 = 0u;
-// A planar mirror drawn with its reflection (src/raster/mirror): group 3 holds the image the
-// mirrored camera drew.
-override MIRROR: bool = false;
 
 const SHADOWS_OFF: u32 = 0u;
 const SHADOWS_MAP: u32 = 1u;
@@ -294,9 +291,18 @@ fn fs_scene(in: VertexOut) -> @location(0) vec4f {
     if masked_out(in.uv) {
         discard;
     }
+    return vec4f(shade(in), 1.0);
+}
+
+// A planar mirror drawn with its reflection (src/raster/mirror): its model plus the mirror term
+// kps·MPS·L(r), as the tracer adds its reflected ray, L(r) read from the mirrored camera's image.
+@fragment
+fn fs_mirror(in: VertexOut) -> @location(0) vec4f {
+    if masked_out(in.uv) {
+        discard;
+    }
     var radiance = shade(in);
-    // The mirror term kps·MPS·L(r), as the tracer adds its reflected ray.
-    if MIRROR && !FLAT_COLOUR && BUMP_VIEW == 0u {
+    if !FLAT_COLOUR && BUMP_VIEW == 0u {
         radiance += material.reflectance * textureLoad(mirror_image, vec2i(in.clip.xy), 0).rgb;
     }
     return vec4f(radiance, 1.0);

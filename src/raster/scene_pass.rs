@@ -133,7 +133,7 @@ pub const HEIGHT_SINE: u32 = 2;
 pub const HEIGHT_NOISE: u32 = 3;
 
 /// The names of the pipeline constants, in the order [`constants`] gives their values.
-pub const CONSTANT_NAMES: [&str; 15] = [
+pub const CONSTANT_NAMES: [&str; 14] = [
     "SHADOW_METHOD",
     "SHADOW_FILTER",
     "SHADOW_TRANSMISSION",
@@ -148,12 +148,11 @@ pub const CONSTANT_NAMES: [&str; 15] = [
     "HEIGHT_KIND",
     "NORMAL_MAP",
     "ALPHA_MODE",
-    "MIRROR",
 ];
 
 /// The pipeline constants of one variant.
-/// The pipeline constants of one variant; `mirror`: a planar mirror drawn with its reflection.
-pub fn constants(frame: &FrameKey, material: &MaterialKey, mirror: bool) -> [(&'static str, f64); 15] {
+/// The pipeline constants of one variant.
+pub fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f64); 14] {
     let flag = |b: bool| f64::from(u8::from(b));
     let values = [
         f64::from(frame.shadow_method),
@@ -170,7 +169,6 @@ pub fn constants(frame: &FrameKey, material: &MaterialKey, mirror: bool) -> [(&'
         f64::from(material.height_kind),
         flag(material.normal_map),
         f64::from(material.alpha_mode),
-        flag(mirror),
     ];
     std::array::from_fn(|i| (CONSTANT_NAMES[i], values[i]))
 }
@@ -305,7 +303,7 @@ impl ScenePass {
 
     fn shading_pipeline(&self, device: &wgpu::Device, key: ShadingKey) -> wgpu::RenderPipeline {
         let (depth, frame, material, mirror) = key;
-        let constants = constants(&frame, &material, mirror);
+        let constants = constants(&frame, &material);
         let depth_state = match depth {
             DepthMode::Write => layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less, true),
             DepthMode::Equal => layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Equal, false),
@@ -319,7 +317,8 @@ impl ScenePass {
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &self.module,
-                entry_point: Some("fs_scene"),
+                // A mirror drawn with its reflection reads group 3 (`fs_mirror`).
+                entry_point: Some(if mirror { "fs_mirror" } else { "fs_scene" }),
                 compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
                 targets: &[Some(HDR_FORMAT.into())],
             }),

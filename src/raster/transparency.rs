@@ -392,7 +392,7 @@ fn blend_state(blend: Blend) -> wgpu::BlendState {
 
 fn shading_pipeline(device: &wgpu::Device, scene_pass: &ScenePass, key: PipelineKey) -> wgpu::RenderPipeline {
     let (blend, faces, depth, frame, material) = key;
-    let constants = constants(&frame, &material, false);
+    let constants = constants(&frame, &material);
     let cull_mode = match faces {
         Faces::Both => None,
         Faces::Back => Some(wgpu::Face::Front),
@@ -432,7 +432,7 @@ fn peel_pipeline(
     frame: FrameKey,
     material: MaterialKey,
 ) -> wgpu::RenderPipeline {
-    let constants = constants(&frame, &material, false);
+    let constants = constants(&frame, &material);
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("transparency::peel_pipeline"),
         layout: Some(peel_layout),

@@ -41,6 +41,8 @@ use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 use super::geometry::{build_mesh, instance_of};
 use super::view::View;
+
+pub mod pass;
 use crate::scene::{Scene, Shape};
 
 /// A surface is flat when every vertex of its triangles lies within `FLATNESS ×` the diagonal of

@@ -1,0 +1,97 @@
+//! The planar-mirror pass (TECHNIQUES.md §6): before the main view is shaded, every mirror it
+//! sees is drawn from its mirrored camera into an image of the frame's size; the mirror's own
+//! fragments then add `kps·MPS` times that image at their pixel (`MIRROR` in
+//! `shaders/scene.wgsl`), as the tracer adds `kps·MPS·L(r)`.
+//!
+//! - **Recursion.** A mirrored view sees the other mirrors too, each of which needs its own view
+//!   of that view: the views form a tree, planned breadth first ([`plan`]) up to
+//!   `mirrors.depth` levels and [`MAX_MIRROR_VIEWS`] views, and drawn deepest first so that each
+//!   view's mirrors find their images ready. At the deepest level mirrors show their plain
+//!   material, as the tracer's mirror rays stop at `max_depth`: two facing mirrors give the same
+//!   corridor of images in both renderers.
+//! - **Two-sided.** Mirador's planes are two-sided in both renderers, so a camera behind a mirror
+//!   sees a mirror too: the view mirrors about the plane turned towards it. A mirror whose plane
+//!   passes through the camera is seen edge on and gets no view.
+//! - **What a mirrored view draws.** The whole frame's passes but the depth prepass and the
+//!   teaching overlays: opaque surfaces (the mirror it looks out of left out, as it lies on the
+//!   view's near plane), their mirrors with their images, and the transparent surfaces in the
+//!   chosen order (its winding flipped). Shadow maps are the frame's; object-precision shadows
+//!   are a mask of the main view's pixels, so mirrored views draw without them.
+
+use std::collections::HashMap;
+
+use super::{Mirror, Side, camera_side, mirrored_view};
+use crate::raster::view::{MAX_MIRROR_VIEWS, View, frustum_corners};
+
+/// One mirrored camera of the frame.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MirrorNode {
+    pub view: View,
+    /// The mirror this camera looks out of (an index into the scene's mirrors).
+    pub mirror: usize,
+    /// The node whose view sees that mirror; `None` for the main view.
+    pub parent: Option<usize>,
+    /// 1 for a mirror the main camera sees, 2 for a mirror seen in it, …
+    pub level: u32,
+}
+
+/// The mirrored cameras of a frame seen from `main`, breadth first (every parent before its
+/// children), at most `depth` levels deep and [`MAX_MIRROR_VIEWS`] views. The second value says
+/// whether views were left out for that limit.
+pub fn plan(main: &View, mirrors: &[Mirror], depth: u32) -> (Vec<MirrorNode>, bool) {
+    let mut nodes: Vec<MirrorNode> = Vec::new();
+    let mut truncated = false;
+    // (the view looking, its node, the mirror it looks out of, its level)
+    let mut queue = std::collections::VecDeque::from([(*main, None, None, 0)]);
+    while let Some((view, node, from, level)) = queue.pop_front() {
+        if level >= depth {
+            continue;
+        }
+        for (index, mirror) in mirrors.iter().enumerate() {
+            if Some(index) == from || !in_view(&view, mirror) {
+                continue;
+            }
+            let plane = match camera_side(&view, &mirror.plane) {
+                Side::Front => mirror.plane,
+                Side::Back => mirror.plane.flipped(),
+                Side::EdgeOn => continue,
+            };
+            if nodes.len() as u32 == MAX_MIRROR_VIEWS {
+                truncated = true;
+                break;
+            }
+            let child = MirrorNode { view: mirrored_view(&view, &plane), mirror: index, parent: node, level: level + 1 };
+            queue.push_back((child.view, Some(nodes.len()), Some(index), level + 1));
+            nodes.push(child);
+        }
+    }
+    (nodes, truncated)
+}
+
+/// Whether any of `mirror` may be inside `view`'s volume: false only when all four corners lie
+/// beyond one of its six clip planes.
+fn in_view(view: &View, mirror: &Mirror) -> bool {
+    let clip: Vec<glam::Vec4> = mirror.corners.iter().map(|c| view.clip_from_world * c.extend(1.0)).collect();
+    let outside = |test: fn(glam::Vec4) -> bool| clip.iter().all(|&c| test(c));
+    !(outside(|c| c.x < -c.w)
+        || outside(|c| c.x > c.w)
+        || outside(|c| c.y < -c.w)
+        || outside(|c| c.y > c.w)
+        || outside(|c| c.z < 0.0)
+        || outside(|c| c.z > c.w))
+}
+
+/// The children of each node (`None`: the main view), as (mirror object… ) pairs: which node's
+/// image each mirror of a view shows.
+pub fn children(nodes: &[MirrorNode]) -> HashMap<Option<usize>, Vec<(usize, usize)>> {
+    let mut map: HashMap<Option<usize>, Vec<(usize, usize)>> = HashMap::new();
+    for (index, node) in nodes.iter().enumerate() {
+        map.entry(node.parent).or_default().push((node.mirror, index));
+    }
+    map
+}
+
+/// The corners of every mirrored camera's view volume, for the `camera` teaching view.
+pub fn volumes(nodes: &[MirrorNode]) -> Vec<[glam::Vec3; 8]> {
+    nodes.iter().map(|node| frustum_corners(node.view.clip_from_world)).collect()
+}
