@@ -42,6 +42,13 @@ fn transparency_stage_per_object_and_exact() {
     }
 }
 
+/// Two facing mirrors: the corridor of reflections at the default depth.
+#[test]
+fn facing_mirrors() {
+    let scene = common::load("scenes/mirrors.toml");
+    common::assert_golden("mirrors", &common::raster(&scene, &scene.settings), TOLERANCE);
+}
+
 #[test]
 fn shadow_stage_with_shadow_maps() {
     let scene = common::load("scenes/shadows.toml");
