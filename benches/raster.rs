@@ -10,7 +10,9 @@
 //!    transparent triangles): each drawing order as a ratio to the frame that draws the same
 //!    surfaces opaque; the CPU sort per frame while the camera moves; the cost of each peeled
 //!    layer.
-//! 4. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
+//! 4. Planar mirrors (`assets/scenes/mirrors.toml`): one mirror, two facing mirrors at depths 1
+//!    to 4, each as a ratio to the frame with mirrors off, and the cost of each mirrored view.
+//! 5. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
 //!    about a million triangles: upload, frame, triangles, beside `trace` of the same scene.
 //!
 //! Times are wall-clock from submit to the queue being idle (the median of several frames after
@@ -327,12 +329,46 @@ fn transparency_costs(gpu: &Gpu) {
     );
 }
 
+fn mirror_costs(gpu: &Gpu) {
+    let mut scene = Scene::load(&mirador::scene::builtin_path("mirrors.toml")).expect("the mirrors scene");
+    scene.camera.width = 1280;
+    scene.camera.height = 720;
+    let mut off = scene.settings.clone();
+    off.mirrors.enabled = false;
+    let mut bench = Bench::new(gpu, &scene);
+    let plain = bench.median_frame(&scene, &off);
+    println!("\nplanar mirrors, 1280×720, ratios to the frame with mirrors off");
+    println!("{:>44} {:>9.1} ms {:>7.2}×", "mirrors off", ms(plain), 1.0);
+    let mut one = scene.clone();
+    let right = one.objects.iter().position(|o| o.name == "right mirror").expect("the right mirror");
+    let matte = one.materials.iter().position(|m| m.name == "frame").expect("the frame material");
+    one.objects[right].material = mirador::scene::MaterialId(matte);
+    let mut cases = vec![("one mirror".to_string(), one, scene.settings.mirrors.depth)];
+    for depth in 1..=4 {
+        cases.push((format!("two facing mirrors, depth {depth}"), scene.clone(), depth));
+    }
+    for (name, scene, depth) in cases {
+        let mut settings = scene.settings.clone();
+        settings.mirrors.depth = depth;
+        let mut bench = Bench::new(gpu, &scene);
+        let t = bench.median_frame(&scene, &settings);
+        let views = bench.frame(&scene, &settings).1.mirror_views;
+        let per_view = (t.as_secs_f64() - plain.as_secs_f64()) / f64::from(views.max(1));
+        println!(
+            "{name:>44} {:>9.1} ms {:>7.2}×   {views} views, {:.2}× a plain frame each",
+            ms(t),
+            t.as_secs_f64() / plain.as_secs_f64(),
+            per_view / plain.as_secs_f64()
+        );
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let quick = args.iter().any(|a| a == "--quick");
     // Section names on the command line run those sections alone:
     // `cargo bench --bench raster -- transparency`.
-    const SECTIONS: [&str; 4] = ["showcase", "shadows", "transparency", "growing"];
+    const SECTIONS: [&str; 5] = ["showcase", "shadows", "transparency", "mirrors", "growing"];
     let chosen: Vec<&str> = SECTIONS.into_iter().filter(|s| args.iter().any(|a| a == s)).collect();
     let run = |section: &str| chosen.is_empty() || chosen.contains(&section);
     let gpu = Gpu::headless().expect("the benchmark needs a graphics adapter");
@@ -345,6 +381,9 @@ fn main() {
     }
     if run("transparency") {
         transparency_costs(&gpu);
+    }
+    if run("mirrors") {
+        mirror_costs(&gpu);
     }
     if run("growing") {
         growing_scenes(&gpu, quick);

@@ -328,7 +328,11 @@ fn print_frame_stats(
             "transparency: {} draws{}{}",
             t.draws,
             if t.layers > 0 { format!(", {} peeled layers", t.layers) } else { String::new() },
-            if t.sorted { format!(", triangles sorted in {:.3} ms", t.sort_time.as_secs_f64() * 1e3) } else { String::new() },
+            if t.sorted {
+                format!(", triangles sorted in {:.3} ms", t.sort_time.as_secs_f64() * 1e3)
+            } else {
+                String::new()
+            },
         );
     }
     println!("passes (each submitted and waited for on its own, shadow maps redrawn):");

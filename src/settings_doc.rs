@@ -16,8 +16,8 @@ use clap::ValueEnum;
 use serde::Serialize;
 
 use crate::settings::{
-    AccelKind, AntiAliasing, BumpView, Prepass, ShadowFilter, ShadowFit, ShadowMethod, ShadowView, TangentSource,
-    MirrorView, TextureFilter, TracerLod, TransparencySort,
+    AccelKind, AntiAliasing, BumpView, MirrorView, Prepass, ShadowFilter, ShadowFit, ShadowMethod, ShadowView,
+    TangentSource, TextureFilter, TracerLod, TransparencySort,
 };
 
 /// One value an enum setting can take.

@@ -35,7 +35,9 @@ fn showcase() {
 fn transparency_stage_per_object_and_exact() {
     use mirador::settings::TransparencySort;
     let scene = common::load("scenes/transparency.toml");
-    for (name, sort) in [("transparency-object", TransparencySort::Object), ("transparency-exact", TransparencySort::Exact)] {
+    for (name, sort) in
+        [("transparency-object", TransparencySort::Object), ("transparency-exact", TransparencySort::Exact)]
+    {
         let mut settings = scene.settings.clone();
         settings.transparency.sort = sort;
         common::assert_golden(name, &common::raster(&scene, &settings), TOLERANCE);

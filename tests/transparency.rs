@@ -301,7 +301,10 @@ fn alpha_blending_is_the_seeds_formula_with_im_scaled_by_alpha() {
     let through = 0.6 * Vec3::new(1.0, 0.5, 0.25);
     let cases = [
         ("constant α", &constant, 0.25 * E + 0.75 * BACKGROUND),
-        ("texture α", &textured, { let a = 0.8 * 128.0 / 255.0; a * E + (1.0 - a) * BACKGROUND }),
+        ("texture α", &textured, {
+            let a = 0.8 * 128.0 / 255.0;
+            a * E + (1.0 - a) * BACKGROUND
+        }),
         ("α and kt", &both, 0.5 * E + (0.5 * through + Vec3::splat(0.5)) * BACKGROUND),
     ];
     for (what, scene, expected) in cases {
@@ -333,15 +336,15 @@ fn a_mask_cuts_the_surface_out_with_or_without_a_depth_prepass() {
 #[test]
 fn a_masked_caster_shadows_only_where_its_surface_is() {
     // A leaf held over a lit floor: half of it is cut out, so half of its shadow is missing.
-    let text = format!(
+    let text = String::from(
         "[camera]\neye = [0, 4, 4]\ncenter = [0, 0, 0]\nfovy = 45\nwidth = 160\nheight = 120\n\
          [world]\nambient = [0.05, 0.05, 0.05]\n\
          [materials.floor]\ncolor = [0.8, 0.8, 0.8]\n\
          [materials.leaf]\ncolor = [0.2, 0.7, 0.2]\ntexture = \"textures/alpha-left-opaque.png\"\n\
-         wrap = \"clamp\"\nalpha_mode = \"{{mode}}\"\n{{cutoff}}\n\
+         wrap = \"clamp\"\nalpha_mode = \"{mode}\"\n{cutoff}\n\
          [[lights]]\ntype = \"directional\"\ndirection = [0.3, -1, -0.2]\nintensity = 0.9\n\
          [[objects]]\ntype = \"plane\"\nsize = [8, 8]\nmaterial = \"floor\"\n\
-         [[objects]]\ntype = \"plane\"\nsize = [1.6, 1.6]\ntranslate = [0, 1.2, 0]\nmaterial = \"leaf\"\n"
+         [[objects]]\ntype = \"plane\"\nsize = [1.6, 1.6]\ntranslate = [0, 1.2, 0]\nmaterial = \"leaf\"\n",
     );
     let masked = text.replace("{mode}", "mask").replace("{cutoff}", "alpha_cutoff = 0.5");
     let opaque = text.replace("{mode}", "opaque").replace("{cutoff}", "");

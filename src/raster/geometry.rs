@@ -291,11 +291,21 @@ impl SceneGeometry {
             .map(|(index, ((object, info), &n))| {
                 let (key, world_from_mesh) = instance_of(object, n);
                 let mirror = info.mirror.then_some(index);
-                (info.transparent, info.material, mirror, key, GpuInstance::new(world_from_mesh), index, world_from_mesh)
+                (
+                    info.transparent,
+                    info.material,
+                    mirror,
+                    key,
+                    GpuInstance::new(world_from_mesh),
+                    index,
+                    world_from_mesh,
+                )
             })
             .collect();
         // Opaque first, then by material, mirror and mesh: runs of equal keys become one draw.
-        entries.sort_by(|a, b| (a.0, a.1, a.2).cmp(&(b.0, b.1, b.2)).then_with(|| mesh_order(&a.3).cmp(&mesh_order(&b.3))));
+        entries.sort_by(|a, b| {
+            (a.0, a.1, a.2).cmp(&(b.0, b.1, b.2)).then_with(|| mesh_order(&a.3).cmp(&mesh_order(&b.3)))
+        });
         for (_, _, _, key, ..) in &entries {
             if !self.meshes.contains_key(key) {
                 let mesh = build_mesh(scene, *key);
@@ -308,7 +318,10 @@ impl SceneGeometry {
             let index = index as u32;
             match self.batches.last_mut() {
                 Some(b)
-                    if b.transparent == *transparent && b.material == *material && b.mirror == *mirror && b.mesh == *key =>
+                    if b.transparent == *transparent
+                        && b.material == *material
+                        && b.mirror == *mirror
+                        && b.mesh == *key =>
                 {
                     b.instances.end = index + 1;
                 }

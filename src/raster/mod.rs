@@ -33,10 +33,10 @@ use crate::gpu::texture::GpuTexture;
 use crate::gpu::{Gpu, readback};
 use crate::scene::Scene;
 use crate::settings::{MirrorView, Prepass, RenderSettings, ShadowMethod};
+use mirror::pass::{children, plan, volumes};
 use overlays::Overlays;
 use present::{PresentInput, PresentPass};
 use scene_gpu::{SceneGpu, SceneLayouts};
-use mirror::pass::{children, plan, volumes};
 use scene_pass::{FrameKey, MirrorImages, SHADOWS_OFF, ScenePass, SceneTargets};
 use shadow::projected::{MASK_FORMAT, ProjectedPass};
 use shadow::views::{ShadowLayout, shadow_layout_in};
@@ -237,7 +237,8 @@ impl Renderer {
         let sorted_transparency = settings.transparency.enabled && scene_gpu.geometry.has_transparent();
         // Planar mirrors: the tree of mirrored cameras, each with its slot and targets.
         let mirrors = &settings.mirrors;
-        let (nodes, truncated) = if mirrors.enabled { plan(&main_view, &scene_gpu.mirrors, mirrors.depth) } else { (Vec::new(), false) };
+        let (nodes, truncated) =
+            if mirrors.enabled { plan(&main_view, &scene_gpu.mirrors, mirrors.depth) } else { (Vec::new(), false) };
         if truncated {
             log::debug!("more than {} mirrored views: the deepest are left out", view::MAX_MIRROR_VIEWS);
         }
@@ -270,7 +271,8 @@ impl Renderer {
         let images_of = children(&nodes);
         for (k, node) in nodes.iter().enumerate().rev() {
             let node_targets = &self.mirror_targets[k];
-            let mut images = mirror_images(device, &self.scene, scene_gpu, &self.mirror_targets, images_of.get(&Some(k)));
+            let mut images =
+                mirror_images(device, &self.scene, scene_gpu, &self.mirror_targets, images_of.get(&Some(k)));
             images.skip = Some(scene_gpu.mirrors[node.mirror].object);
             let slot = ViewSlot::Mirror(k as u32);
             let node_scene_targets = SceneTargets {

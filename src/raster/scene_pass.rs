@@ -286,7 +286,14 @@ impl ScenePass {
 
     /// Compiles the shading variants this frame needs that were not compiled before: every
     /// batch's material, and its mirror variant for mirror batches when `mirrors` are drawn.
-    pub fn prepare(&mut self, device: &wgpu::Device, frame: FrameKey, scene: &SceneGpu, after_prepass: bool, mirrors: bool) {
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        frame: FrameKey,
+        scene: &SceneGpu,
+        after_prepass: bool,
+        mirrors: bool,
+    ) {
         let depth = if after_prepass { DepthMode::Equal } else { DepthMode::Write };
         for batch in &scene.geometry.batches {
             let material = scene.material_keys[batch.material];

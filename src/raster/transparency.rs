@@ -172,9 +172,9 @@ impl TransparencyPass {
         let forward = -view.view_axis;
         self.mirrored = view.mirrored;
         let draws: Vec<Draw> = match settings.sort {
-            TransparencySort::Unsorted => {
-                (0..scene_gpu.geometry.transparent.len()).map(|object| Draw::Object { object, faces: Faces::Both }).collect()
-            }
+            TransparencySort::Unsorted => (0..scene_gpu.geometry.transparent.len())
+                .map(|object| Draw::Object { object, faces: Faces::Both })
+                .collect(),
             TransparencySort::Object => {
                 let objects = &scene_gpu.geometry.transparent;
                 let mut order: Vec<usize> = (0..objects.len()).collect();
@@ -185,7 +185,9 @@ impl TransparencyPass {
                 });
                 order
                     .into_iter()
-                    .flat_map(|object| [Draw::Object { object, faces: Faces::Back }, Draw::Object { object, faces: Faces::Front }])
+                    .flat_map(|object| {
+                        [Draw::Object { object, faces: Faces::Back }, Draw::Object { object, faces: Faces::Front }]
+                    })
                     .collect()
             }
             TransparencySort::Triangle => {
@@ -197,11 +199,24 @@ impl TransparencyPass {
                 let start = Instant::now();
                 report.sorted = list.sort(queue, view.eye, forward);
                 report.sort_time = start.elapsed();
-                list.runs.iter().map(|(material, indices)| Draw::Triangles { material: *material, indices: indices.clone() }).collect()
+                list.runs
+                    .iter()
+                    .map(|(material, indices)| Draw::Triangles { material: *material, indices: indices.clone() })
+                    .collect()
             }
             TransparencySort::Exact => {
                 report.layers = settings.peel_layers;
-                report.draws = self.record_peeled(device, encoder, scene_pass, scene_gpu, lighting, frame, slot, targets, settings.peel_layers);
+                report.draws = self.record_peeled(
+                    device,
+                    encoder,
+                    scene_pass,
+                    scene_gpu,
+                    lighting,
+                    frame,
+                    slot,
+                    targets,
+                    settings.peel_layers,
+                );
                 return report;
             }
         };
@@ -228,10 +243,7 @@ impl TransparencyPass {
     ) {
         for draw in draws {
             let key = self.key(scene_gpu, frame, draw, depth);
-            if !self.pipelines.contains_key(&key) {
-                let pipeline = shading_pipeline(device, scene_pass, key);
-                self.pipelines.insert(key, pipeline);
-            }
+            self.pipelines.entry(key).or_insert_with(|| shading_pipeline(device, scene_pass, key));
         }
     }
 
@@ -248,7 +260,14 @@ impl TransparencyPass {
         (blend, faces, depth, frame, key)
     }
 
-    fn record_draw(&self, pass: &mut wgpu::RenderPass<'_>, scene_gpu: &SceneGpu, frame: FrameKey, draw: &Draw, depth: Depth) {
+    fn record_draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        scene_gpu: &SceneGpu,
+        frame: FrameKey,
+        draw: &Draw,
+        depth: Depth,
+    ) {
         let key = self.key(scene_gpu, frame, draw, depth);
         pass.set_pipeline(&self.pipelines[&key]);
         let material = match *draw {
@@ -381,7 +400,11 @@ fn blend_state(blend: Blend) -> wgpu::BlendState {
         Blend::Coverage => wgpu::BlendFactor::OneMinusSrcAlpha,
     };
     wgpu::BlendState {
-        color: wgpu::BlendComponent { src_factor: wgpu::BlendFactor::One, dst_factor, operation: wgpu::BlendOperation::Add },
+        color: wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor,
+            operation: wgpu::BlendOperation::Add,
+        },
         alpha: wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::Zero,
             dst_factor: wgpu::BlendFactor::One,
@@ -463,13 +486,17 @@ struct PeelTargets {
 
 impl PeelTargets {
     fn new(device: &wgpu::Device, group_layout: &wgpu::BindGroupLayout, targets: &FrameTargets) -> PeelTargets {
-        let depth = [0, 1].map(|i| GpuTexture::target(device, &format!("transparency::peel_depth {i}"), targets.size, DEPTH_FORMAT));
+        let depth = [0, 1]
+            .map(|i| GpuTexture::target(device, &format!("transparency::peel_depth {i}"), targets.size, DEPTH_FORMAT));
         let group = |previous: &wgpu::TextureView| {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("transparency::peel_group"),
                 layout: group_layout,
                 entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&targets.depth.view) },
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&targets.depth.view),
+                    },
                     wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(previous) },
                 ],
             })
@@ -509,8 +536,7 @@ impl TriangleList {
             let tangents = tangents_or_generate(&mesh, existing);
             let normal_from_mesh = Mat3::from_mat4(object.world_from_mesh).inverse().transpose();
             let base = vertices.len() as u32;
-            for i in 0..mesh.positions.len() {
-                let t = tangents[i];
+            for (i, t) in tangents.iter().enumerate() {
                 vertices.push(Vertex {
                     position: object.world_from_mesh.transform_point3(mesh.positions[i]).to_array(),
                     normal: (normal_from_mesh * mesh.normals[i]).to_array(),
@@ -520,7 +546,8 @@ impl TriangleList {
             }
             for triangle in mesh.indices.chunks_exact(3) {
                 let corners = [triangle[0], triangle[1], triangle[2]].map(|i| i + base);
-                let centroid = corners.iter().map(|&i| Vec3::from_array(vertices[i as usize].position)).sum::<Vec3>() / 3.0;
+                let centroid =
+                    corners.iter().map(|&i| Vec3::from_array(vertices[i as usize].position)).sum::<Vec3>() / 3.0;
                 triangles.push(corners);
                 centroids.push(centroid);
                 materials.push(object.material);

@@ -60,7 +60,8 @@ pub fn plan(main: &View, mirrors: &[Mirror], depth: u32) -> (Vec<MirrorNode>, bo
                 truncated = true;
                 break;
             }
-            let child = MirrorNode { view: mirrored_view(&view, &plane), mirror: index, parent: node, level: level + 1 };
+            let child =
+                MirrorNode { view: mirrored_view(&view, &plane), mirror: index, parent: node, level: level + 1 };
             queue.push_back((child.view, Some(nodes.len()), Some(index), level + 1));
             nodes.push(child);
         }

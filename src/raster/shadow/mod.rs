@@ -412,4 +412,3 @@ fn vertex_state(module: &wgpu::ShaderModule) -> wgpu::VertexState<'_> {
         buffers: &VERTEX_BUFFERS,
     }
 }
-
