@@ -133,3 +133,32 @@ fn degenerate_mirrors_are_drawn_plain_and_never_panic() {
     assert!(settings.set("mirrors.depth=9").is_err());
     assert!(settings.set("mirrors.depth=8").is_ok());
 }
+
+#[test]
+fn each_face_of_a_mirror_box_is_a_planar_mirror() {
+    // A mirror cube between the two mirrors' stands, turned 30° so two faces face the camera.
+    let mut scene = scene();
+    let text = "[materials.chrome]\ncolor = [0.05, 0.05, 0.05]\nkd = 0.05\nmirror = 0.85\n\
+                [[objects]]\nname = \"mirror cube\"\ntype = \"box\"\nmin = [-0.4, 0, -0.4]\nmax = [0.4, 0.8, 0.4]\n\
+                rotate = [0, 30, 0]\ntranslate = [0.2, 0, 0.9]\nmaterial = \"chrome\"\n";
+    let source = std::fs::read_to_string(common::asset("scenes/mirrors.toml")).unwrap();
+    let with_cube =
+        mirador::scene::file::parse(&format!("{source}\n{text}"), &common::asset("scenes/mirrors.toml")).unwrap();
+    scene.objects = with_cube.objects;
+    scene.materials = with_cube.materials;
+    let gpu = common::gpu();
+    let mut headless = mirador::raster::Headless::new(gpu, &scene);
+    let mut settings = scene.settings.clone();
+    settings.mirrors.depth = 1;
+    settings.trace.max_depth = 1;
+    let raster = headless.render(gpu, &scene, &settings);
+    // The left mirror, and the cube's faces that face the camera (a top too, seen from above).
+    assert!(headless.report.mirror_views >= 3, "{} mirrored views", headless.report.mirror_views);
+    let traced = mirador::trace::render_image(&scene, &settings);
+    let error = flip(&traced, &raster);
+    assert!(error < 0.04, "the mirror cube vs traced: FLIP {error}");
+    let mut off = settings.clone();
+    off.mirrors.enabled = false;
+    let without = flip(&traced, &common::raster(&scene, &off));
+    assert!(without > error + 0.005, "mirrors off {without}, on {error}");
+}

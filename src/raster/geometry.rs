@@ -379,13 +379,30 @@ impl SceneGeometry {
 
     /// Records `instances` of `mesh` (the pipeline and material group are the caller's).
     pub fn draw_instances(&self, pass: &mut wgpu::RenderPass<'_>, mesh: MeshKey, instances: Range<u32>) {
+        let count = self.meshes[&mesh].index_count;
+        self.draw_part(pass, mesh, 0..count, instances);
+    }
+
+    /// Records the triangles `indices` of `mesh` (a face of a box, say) for `instances`.
+    pub fn draw_part(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        mesh: MeshKey,
+        indices: Range<u32>,
+        instances: Range<u32>,
+    ) {
         let mesh = &self.meshes[&mesh];
         let buffer = self.instances.as_ref().expect("prepare() made the instance buffer for these instances");
         let stride = std::mem::size_of::<GpuInstance>() as u64;
         pass.set_vertex_buffer(0, mesh.vertices.slice(..));
         pass.set_vertex_buffer(1, buffer.slice(u64::from(instances.start) * stride..));
         pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..mesh.index_count, 0, 0..instances.len() as u32);
+        pass.draw_indexed(indices, 0, 0..instances.len() as u32);
+    }
+
+    /// The number of indices of `mesh`.
+    pub fn index_count(&self, mesh: MeshKey) -> u32 {
+        self.meshes[&mesh].index_count
     }
 
     /// Triangles drawn per view with the current draw list.

@@ -26,6 +26,7 @@ pub mod transparency;
 pub mod uniforms;
 pub mod view;
 
+use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
 use crate::gpu::mipmap::MipmapGenerator;
@@ -402,9 +403,13 @@ fn mirror_images(
                     resource: wgpu::BindingResource::TextureView(&mirror_targets[node].hdr.view),
                 }],
             });
-            (scene_gpu.mirrors[mirror].object, group)
+            (mirror, group)
         })
-        .collect();
+        .fold(HashMap::new(), |mut images: HashMap<usize, Vec<_>>, (mirror, group)| {
+            let mirror = &scene_gpu.mirrors[mirror];
+            images.entry(mirror.object).or_default().push((mirror.indices.clone(), group));
+            images
+        });
     MirrorImages { images, skip: None }
 }
 

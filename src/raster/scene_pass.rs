@@ -17,6 +17,7 @@
 //! No back-face culling: planes are two-sided, and the shader turns the normal to the viewer.
 
 use std::collections::HashMap;
+use std::ops::Range;
 
 use super::scene_gpu::{SceneGpu, SceneLayouts};
 use super::uniforms::{ALPHA_MASK, GpuInstance, Vertex, alpha_mode_code};
@@ -198,12 +199,13 @@ pub struct ScenePass {
 /// and whether it is a mirror drawn with its reflection.
 type ShadingKey = (DepthMode, FrameKey, MaterialKey, bool);
 
-/// The reflections a view's mirrors show: per mirror object, the group 3 holding the image its
-/// mirrored camera drew. `skip` is the mirror a mirrored view looks out of: it lies on the view's
-/// near plane and is not drawn.
+/// The reflections a view's mirrors show: per mirror object, and per part of it that is a mirror
+/// (a box's face; `None`: all of it), the group 3 holding the image its mirrored camera drew.
+/// `skip` is the object a mirrored view looks out of: it lies on the view's near plane (a box's
+/// other faces behind it) and is not drawn.
 #[derive(Default)]
 pub struct MirrorImages {
-    pub images: HashMap<usize, wgpu::BindGroup>,
+    pub images: HashMap<usize, Vec<(Option<Range<u32>>, wgpu::BindGroup)>>,
     pub skip: Option<usize>,
 }
 
@@ -423,17 +425,32 @@ impl ScenePass {
             if batch.mirror.is_some() && batch.mirror == mirrors.skip {
                 continue;
             }
-            let image = batch.mirror.and_then(|object| mirrors.images.get(&object));
-            let key = (depth_mode, frame, scene.material_keys[batch.material], image.is_some());
-            if current != Some(key) {
-                pass.set_pipeline(&self.shading[&key]);
-                current = Some(key);
-            }
-            if let Some(image) = image {
-                pass.set_bind_group(3, image, &[]);
-            }
             pass.set_bind_group(1, &scene.materials()[batch.material], &[]);
-            scene.geometry.draw(&mut pass, batch);
+            let material = scene.material_keys[batch.material];
+            let Some(object) = batch.mirror else {
+                let key = (depth_mode, frame, material, false);
+                if current != Some(key) {
+                    pass.set_pipeline(&self.shading[&key]);
+                    current = Some(key);
+                }
+                scene.geometry.draw(&mut pass, batch);
+                continue;
+            };
+            // A mirror: each of its parts with its image where its view was drawn, plain where not.
+            let images = mirrors.images.get(&object);
+            for part in scene.mirrors.iter().filter(|m| m.object == object).map(|m| m.indices.clone()) {
+                let image = images.and_then(|list| list.iter().find(|(p, _)| *p == part)).map(|(_, group)| group);
+                let key = (depth_mode, frame, material, image.is_some());
+                if current != Some(key) {
+                    pass.set_pipeline(&self.shading[&key]);
+                    current = Some(key);
+                }
+                if let Some(image) = image {
+                    pass.set_bind_group(3, image, &[]);
+                }
+                let count = scene.geometry.index_count(batch.mesh);
+                scene.geometry.draw_part(&mut pass, batch.mesh, part.unwrap_or(0..count), batch.instances.clone());
+            }
         }
         pass.pop_debug_group();
     }

@@ -118,6 +118,8 @@ pub struct TransparencyPass {
     triangles: Option<TriangleList>,
     /// The view being drawn is mirrored: its triangles' winding is flipped.
     mirrored: bool,
+    /// The view whose triangle order is being drawn.
+    sorted_slot: ViewSlot,
 }
 
 impl TransparencyPass {
@@ -145,6 +147,7 @@ impl TransparencyPass {
             peel: Vec::new(),
             triangles: None,
             mirrored: false,
+            sorted_slot: ViewSlot::Main,
         }
     }
 
@@ -197,9 +200,11 @@ impl TransparencyPass {
                 }
                 let list = self.triangles.as_mut().expect("made just above");
                 let start = Instant::now();
-                report.sorted = list.sort(queue, view.eye, forward);
+                report.sorted = list.sort(device, queue, slot, view.eye, forward);
                 report.sort_time = start.elapsed();
-                list.runs
+                self.sorted_slot = slot;
+                list.orders[&slot]
+                    .runs
                     .iter()
                     .map(|(material, indices)| Draw::Triangles { material: *material, indices: indices.clone() })
                     .collect()
@@ -286,7 +291,7 @@ impl TransparencyPass {
                 let list = self.triangles.as_ref().expect("sorted before drawing");
                 pass.set_vertex_buffer(0, list.vertices.slice(..));
                 pass.set_vertex_buffer(1, list.identity.slice(..));
-                pass.set_index_buffer(list.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.set_index_buffer(list.orders[&self.sorted_slot].indices.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(indices.clone(), 0, 0..1);
             }
         }
@@ -507,19 +512,27 @@ impl PeelTargets {
     }
 }
 
-/// Every transparent triangle in world space, for sorting one by one: the vertices once, the
-/// index buffer rewritten in sorted order whenever the view moves.
+/// Every transparent triangle in world space, for sorting one by one: the vertices once, and for
+/// each view an index buffer rewritten in sorted order whenever that view moves. (One buffer per
+/// view: buffer writes land before the frame's commands run, so views sharing one would all draw
+/// the last view's order.)
 struct TriangleList {
     geometry: u64,
     vertices: wgpu::Buffer,
-    indices: wgpu::Buffer,
     /// One identity instance: the vertices are already in world space.
     identity: wgpu::Buffer,
     triangles: Vec<[u32; 3]>,
     centroids: Vec<Vec3>,
     materials: Vec<usize>,
-    /// The (eye, forward) the current order was sorted for.
-    sorted_for: Option<(Vec3, Vec3)>,
+    /// Per view slot, its order.
+    orders: HashMap<ViewSlot, SortedOrder>,
+}
+
+/// The triangles in one view's order.
+struct SortedOrder {
+    indices: wgpu::Buffer,
+    /// The (eye, forward) the order was sorted for.
+    sorted_for: (Vec3, Vec3),
     /// Runs of one material in the sorted index buffer.
     runs: Vec<(usize, Range<u32>)>,
 }
@@ -559,11 +572,6 @@ impl TriangleList {
         TriangleList {
             geometry,
             vertices: buffer("transparency::vertices", bytemuck::cast_slice(&vertices), wgpu::BufferUsages::VERTEX),
-            indices: buffer(
-                "transparency::sorted_indices",
-                bytemuck::cast_slice(&triangles),
-                wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
-            ),
             identity: buffer(
                 "transparency::identity_instance",
                 bytemuck::bytes_of(&GpuInstance::new(Mat4::IDENTITY)),
@@ -572,30 +580,42 @@ impl TriangleList {
             triangles,
             centroids,
             materials,
-            sorted_for: None,
-            runs: Vec::new(),
+            orders: HashMap::new(),
         }
     }
 
-    /// Sorts the triangles farthest first along `forward` from `eye`, unless they already are for
-    /// this view. Returns whether it sorted.
-    fn sort(&mut self, queue: &wgpu::Queue, eye: Vec3, forward: Vec3) -> bool {
-        if self.sorted_for == Some((eye, forward)) {
+    /// Sorts the triangles farthest first along `forward` from `eye` for the view in `slot`,
+    /// unless they already are. Returns whether it sorted.
+    fn sort(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, slot: ViewSlot, eye: Vec3, forward: Vec3) -> bool {
+        if self.orders.get(&slot).is_some_and(|o| o.sorted_for == (eye, forward)) {
             return false;
         }
         let order = sorted_far_first(&self.centroids, eye, forward);
         let indices: Vec<[u32; 3]> = order.iter().map(|&t| self.triangles[t as usize]).collect();
-        queue.write_buffer(&self.indices, 0, bytemuck::cast_slice(&indices));
-        self.runs.clear();
+        let mut runs: Vec<(usize, Range<u32>)> = Vec::new();
         for (position, &t) in order.iter().enumerate() {
             let material = self.materials[t as usize];
             let index = position as u32 * 3;
-            match self.runs.last_mut() {
+            match runs.last_mut() {
                 Some((m, range)) if *m == material => range.end = index + 3,
-                _ => self.runs.push((material, index..index + 3)),
+                _ => runs.push((material, index..index + 3)),
             }
         }
-        self.sorted_for = Some((eye, forward));
+        match self.orders.get_mut(&slot) {
+            Some(existing) => {
+                queue.write_buffer(&existing.indices, 0, bytemuck::cast_slice(&indices));
+                existing.sorted_for = (eye, forward);
+                existing.runs = runs;
+            }
+            None => {
+                let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("transparency::sorted_indices"),
+                    contents: bytemuck::cast_slice(&indices),
+                    usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
+                });
+                self.orders.insert(slot, SortedOrder { indices, sorted_for: (eye, forward), runs });
+            }
+        }
         true
     }
 }

@@ -65,7 +65,7 @@ impl View {
 }
 
 /// Where each view of a frame lives in the view buffer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ViewSlot {
     /// The scene camera.
     Main,

@@ -29,8 +29,8 @@
 //!   that is flat to within [`FLATNESS`] of its size. One mirrored view serves one plane.
 //!
 //! Limits. Curved mirrors (spheres, tori, rounded boxes, curved meshes) have no single mirrored
-//! camera: environment maps (the rest of §6) are their technique. A box's six faces would each
-//! need their own mirrored view; that is left out, and a box with `kps > 0` only warns. A mirror
+//! camera: environment maps (the rest of §6) are their technique. A box is six planar mirrors,
+//! one per face, each with its own mirrored view ([`Mirror::indices`] names the face). A mirror
 //! seen in a mirror needs a view of a view; [`mirrored_view`] composes (the `mirrored` flag
 //! toggles), but a view has one clip plane, so the nested view keeps only the inner mirror's.
 //! The oblique near plane spends the depth range between the mirror and the far corner of the
@@ -195,6 +195,9 @@ pub struct Mirror {
     pub corners: [Vec3; 4],
     /// The area of its triangles, in world units squared.
     pub area: f32,
+    /// The part of the object's mesh that is this mirror, as a range of its indices: one face of
+    /// a box. `None`: the whole mesh.
+    pub indices: Option<std::ops::Range<u32>>,
 }
 
 /// The scene's planar mirrors, and a warning for every object with a mirror material (`kps > 0`)
@@ -209,9 +212,11 @@ pub struct Mirror {
 /// back-facing triangles cancel, to the side of the vertex normals. `plane` shapes always
 /// qualify, and so does a flat mesh.
 ///
+/// A box with `kps > 0` is six planar mirrors, one per face (its `indices`).
+///
 /// Warned about and skipped: curved shapes (spheres, tori, rounded boxes) and meshes that are not
-/// flat, for which environment maps are the technique; boxes, whose six faces would each need
-/// their own mirrored view (left out); and mirrors with no area ([`DEGENERATE_AREA`]).
+/// flat, for which environment maps are the technique; and mirrors with no area
+/// ([`DEGENERATE_AREA`]).
 pub fn find_mirrors(scene: &Scene) -> (Vec<Mirror>, Vec<String>) {
     let mut mirrors = Vec::new();
     let mut warnings = Vec::new();
@@ -228,17 +233,34 @@ pub fn find_mirrors(scene: &Scene) -> (Vec<Mirror>, Vec<String>) {
             Shape::Sphere { .. } | Shape::Torus { .. } | Shape::RoundedBox { .. } => warnings.push(format!(
                 "object `{name}`: a curved mirror (kps = {kps}) has no single mirrored camera; {curved}"
             )),
-            Shape::Cuboid { .. } => warnings.push(format!(
-                "object `{name}`: a box is not flat, and each of its faces would need its own mirrored \
-                 view, which is left out; it is drawn without its reflection (kps = {kps})"
-            )),
+            // Each face of a box is a planar mirror of its own (`Mesh::cuboid` draws face `f` with
+            // indices 6f..6f + 6).
+            Shape::Cuboid { .. } => {
+                for face in 0..6u32 {
+                    let indices = 6 * face..6 * face + 6;
+                    match planar(scene, index, Some(indices.clone())) {
+                        Ok(fit) => mirrors.push(Mirror {
+                            object: index,
+                            plane: fit.plane,
+                            corners: fit.corners,
+                            area: fit.area,
+                            indices: Some(indices),
+                        }),
+                        Err(_) => warnings.push(format!("object `{name}`: face {face} has no area; skipped")),
+                    }
+                }
+            }
             Shape::Mesh(mesh) if mesh >= scene.meshes.len() => {
                 warnings.push(format!("object `{name}`: mesh {mesh} does not exist; skipped"));
             }
-            Shape::Plane { .. } | Shape::Mesh(_) => match planar(scene, index) {
-                Ok(fit) => {
-                    mirrors.push(Mirror { object: index, plane: fit.plane, corners: fit.corners, area: fit.area })
-                }
+            Shape::Plane { .. } | Shape::Mesh(_) => match planar(scene, index, None) {
+                Ok(fit) => mirrors.push(Mirror {
+                    object: index,
+                    plane: fit.plane,
+                    corners: fit.corners,
+                    area: fit.area,
+                    indices: None,
+                }),
                 Err(NotPlanar::Degenerate) => {
                     warnings.push(format!("object `{name}`: a mirror with no area; skipped"));
                 }
@@ -271,8 +293,9 @@ enum NotPlanar {
     },
 }
 
-/// The plane of object `index` (a plane shape or a mesh), from its world-space triangles.
-fn planar(scene: &Scene, index: usize) -> Result<PlaneFit, NotPlanar> {
+/// The plane of object `index` (a plane shape, a mesh, or the triangles of `indices` of its
+/// mesh), from its world-space triangles.
+fn planar(scene: &Scene, index: usize, indices: Option<std::ops::Range<u32>>) -> Result<PlaneFit, NotPlanar> {
     let object = &scene.objects[index];
     let (key, world_from_mesh) = instance_of(object, scene.settings.sphere_segments);
     let mesh = build_mesh(scene, key);
@@ -280,13 +303,16 @@ fn planar(scene: &Scene, index: usize) -> Result<PlaneFit, NotPlanar> {
     // names the front.
     let turned = world_from_mesh.determinant() < 0.0;
     let world = |i: u32| world_from_mesh.transform_point3(mesh.positions[i as usize]);
-    let triangles: Vec<[Vec3; 3]> = mesh
-        .indices
+    let part = match indices {
+        Some(range) => &mesh.indices[range.start as usize..range.end as usize],
+        None => &mesh.indices[..],
+    };
+    let triangles: Vec<[Vec3; 3]> = part
         .chunks_exact(3)
         .map(|t| if turned { [world(t[0]), world(t[2]), world(t[1])] } else { [world(t[0]), world(t[1]), world(t[2])] })
         .collect();
     let normal_from_mesh = Mat3::from_mat4(world_from_mesh).inverse().transpose();
-    let normals: Vec3 = mesh.normals.iter().map(|&n| normal_from_mesh * n).sum();
+    let normals: Vec3 = part.iter().map(|&i| normal_from_mesh * mesh.normals[i as usize]).sum();
     fit_plane(&triangles, normals)
 }
 
@@ -606,7 +632,7 @@ mod tests {
     }
 
     #[test]
-    fn a_rotated_plane_is_a_mirror_and_curved_shapes_and_boxes_warn() {
+    fn a_rotated_plane_and_a_boxs_faces_are_mirrors_and_curved_shapes_warn() {
         let scene = scene(
             r#"
             [[objects]]
@@ -637,7 +663,24 @@ mod tests {
             "#,
         );
         let (mirrors, warnings) = find_mirrors(&scene);
-        assert_eq!(mirrors.len(), 1, "{mirrors:?}");
+        assert_eq!(mirrors.len(), 7, "the plane and the box's six faces: {mirrors:?}");
+        // The box [0, 1]³: each face is a unit square facing out, named by its indices.
+        for (face, (normal, d)) in [
+            (Vec3::X, -1.0),
+            (Vec3::NEG_X, 0.0),
+            (Vec3::Y, -1.0),
+            (Vec3::NEG_Y, 0.0),
+            (Vec3::Z, -1.0),
+            (Vec3::NEG_Z, 0.0),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let m = &mirrors[1 + face];
+            assert_eq!((m.object, m.indices.clone()), (3, Some(6 * face as u32..6 * face as u32 + 6)));
+            assert_close(m.plane.normal, normal, 1e-6, "a face's normal");
+            assert!((m.plane.d - d).abs() < 1e-6 && (m.area - 1.0).abs() < 1e-5, "face {face}: {m:?}");
+        }
         let mirror = &mirrors[0];
         assert_eq!(mirror.object, 0);
         // +y turned 45° about x is (0, √½, √½); then 90° about z, (−√½, 0, √½). Through (1, 2, 3):
@@ -655,10 +698,9 @@ mod tests {
         let [a, b, c, _] = mirror.corners;
         assert!((b - a).cross(c - b).dot(mirror.plane.normal) > 0.0, "corners clockwise");
 
-        assert_eq!(warnings.len(), 3, "{warnings:#?}");
+        assert_eq!(warnings.len(), 2, "{warnings:#?}");
         assert!(warnings[0].contains("`ball`") && warnings[0].contains("environment maps"), "{}", warnings[0]);
-        assert!(warnings[1].contains("`crate`") && warnings[1].contains("faces"), "{}", warnings[1]);
-        assert!(warnings[2].contains("`ring`") && warnings[2].contains("environment maps"), "{}", warnings[2]);
+        assert!(warnings[1].contains("`ring`") && warnings[1].contains("environment maps"), "{}", warnings[1]);
     }
 
     #[test]
