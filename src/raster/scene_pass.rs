@@ -205,9 +205,12 @@ type ShadingKey = (DepthMode, FrameKey, MaterialKey, bool);
 /// other faces behind it) and is not drawn.
 #[derive(Default)]
 pub struct MirrorImages {
-    pub images: HashMap<usize, Vec<(Option<Range<u32>>, wgpu::BindGroup)>>,
+    pub images: HashMap<usize, Vec<MirrorImage>>,
     pub skip: Option<usize>,
 }
+
+/// The part of a mirror object that shows an image (`None`: all of it), and its group 3.
+pub type MirrorImage = (Option<Range<u32>>, wgpu::BindGroup);
 
 /// What the pass draws into.
 pub struct SceneTargets<'a> {
