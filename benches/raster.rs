@@ -333,33 +333,48 @@ fn mirror_costs(gpu: &Gpu) {
     let mut scene = Scene::load(&mirador::scene::builtin_path("mirrors.toml")).expect("the mirrors scene");
     scene.camera.width = 1280;
     scene.camera.height = 720;
-    let mut off = scene.settings.clone();
-    off.mirrors.enabled = false;
-    let mut bench = Bench::new(gpu, &scene);
-    let plain = bench.median_frame(&scene, &off);
-    println!("\nplanar mirrors, 1280×720, ratios to the frame with mirrors off");
-    println!("{:>44} {:>9.1} ms {:>7.2}×", "mirrors off", ms(plain), 1.0);
     let mut one = scene.clone();
     let right = one.objects.iter().position(|o| o.name == "right mirror").expect("the right mirror");
     let matte = one.materials.iter().position(|m| m.name == "frame").expect("the frame material");
     one.objects[right].material = mirador::scene::MaterialId(matte);
-    let mut cases = vec![("one mirror".to_string(), one, scene.settings.mirrors.depth)];
-    for depth in 1..=4 {
-        cases.push((format!("two facing mirrors, depth {depth}"), scene.clone(), depth));
-    }
-    for (name, scene, depth) in cases {
+    let with = |scene: &Scene, enabled: bool, depth: u32| {
         let mut settings = scene.settings.clone();
+        settings.mirrors.enabled = enabled;
         settings.mirrors.depth = depth;
-        let mut bench = Bench::new(gpu, &scene);
-        let t = bench.median_frame(&scene, &settings);
-        let views = bench.frame(&scene, &settings).1.mirror_views;
-        let per_view = (t.as_secs_f64() - plain.as_secs_f64()) / f64::from(views.max(1));
-        println!(
-            "{name:>44} {:>9.1} ms {:>7.2}×   {views} views, {:.2}× a plain frame each",
-            ms(t),
-            t.as_secs_f64() / plain.as_secs_f64(),
-            per_view / plain.as_secs_f64()
-        );
+        settings
+    };
+    let mut cases = vec![
+        ("mirrors off".to_string(), scene.clone(), with(&scene, false, 0)),
+        ("one mirror".to_string(), one.clone(), with(&one, true, 3)),
+    ];
+    for depth in 1..=4 {
+        cases.push((format!("two facing mirrors, depth {depth}"), scene.clone(), with(&scene, true, depth)));
+    }
+    // Frames of every case interleaved, round after round: this VM's speed drifts by tens of
+    // percent over seconds, and interleaving spreads the drift over all cases alike.
+    let mut benches: Vec<Bench> = cases.iter().map(|(_, scene, _)| Bench::new(gpu, scene)).collect();
+    let mut times = vec![Vec::new(); cases.len()];
+    let mut views = vec![0; cases.len()];
+    for round in 0..FRAMES + 2 {
+        for (k, (_, scene, settings)) in cases.iter().enumerate() {
+            let (t, report) = benches[k].frame(scene, settings);
+            views[k] = report.mirror_views;
+            if round >= 2 {
+                times[k].push(t);
+            }
+        }
+    }
+    let medians: Vec<Duration> = times.into_iter().map(median).collect();
+    let plain = medians[0].as_secs_f64();
+    println!("\nplanar mirrors, 1280×720, frames of every case interleaved, ratios to mirrors off");
+    for (k, (name, ..)) in cases.iter().enumerate() {
+        let t = medians[k].as_secs_f64();
+        let each = if views[k] > 0 {
+            format!("   {} views, {:.2}× a plain frame each", views[k], (t - plain) / plain / f64::from(views[k]))
+        } else {
+            String::new()
+        };
+        println!("{name:>44} {:>9.1} ms {:>7.2}×{each}", t * 1e3, t / plain);
     }
 }
 

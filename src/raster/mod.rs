@@ -82,6 +82,8 @@ pub struct FrameTargets {
     pub shadow_mask: GpuTexture,
     present_input: PresentInput,
     generation: u64,
+    /// Draw only inside `[x, y, width, height]` (a mirrored view's window); `None`: everywhere.
+    pub scissor: Option<[u32; 4]>,
 }
 
 /// What a frame did, for `--stats`, the viewer's corner and the tests of the caches.
@@ -176,7 +178,7 @@ impl Renderer {
         let shadow_mask = GpuTexture::target(device, "frame::shadow_mask", size, MASK_FORMAT);
         let present_input = self.present.bind(device, &hdr.view);
         let generation = GENERATION.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        FrameTargets { size, hdr, depth, shadow_mask, present_input, generation }
+        FrameTargets { size, hdr, depth, shadow_mask, present_input, generation, scissor: None }
     }
 
     /// The number of scene-pass shader variants compiled so far.
@@ -243,15 +245,16 @@ impl Renderer {
         if truncated {
             log::debug!("more than {} mirrored views: the deepest are left out", view::MAX_MIRROR_VIEWS);
         }
-        for (k, node) in nodes.iter().enumerate() {
-            scene_gpu.views.write(queue, ViewSlot::Mirror(k as u32), &node.view);
-        }
         if self.mirror_targets.first().is_some_and(|t| t.size != size) {
             self.mirror_targets.clear();
         }
         while self.mirror_targets.len() < nodes.len() {
             let made = self.targets(device, size);
             self.mirror_targets.push(made);
+        }
+        for (k, node) in nodes.iter().enumerate() {
+            scene_gpu.views.write(queue, ViewSlot::Mirror(k as u32), &node.view);
+            self.mirror_targets[k].scissor = Some(mirror::pass::scissor(node.window, size));
         }
         // Object-precision shadows are a mask of the main view's pixels: mirrored views go without.
         let mirror_key = if projected { FrameKey { shadow_method: SHADOWS_OFF, ..frame_key } } else { frame_key };
@@ -280,6 +283,7 @@ impl Renderer {
                 hdr: &node_targets.hdr.view,
                 depth: &node_targets.depth.view,
                 background: scene.background,
+                scissor: node_targets.scissor,
             };
             self.scene.record_opaque(
                 &mut frame.encoder,
@@ -328,8 +332,12 @@ impl Renderer {
                 self.projected.record(device, &mut frame.encoder, scene, scene_gpu, &layout, targets);
             frame.end("projected shadows");
         }
-        let scene_targets =
-            SceneTargets { hdr: &targets.hdr.view, depth: &targets.depth.view, background: scene.background };
+        let scene_targets = SceneTargets {
+            hdr: &targets.hdr.view,
+            depth: &targets.depth.view,
+            background: scene.background,
+            scissor: None,
+        };
         self.scene.record_opaque(
             &mut frame.encoder,
             scene_gpu,

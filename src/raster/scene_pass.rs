@@ -218,6 +218,8 @@ pub struct SceneTargets<'a> {
     pub depth: &'a wgpu::TextureView,
     /// Linear radiance where nothing is drawn.
     pub background: glam::Vec3,
+    /// Draw only inside `[x, y, width, height]`; `None`: everywhere.
+    pub scissor: Option<[u32; 4]>,
 }
 
 /// The vertex buffers of every scene pipeline: the mesh's vertices, and the instances.
@@ -420,6 +422,9 @@ impl ScenePass {
             multiview_mask: None,
         });
         pass.push_debug_group("opaque");
+        if let Some([x, y, width, height]) = targets.scissor {
+            pass.set_scissor_rect(x, y, width, height);
+        }
         pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view)]);
         pass.set_bind_group(2, lighting, &[]);
         // Batches come sorted by material: the pipeline changes only where the variant does.

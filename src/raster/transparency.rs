@@ -226,7 +226,7 @@ impl TransparencyPass {
             }
         };
         self.prepare(device, scene_pass, scene_gpu, frame, &draws, Depth::Less);
-        let mut pass = begin(encoder, "transparency::sorted", &targets.hdr.view, &targets.depth.view);
+        let mut pass = begin(encoder, "transparency::sorted", targets, &targets.depth.view);
         pass.set_bind_group(0, scene_gpu.frame_group(), &[scene_gpu.views.offset(slot)]);
         pass.set_bind_group(2, lighting, &[]);
         for draw in &draws {
@@ -347,6 +347,7 @@ impl TransparencyPass {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
+                scissor(&mut pass, targets);
                 pass.set_bind_group(0, scene_gpu.frame_group(), &view_offset);
                 pass.set_bind_group(2, lighting, &[]);
                 // Layer 0 peels below the opaque depth alone; layer k below layer k − 1 too.
@@ -358,7 +359,7 @@ impl TransparencyPass {
                     scene_gpu.geometry.draw_instances(&mut pass, object.mesh, object.instance..object.instance + 1);
                 }
             }
-            let mut pass = begin(encoder, "transparency::peeled_layer", &targets.hdr.view, depth);
+            let mut pass = begin(encoder, "transparency::peeled_layer", targets, depth);
             pass.set_bind_group(0, scene_gpu.frame_group(), &view_offset);
             pass.set_bind_group(2, lighting, &[]);
             for draw in &draws {
@@ -381,21 +382,31 @@ impl Faces {
     }
 }
 
-/// A render pass over the frame's colour, testing against `depth` without writing it.
+/// A render pass over the frame's colour, testing against `depth` without writing it, inside
+/// the targets' scissor.
 fn begin<'e>(
     encoder: &'e mut wgpu::CommandEncoder,
     label: &'static str,
-    hdr: &wgpu::TextureView,
+    targets: &FrameTargets,
     depth: &wgpu::TextureView,
 ) -> wgpu::RenderPass<'e> {
-    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
-        color_attachments: &[Some(layout::color_attachment(hdr, wgpu::LoadOp::Load))],
+        color_attachments: &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
         depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Load)),
         timestamp_writes: None,
         occlusion_query_set: None,
         multiview_mask: None,
-    })
+    });
+    scissor(&mut pass, targets);
+    pass
+}
+
+/// Limits `pass` to the targets' scissor, if they have one.
+fn scissor(pass: &mut wgpu::RenderPass<'_>, targets: &FrameTargets) {
+    if let Some([x, y, width, height]) = targets.scissor {
+        pass.set_scissor_rect(x, y, width, height);
+    }
 }
 
 /// `I = Im + kt·Mt·I`; the target's alpha is left as it is.

@@ -12,6 +12,9 @@
 //! - **Two-sided.** Mirador's planes are two-sided in both renderers, so a camera behind a mirror
 //!   sees a mirror too: the view mirrors about the plane turned towards it. A mirror whose plane
 //!   passes through the camera is seen edge on and gets no view.
+//! - **Only where it shows.** A view's image is read only inside its mirror as the parent view
+//!   sees it, so each view draws inside that screen rectangle (a scissor), nested views inside
+//!   their parents'; a mirror whose rectangle misses its parent's gets no view at all.
 //! - **What a mirrored view draws.** The whole frame's passes but the depth prepass and the
 //!   teaching overlays: opaque surfaces (the mirror it looks out of left out, as it lies on the
 //!   view's near plane), their mirrors with their images, and the transparent surfaces in the
@@ -33,6 +36,10 @@ pub struct MirrorNode {
     pub parent: Option<usize>,
     /// 1 for a mirror the main camera sees, 2 for a mirror seen in it, …
     pub level: u32,
+    /// Where on screen this view's image is read (`[x0, y0, x1, y1]` in normalized device
+    /// coordinates): around the mirror as its parent view sees it, within the parent's own
+    /// window. The view draws only there (a scissor): the rest of its image is never shown.
+    pub window: [f32; 4],
 }
 
 /// The mirrored cameras of a frame seen from `main`, breadth first (every parent before its
@@ -41,9 +48,9 @@ pub struct MirrorNode {
 pub fn plan(main: &View, mirrors: &[Mirror], depth: u32) -> (Vec<MirrorNode>, bool) {
     let mut nodes: Vec<MirrorNode> = Vec::new();
     let mut truncated = false;
-    // (the view looking, its node, the mirror it looks out of, its level)
-    let mut queue = std::collections::VecDeque::from([(*main, None, None, 0)]);
-    while let Some((view, node, from, level)) = queue.pop_front() {
+    // (the view looking, its node, the mirror it looks out of, its level, its window)
+    let mut queue = std::collections::VecDeque::from([(*main, None, None, 0, FULL_WINDOW)]);
+    while let Some((view, node, from, level, window)) = queue.pop_front() {
         if level >= depth {
             continue;
         }
@@ -51,6 +58,7 @@ pub fn plan(main: &View, mirrors: &[Mirror], depth: u32) -> (Vec<MirrorNode>, bo
             if Some(index) == from || !in_view(&view, mirror) {
                 continue;
             }
+            let Some(window) = intersect(window, screen_window(&view, mirror)) else { continue };
             let plane = match camera_side(&view, &mirror.plane) {
                 Side::Front => mirror.plane,
                 Side::Back => mirror.plane.flipped(),
@@ -60,13 +68,58 @@ pub fn plan(main: &View, mirrors: &[Mirror], depth: u32) -> (Vec<MirrorNode>, bo
                 truncated = true;
                 break;
             }
-            let child =
-                MirrorNode { view: mirrored_view(&view, &plane), mirror: index, parent: node, level: level + 1 };
-            queue.push_back((child.view, Some(nodes.len()), Some(index), level + 1));
+            let child = MirrorNode {
+                view: mirrored_view(&view, &plane),
+                mirror: index,
+                parent: node,
+                level: level + 1,
+                window,
+            };
+            queue.push_back((child.view, Some(nodes.len()), Some(index), level + 1, window));
             nodes.push(child);
         }
     }
     (nodes, truncated)
+}
+
+/// The whole screen, in normalized device coordinates.
+const FULL_WINDOW: [f32; 4] = [-1.0, -1.0, 1.0, 1.0];
+
+/// The screen rectangle around `mirror`'s corners as `view` projects them; the whole screen when
+/// a corner lies behind the eye (its projection would wrap around).
+fn screen_window(view: &View, mirror: &Mirror) -> [f32; 4] {
+    let mut window = [f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY];
+    for corner in mirror.corners {
+        let clip = view.clip_from_world * corner.extend(1.0);
+        if clip.w <= 1e-6 {
+            return FULL_WINDOW;
+        }
+        let (x, y) = (clip.x / clip.w, clip.y / clip.w);
+        window = [window[0].min(x), window[1].min(y), window[2].max(x), window[3].max(y)];
+    }
+    window
+}
+
+/// The common part of two windows, `None` when they do not overlap.
+fn intersect(a: [f32; 4], b: [f32; 4]) -> Option<[f32; 4]> {
+    let window = [a[0].max(b[0]), a[1].max(b[1]), a[2].min(b[2]), a[3].min(b[3])];
+    (window[0] < window[2] && window[1] < window[3]).then_some(window)
+}
+
+/// A window in pixels of a `size` target, `[x, y, width, height]` from the top-left corner,
+/// grown to whole pixels (and one more on each side, for the rasterizer's edge rules).
+pub fn scissor(window: [f32; 4], size: (u32, u32)) -> [u32; 4] {
+    let (w, h) = (size.0 as f32, size.1 as f32);
+    let x0 = ((window[0] + 1.0) / 2.0 * w - 1.0).floor().clamp(0.0, w);
+    let x1 = ((window[2] + 1.0) / 2.0 * w + 1.0).ceil().clamp(0.0, w);
+    let y0 = ((1.0 - window[3]) / 2.0 * h - 1.0).floor().clamp(0.0, h);
+    let y1 = ((1.0 - window[1]) / 2.0 * h + 1.0).ceil().clamp(0.0, h);
+    [
+        x0 as u32,
+        y0 as u32,
+        ((x1 - x0).max(1.0) as u32).min(size.0 - x0 as u32),
+        ((y1 - y0).max(1.0) as u32).min(size.1 - y0 as u32),
+    ]
 }
 
 /// Whether any of `mirror` may be inside `view`'s volume: false only when all four corners lie
