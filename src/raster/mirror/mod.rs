@@ -191,7 +191,7 @@ pub struct Mirror {
     pub plane: MirrorPlane,
     /// The smallest rectangle in the plane around the mirror's triangles, counter-clockwise seen
     /// from the front, with sides along an edge of its largest triangle: a `plane` shape's own
-    /// quad. What the mirror pass can bound its view or scissor by.
+    /// quad. What the mirror pass bounds its view's scissor by.
     pub corners: [Vec3; 4],
     /// The area of its triangles, in world units squared.
     pub area: f32,
