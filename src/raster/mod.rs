@@ -63,7 +63,7 @@ pub struct Renderer {
     present: PresentPass,
     /// The targets of the mirrored views (`mirror::pass`), one per view of the largest frame so
     /// far.
-    mirror_targets: Vec<FrameTargets>,
+    mirror_targets: Vec<MirrorTarget>,
     /// The lighting inputs (group 2), and the (shadow maps, frame targets) generations they were
     /// made for.
     lighting: Option<((u64, u64), wgpu::BindGroup)>,
@@ -245,16 +245,17 @@ impl Renderer {
         if truncated {
             log::debug!("more than {} mirrored views: the deepest are left out", view::MAX_MIRROR_VIEWS);
         }
-        if self.mirror_targets.first().is_some_and(|t| t.size != size) {
+        if self.mirror_targets.first().is_some_and(|t| t.targets.size != size) {
             self.mirror_targets.clear();
         }
         while self.mirror_targets.len() < nodes.len() {
-            let made = self.targets(device, size);
-            self.mirror_targets.push(made);
+            let targets = self.targets(device, size);
+            let image = self.scene.mirror_image_group(device, &targets.hdr.view);
+            self.mirror_targets.push(MirrorTarget { targets, image });
         }
         for (k, node) in nodes.iter().enumerate() {
             scene_gpu.views.write(queue, ViewSlot::Mirror(k as u32), &node.view);
-            self.mirror_targets[k].scissor = Some(mirror::pass::scissor(node.window, size));
+            self.mirror_targets[k].targets.scissor = Some(mirror::pass::scissor(node.window, size));
         }
         // Object-precision shadows are a mask of the main view's pixels: mirrored views go without.
         let mirror_key = if projected { FrameKey { shadow_method: SHADOWS_OFF, ..frame_key } } else { frame_key };
@@ -274,9 +275,8 @@ impl Renderer {
         // Deepest first: every view's mirrors find their images drawn.
         let images_of = children(&nodes);
         for (k, node) in nodes.iter().enumerate().rev() {
-            let node_targets = &self.mirror_targets[k];
-            let mut images =
-                mirror_images(device, &self.scene, scene_gpu, &self.mirror_targets, images_of.get(&Some(k)));
+            let node_targets = &self.mirror_targets[k].targets;
+            let mut images = mirror_images(scene_gpu, &self.mirror_targets, images_of.get(&Some(k)));
             images.skip = Some(scene_gpu.mirrors[node.mirror].object);
             let slot = ViewSlot::Mirror(k as u32);
             let node_scene_targets = SceneTargets {
@@ -347,7 +347,7 @@ impl Renderer {
             &scene_targets,
             prepass,
             sorted_transparency,
-            &mirror_images(device, &self.scene, scene_gpu, &self.mirror_targets, images_of.get(&None)),
+            &mirror_images(scene_gpu, &self.mirror_targets, images_of.get(&None)),
         );
         frame.end("opaque");
         let mut transparency = TransparencyReport::default();
@@ -373,7 +373,7 @@ impl Renderer {
         }
         // The first mirror camera's own image, in place of the frame.
         let shown = match nodes.first() {
-            Some(_) if mirrors.view == MirrorView::Image => &self.mirror_targets[0].present_input,
+            Some(_) if mirrors.view == MirrorView::Image => &self.mirror_targets[0].targets.present_input,
             _ => &targets.present_input,
         };
         self.present.record(queue, &mut frame.encoder, shown, output, settings.exposure);
@@ -390,34 +390,25 @@ impl Renderer {
     }
 }
 
+/// One mirrored view's targets, and the group 3 through which its mirror reads its image (made
+/// once with the targets).
+struct MirrorTarget {
+    targets: FrameTargets,
+    image: wgpu::BindGroup,
+}
+
 /// The reflections the mirrors of one view show: for each `(mirror, node)` child of the view,
 /// the group 3 reading that node's image.
 fn mirror_images(
-    device: &wgpu::Device,
-    scene_pass: &ScenePass,
     scene_gpu: &SceneGpu,
-    mirror_targets: &[FrameTargets],
+    mirror_targets: &[MirrorTarget],
     children: Option<&Vec<(usize, usize)>>,
 ) -> MirrorImages {
-    let images = children
-        .into_iter()
-        .flatten()
-        .map(|&(mirror, node)| {
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("frame::mirror_image_group"),
-                layout: &scene_pass.mirror_group_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&mirror_targets[node].hdr.view),
-                }],
-            });
-            (mirror, group)
-        })
-        .fold(HashMap::new(), |mut images: HashMap<usize, Vec<_>>, (mirror, group)| {
-            let mirror = &scene_gpu.mirrors[mirror];
-            images.entry(mirror.object).or_default().push((mirror.indices.clone(), group));
-            images
-        });
+    let mut images: HashMap<usize, Vec<_>> = HashMap::new();
+    for &(mirror, node) in children.into_iter().flatten() {
+        let mirror = &scene_gpu.mirrors[mirror];
+        images.entry(mirror.object).or_default().push((mirror.indices.clone(), mirror_targets[node].image.clone()));
+    }
     MirrorImages { images, skip: None }
 }
 

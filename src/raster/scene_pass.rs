@@ -187,7 +187,7 @@ pub struct ScenePass {
     module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
     /// Group 3 of the mirror variants: the reflection image.
-    pub mirror_group_layout: wgpu::BindGroupLayout,
+    mirror_group_layout: wgpu::BindGroupLayout,
     mirror_layout: wgpu::PipelineLayout,
     prepass: wgpu::RenderPipeline,
     /// The prepass of cut-out materials (`ALPHA_MASK`): depth only where the surface is.
@@ -344,6 +344,15 @@ impl ScenePass {
     /// The number of shading variants compiled so far.
     pub fn variant_count(&self) -> usize {
         self.shading.len()
+    }
+
+    /// The group 3 of the mirror variants that reads `image`, a mirrored view's HDR target.
+    pub fn mirror_image_group(&self, device: &wgpu::Device, image: &wgpu::TextureView) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene::mirror_image_group"),
+            layout: &self.mirror_group_layout,
+            entries: &[wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(image) }],
+        })
     }
 
     /// The shading module every scene pipeline is made from, and its pipeline layout (groups 0

@@ -102,10 +102,11 @@ pub struct TransparencyReport {
 
 /// One draw of the pass.
 enum Draw {
-    /// One object's triangles, or only its back or front faces.
-    Object { object: usize, faces: Faces },
-    /// A run of sorted triangles of one material, from the triangle list.
-    Triangles { material: usize, indices: Range<u32> },
+    /// One object's triangles, or only its back or front faces; `winding` is the faces in terms
+    /// of the triangles' winding (swapped where the object's transform or the view mirrors).
+    Object { object: usize, winding: Faces },
+    /// A run of sorted triangles of one material, from the triangle list in `order`'s order.
+    Triangles { material: usize, indices: Range<u32>, order: ViewSlot },
 }
 
 pub struct TransparencyPass {
@@ -116,10 +117,6 @@ pub struct TransparencyPass {
     /// Peel depths for each set of frame targets drawn into (the main view's, mirrored views').
     peel: Vec<PeelTargets>,
     triangles: Option<TriangleList>,
-    /// The view being drawn is mirrored: its triangles' winding is flipped.
-    mirrored: bool,
-    /// The view whose triangle order is being drawn.
-    sorted_slot: ViewSlot,
 }
 
 impl TransparencyPass {
@@ -146,8 +143,6 @@ impl TransparencyPass {
             peel_pipelines: HashMap::new(),
             peel: Vec::new(),
             triangles: None,
-            mirrored: false,
-            sorted_slot: ViewSlot::Main,
         }
     }
 
@@ -173,13 +168,14 @@ impl TransparencyPass {
             return report;
         }
         let forward = -view.view_axis;
-        self.mirrored = view.mirrored;
+        let objects = &scene_gpu.geometry.transparent;
+        let object_draw = |object: usize, faces: Faces| Draw::Object {
+            object,
+            winding: if objects[object].flipped != view.mirrored { faces.swapped() } else { faces },
+        };
         let draws: Vec<Draw> = match settings.sort {
-            TransparencySort::Unsorted => (0..scene_gpu.geometry.transparent.len())
-                .map(|object| Draw::Object { object, faces: Faces::Both })
-                .collect(),
+            TransparencySort::Unsorted => (0..objects.len()).map(|object| object_draw(object, Faces::Both)).collect(),
             TransparencySort::Object => {
-                let objects = &scene_gpu.geometry.transparent;
                 let mut order: Vec<usize> = (0..objects.len()).collect();
                 // Farthest first; a stable sort keeps the scene's order between equals.
                 order.sort_by(|&a, &b| {
@@ -188,9 +184,7 @@ impl TransparencyPass {
                 });
                 order
                     .into_iter()
-                    .flat_map(|object| {
-                        [Draw::Object { object, faces: Faces::Back }, Draw::Object { object, faces: Faces::Front }]
-                    })
+                    .flat_map(|object| [object_draw(object, Faces::Back), object_draw(object, Faces::Front)])
                     .collect()
             }
             TransparencySort::Triangle => {
@@ -202,11 +196,14 @@ impl TransparencyPass {
                 let start = Instant::now();
                 report.sorted = list.sort(device, queue, slot, view.eye, forward);
                 report.sort_time = start.elapsed();
-                self.sorted_slot = slot;
                 list.orders[&slot]
                     .runs
                     .iter()
-                    .map(|(material, indices)| Draw::Triangles { material: *material, indices: indices.clone() })
+                    .map(|(material, indices)| Draw::Triangles {
+                        material: *material,
+                        indices: indices.clone(),
+                        order: slot,
+                    })
                     .collect()
             }
             TransparencySort::Exact => {
@@ -254,10 +251,7 @@ impl TransparencyPass {
 
     fn key(&self, scene_gpu: &SceneGpu, frame: FrameKey, draw: &Draw, depth: Depth) -> PipelineKey {
         let (material, faces) = match *draw {
-            Draw::Object { object, faces } => {
-                let object = &scene_gpu.geometry.transparent[object];
-                (object.material, if object.flipped != self.mirrored { faces.swapped() } else { faces })
-            }
+            Draw::Object { object, winding } => (scene_gpu.geometry.transparent[object].material, winding),
             Draw::Triangles { material, .. } => (material, Faces::Both),
         };
         let key = scene_gpu.material_keys[material];
@@ -287,11 +281,11 @@ impl TransparencyPass {
                 let object: &TransparentObject = &scene_gpu.geometry.transparent[*object];
                 scene_gpu.geometry.draw_instances(pass, object.mesh, object.instance..object.instance + 1);
             }
-            Draw::Triangles { indices, .. } => {
+            Draw::Triangles { indices, order, .. } => {
                 let list = self.triangles.as_ref().expect("sorted before drawing");
                 pass.set_vertex_buffer(0, list.vertices.slice(..));
                 pass.set_vertex_buffer(1, list.identity.slice(..));
-                pass.set_index_buffer(list.orders[&self.sorted_slot].indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.set_index_buffer(list.orders[order].indices.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(indices.clone(), 0, 0..1);
             }
         }
@@ -313,7 +307,7 @@ impl TransparencyPass {
         layers: u32,
     ) -> u32 {
         let objects = &scene_gpu.geometry.transparent;
-        let draws: Vec<Draw> = (0..objects.len()).map(|object| Draw::Object { object, faces: Faces::Both }).collect();
+        let draws: Vec<Draw> = (0..objects.len()).map(|object| Draw::Object { object, winding: Faces::Both }).collect();
         self.prepare(device, scene_pass, scene_gpu, frame, &draws, Depth::Equal);
         for object in objects {
             let key = scene_gpu.material_keys[object.material];
