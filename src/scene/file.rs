@@ -16,6 +16,7 @@ use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use toml::Spanned;
 
 use super::camera::{Camera, Projection};
+use super::environment::{self, Environment, EnvironmentSource, Sky};
 use super::gltf::{GltfCamera, GltfImport, GltfProjection};
 use super::light::{Attenuation, Light, LightKind};
 use super::material::{AlphaMode, ColorSpace, Material, MaterialId, ProceduralHeight, TextureId, Wrap};
@@ -220,6 +221,31 @@ struct CameraDesc {
 struct WorldDesc {
     ambient: Option<Rgb>,
     background: Option<Rgb>,
+    environment: Option<Spanned<EnvironmentDesc>>,
+}
+
+/// `[world.environment]`: exactly one source, and an intensity.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EnvironmentDesc {
+    sky: Option<SkyDesc>,
+    latlong: Option<String>,
+    cube: Option<[String; 6]>,
+    cross: Option<String>,
+    sphere: Option<String>,
+    intensity: Option<NonNegative>,
+}
+
+/// `sky = { … }`: every key optional, `sun_radius` in degrees.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SkyDesc {
+    zenith: Option<Rgb>,
+    horizon: Option<Rgb>,
+    ground: Option<Rgb>,
+    sun_direction: Option<Spanned<V3>>,
+    sun_color: Option<Rgb>,
+    sun_radius: Option<Spanned<Finite>>,
 }
 
 #[derive(Deserialize)]
@@ -457,6 +483,14 @@ impl<'a> Builder<'a> {
         }
         self.scene.ambient = file.world.ambient.map_or(Vec3::splat(0.1), |Rgb(c)| c);
         self.scene.background = file.world.background.map_or(Vec3::ZERO, |Rgb(c)| c);
+        if let Some(environment) = file.world.environment {
+            let span = environment.span();
+            if file.world.background.is_some() {
+                let message = "give [world] either a `background` or an `environment`, not both";
+                return Err(self.error(message, span));
+            }
+            self.scene.environment = Some(self.environment(environment.into_inner(), span)?);
+        }
         self.materials(file.materials)?;
         for light in file.lights {
             let span = light.span();
@@ -612,6 +646,78 @@ impl<'a> Builder<'a> {
         self.scene.textures.push(texture);
         self.texture_ids.insert(key, id);
         Ok(id)
+    }
+
+    fn environment(&self, d: EnvironmentDesc, span: Range<usize>) -> Result<Environment, SceneError> {
+        let fail = |message: String| self.error(message, span.clone());
+        let given: Vec<&str> = [
+            ("sky", d.sky.is_some()),
+            ("latlong", d.latlong.is_some()),
+            ("cube", d.cube.is_some()),
+            ("cross", d.cross.is_some()),
+            ("sphere", d.sphere.is_some()),
+        ]
+        .into_iter()
+        .filter_map(|(key, present)| present.then_some(key))
+        .collect();
+        if given.len() != 1 {
+            let got = if given.is_empty() { "none".to_string() } else { format!("`{}`", given.join("`, `")) };
+            return Err(fail(format!(
+                "[world.environment] needs exactly one of `sky`, `latlong`, `cube`, `cross`, `sphere`; got {got}"
+            )));
+        }
+        // An image's own problems name the image; they are placed at the environment's table.
+        let place = |e: SceneError| fail(e.to_string());
+        let (source, path) = if let Some(sky) = d.sky {
+            (EnvironmentSource::Sky(self.sky(sky)?), None)
+        } else if let Some(relative) = d.latlong {
+            let path = self.dir.join(relative);
+            (EnvironmentSource::LatLong(environment::load_latlong(&path).map_err(place)?), Some(path))
+        } else if let Some(relatives) = d.cube {
+            let paths = relatives.map(|r| self.dir.join(r));
+            let faces = environment::load_cube(&paths).map_err(place)?;
+            (EnvironmentSource::Cube(faces), Some(paths[0].clone()))
+        } else if let Some(relative) = d.cross {
+            let path = self.dir.join(relative);
+            (EnvironmentSource::Cube(environment::load_cross(&path).map_err(place)?), Some(path))
+        } else if let Some(relative) = d.sphere {
+            let path = self.dir.join(relative);
+            (EnvironmentSource::Sphere(environment::load_sphere(&path).map_err(place)?), Some(path))
+        } else {
+            unreachable!("exactly one source was checked above")
+        };
+        Ok(Environment { source, intensity: d.intensity.map_or(1.0, |NonNegative(x)| x), path })
+    }
+
+    fn sky(&self, d: SkyDesc) -> Result<Sky, SceneError> {
+        let base = Sky::default();
+        let sun_direction = match d.sun_direction {
+            Some(v) => {
+                let span = v.span();
+                let V3(direction) = v.into_inner();
+                direction.try_normalize().ok_or_else(|| self.error("`sun_direction` is the zero vector", span))?
+            }
+            None => base.sun_direction,
+        };
+        let sun_radius = match d.sun_radius {
+            Some(r) => {
+                let span = r.span();
+                let Finite(degrees) = r.into_inner();
+                if !(degrees > 0.0 && degrees < 90.0) {
+                    return Err(self.error(format!("sun_radius must be > 0 and < 90 degrees, got {degrees}"), span));
+                }
+                degrees.to_radians()
+            }
+            None => base.sun_radius,
+        };
+        Ok(Sky {
+            zenith: d.zenith.map_or(base.zenith, |Rgb(c)| c),
+            horizon: d.horizon.map_or(base.horizon, |Rgb(c)| c),
+            ground: d.ground.map_or(base.ground, |Rgb(c)| c),
+            sun_direction,
+            sun_color: d.sun_color.map_or(base.sun_color, |Rgb(c)| c),
+            sun_radius,
+        })
     }
 
     fn light(&self, d: LightDesc, span: Range<usize>) -> Result<Light, SceneError> {
@@ -887,6 +993,7 @@ fn empty_scene(path: &Path) -> Scene {
         },
         ambient: Vec3::splat(0.1),
         background: Vec3::ZERO,
+        environment: None,
         lights: Vec::new(),
         materials: Vec::new(),
         textures: Vec::new(),

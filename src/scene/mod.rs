@@ -6,6 +6,7 @@
 //! cameras. Scenes are written in TOML ([`file`], documented in `docs/scene-format.md`).
 
 pub mod camera;
+pub mod environment;
 pub mod file;
 pub mod gltf;
 pub mod light;
@@ -20,6 +21,7 @@ use std::path::{Path, PathBuf};
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
 pub use camera::{Camera, Projection, Ray};
+pub use environment::{EnvImage, Environment, EnvironmentSource, Sky};
 pub use light::{Attenuation, Light, LightKind};
 pub use material::{AlphaMode, ColorSpace, Material, MaterialId, ProceduralHeight, Texture, TextureId, Wrap};
 pub use mesh::Mesh;
@@ -99,8 +101,11 @@ pub struct Scene {
     pub camera: Camera,
     /// `A`: global ambient radiance (see `shading.rs` for how it is reflected).
     pub ambient: Vec3,
-    /// Radiance of rays that hit nothing.
+    /// Radiance of rays that hit nothing, where there is no `environment`.
     pub background: Vec3,
+    /// The radiance of rays that hit nothing, by direction ([`environment`]); `None` for a plain
+    /// `background` (and for scenes built in code and bare glTF models).
+    pub environment: Option<Environment>,
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
     pub textures: Vec<Texture>,
@@ -147,6 +152,15 @@ impl Scene {
     /// The built-in default scene, `assets/scenes/showcase.toml`.
     pub fn showcase() -> Result<Scene, SceneError> {
         Scene::load(&builtin_path("showcase.toml"))
+    }
+
+    /// The radiance arriving from `direction` (need not be unit) along a ray that hits nothing:
+    /// the environment's, or the plain background where there is none.
+    pub fn environment_radiance(&self, direction: Vec3) -> Vec3 {
+        match &self.environment {
+            Some(environment) => environment.radiance(direction),
+            None => self.background,
+        }
     }
 
     /// The triangles the rasterizer draws for `object`, in its local coordinates.

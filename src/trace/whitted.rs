@@ -2,7 +2,7 @@
 //! 003 and 004):
 //!
 //! ```text
-//! RayTracing(o, u, n):  nearest hit p of the ray o + t·u, or the background if none;
+//! RayTracing(o, u, n):  nearest hit p of the ray o + t·u, or the environment L_env(u) if none;
 //!   ME + AG + Σ_i V_i·S_i·L_dir(p, v, l_i)
 //!      + kps·MPS·RayTracing(p, r, n + 1)      r = 2(n·v)n − v
 //!      + kt·MT·RayTracing(p, t, n + 1)        t by Snell's law
@@ -28,7 +28,7 @@
 //!   maximum depth the `1 − α` share is dropped, as `kt·MT·L(t)` is). Through a surface covering
 //!   `α`, a shadow ray carries `α·kt·MT + (1 − α)`: grey `1 − α` for a blended surface without
 //!   kt, 1 through a mask's holes. Shadow rays carry no cone, so they read the texture's alpha at
-//!   level 0. A ray gives up after [`MAX_LAYERS`] masked hits (the background) or occluders.
+//!   level 0. A ray gives up after [`MAX_LAYERS`] masked hits (seeing the environment) or occluders.
 //! - **Refraction.** The side is read from the geometric normal: a ray against it enters the
 //!   object (`η = 1/ior`), a ray along it leaves (`η = ior`). With `sin²θt = η²(1 − cos²θi) > 1`
 //!   there is total internal reflection: no ray leaves, and the `kt·MT` energy goes to the
@@ -120,7 +120,7 @@ impl Whitted<'_> {
     pub fn radiance(&self, ray: &Ray, cone: RayCone, depth: u32, counts: &mut RayCounts) -> Vec3 {
         match self.nearest_surface(ray, cone) {
             Some((surface, ray, cone)) => self.shade(&ray, cone, &surface, depth, counts),
-            None => self.scene.background,
+            None => self.scene.environment_radiance(ray.direction),
         }
     }
 
