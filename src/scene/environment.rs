@@ -65,7 +65,8 @@ impl EnvImage {
         let y = uv.y * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        // `as` saturates and maps NaN to 0, so a degenerate direction reads a texel, not out of bounds.
+        // `as` saturates and maps NaN to 0: a NaN coordinate (from a zero direction) gives NaN, never
+        // an index out of bounds.
         let column = |i: i64| if wrap_u { i.rem_euclid(w) } else { i.clamp(0, w - 1) };
         let row = |j: i64| j.clamp(0, h - 1);
         let (x0, y0) = (x0 as i64, y0 as i64);
@@ -665,8 +666,13 @@ mod tests {
         assert_eq!(image.bilinear(Vec2::new(1.5 / 4.0, 2.5 / 4.0), false), Vec3::new(1.0, 2.0, 1.0));
         assert!(close(image.bilinear(Vec2::new(0.5, 0.5), false), Vec3::new(1.5, 1.5, 1.0), 1e-6));
         assert!(close(image.bilinear(Vec2::new(1.0, 1.0), false), Vec3::new(3.0, 3.0, 1.0), 1e-6));
-        // A degenerate coordinate reads some texel instead of panicking.
-        assert!(image.bilinear(Vec2::NAN, true).is_nan() || image.bilinear(Vec2::NAN, true).is_finite());
+        // A NaN coordinate (a zero direction) is NaN radiance, not an index out of bounds.
+        assert!(image.bilinear(Vec2::NAN, true).is_nan() && image.bilinear(Vec2::NAN, false).is_nan());
+        assert!(
+            Environment { source: EnvironmentSource::LatLong(image), intensity: 1.0, path: None }
+                .radiance(Vec3::ZERO)
+                .is_nan()
+        );
     }
 
     #[test]
