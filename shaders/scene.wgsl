@@ -24,6 +24,8 @@ override HEIGHT_KIND: u32 = 0u;
 override NORMAL_MAP: bool = false;
 // ALPHA_* of shaders/common/types.wgsl: whether coverage cuts the surface out or blends it.
 override ALPHA_MODE: u32 = 0u;
+// ENV_MAP_*: the map curved mirrors look kps·MPS·L(r) up in; 0: none.
+override ENVIRONMENT: u32 = 0u;
 
 const SHADOWS_OFF: u32 = 0u;
 const SHADOWS_MAP: u32 = 1u;
@@ -36,6 +38,11 @@ const HEIGHT_NONE: u32 = 0u;
 const HEIGHT_TEXTURE: u32 = 1u;
 const HEIGHT_SINE: u32 = 2u;
 const HEIGHT_NOISE: u32 = 3u;
+
+const ENV_MAP_CUBE: u32 = 1u;
+const ENV_MAP_SPHERE: u32 = 2u;
+const ENV_MAP_LATLONG: u32 = 3u;
+const ENV_MAP_DYNAMIC: u32 = 4u;
 
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> frame: Frame;
@@ -57,6 +64,15 @@ const HEIGHT_NOISE: u32 = 3u;
 @group(2) @binding(2) var shadow_sampler: sampler_comparison;
 @group(2) @binding(3) var transmission_maps: texture_2d_array<f32>;
 @group(2) @binding(4) var projected_mask: texture_2d<f32>;
+// The environment (shaders/common/environment.wgsl; src/raster/environment): the world's, as a
+// cube, a sphere map and a lat–long map, and the cubes drawn from reflective objects' centres.
+@group(2) @binding(5) var<uniform> environment: Environment;
+// Trilinear; u repeats (the lat–long map's wrap), v clamps. Cube lookups ignore both.
+@group(2) @binding(6) var env_sampler: sampler;
+@group(2) @binding(7) var env_cube: texture_cube<f32>;
+@group(2) @binding(8) var env_cubes: texture_cube_array<f32>;
+@group(2) @binding(9) var env_sphere: texture_2d<f32>;
+@group(2) @binding(10) var env_latlong: texture_2d<f32>;
 // Group 3 (mirror variants only): the reflection, drawn by the camera mirrored about this mirror's
 // plane at the same size as this view, so the mirror's own pixel is where its reflection is
 // (the projective lookup of TECHNIQUES.md §6 reduces to the fragment's pixel).
@@ -78,6 +94,8 @@ struct VertexOut {
     @location(2) uv: vec2f,
     // World-space tangent, and the bitangent's sign in w.
     @location(3) tangent: vec4f,
+    // The object's dynamic environment cube, −1 for the world's.
+    @location(4) @interpolate(flat) env_layer: i32,
 }
 
 @vertex
@@ -90,6 +108,7 @@ fn vs_scene(in: VertexIn, instance: Instance) -> VertexOut {
     out.normal = instance_normal_from_local(instance) * in.normal;
     out.uv = in.uv;
     out.tangent = vec4f((world_from_local * vec4f(in.tangent.xyz, 0.0)).xyz, in.tangent.w);
+    out.env_layer = instance.env_layer;
     return out;
 }
 
@@ -270,7 +289,35 @@ fn shade(in: VertexOut) -> vec3f {
     if checker >= 0.0 {
         radiance *= mix(0.55, 1.0, checker);
     }
+    if ENVIRONMENT != 0u {
+        // Looked up everywhere (its derivatives need uniform control flow), kept where the
+        // object reflects through a map.
+        let reflected = material.reflectance * environment_reflection(n, v, in.env_layer);
+        radiance += select(vec3f(0.0), reflected, in.env_layer != ENV_LAYER_NONE);
+    }
     return radiance;
+}
+
+// L(r) for the mirror term kps·MPS·L(r) of a curved mirror (TECHNIQUES.md §6), r = 2(n·v)n − v
+// looked up in the environment map. The level of detail comes from r's change across the pixel,
+// taken here in uniform control flow, so a reflection minified on a small sphere is filtered
+// rather than aliased.
+fn environment_reflection(n: vec3f, v: vec3f, layer: i32) -> vec3f {
+    let r = 2.0 * dot(n, v) * n - v;
+    let drdx = dpdx(r);
+    let drdy = dpdy(r);
+    if ENVIRONMENT == ENV_MAP_SPHERE {
+        let uv = sphere_map_uv(environment.sphere_from_world * r);
+        return textureSampleGrad(env_sphere, env_sampler, uv, dpdx(uv), dpdy(uv)).rgb;
+    }
+    if ENVIRONMENT == ENV_MAP_LATLONG {
+        let uv = latlong_uv(r);
+        return textureSampleGrad(env_latlong, env_sampler, uv, latlong_gradient(dpdx(uv)), latlong_gradient(dpdy(uv))).rgb;
+    }
+    if ENVIRONMENT == ENV_MAP_DYNAMIC && layer >= 0 {
+        return textureSampleGrad(env_cubes, env_sampler, r, layer, drdx, drdy).rgb;
+    }
+    return textureSampleGrad(env_cube, env_sampler, r, drdx, drdy).rgb;
 }
 
 // Coverage α: the material's alpha times its colour texture's (glTF's base colour alpha).
@@ -314,4 +361,55 @@ fn fs_mask(in: VertexOut) {
     if masked_out(in.uv) {
         discard;
     }
+}
+
+// The world where nothing is drawn (TECHNIQUES.md §6): one triangle over the screen at the far
+// plane, drawn after the opaque surfaces with the depth test LessEqual, so only the pixels no
+// surface covered run it. Each pixel looks along the camera ray through its centre, the same ray
+// the tracer sends, and returns the environment's radiance there (the tracer's rays that hit
+// nothing return the same function: src/scene/environment.rs).
+struct BackgroundOut {
+    @builtin(position) clip: vec4f,
+    // The pixel's normalized device coordinates (interpolated exactly: they are linear).
+    @location(0) ndc: vec2f,
+}
+
+@vertex
+fn vs_background(@builtin(vertex_index) index: u32) -> BackgroundOut {
+    let p = fullscreen_position(index).xy;
+    return BackgroundOut(vec4f(p, 1.0, 1.0), p);
+}
+
+@fragment
+fn fs_background(in: BackgroundOut) -> @location(0) vec4f {
+    // Any point on the pixel's ray, unprojected; q.xyz − eye·q.w points away from the eye along
+    // the ray whatever the sign of q.w (oblique projections of mirrored views included).
+    let q = view.world_from_clip * vec4f(in.ndc, 0.5, 1.0);
+    var d = q.xyz - view.eye * q.w;
+    if view.orthographic != 0u {
+        d = -view.view_axis;
+    }
+    return vec4f(world_radiance(d), 1.0);
+}
+
+// The world's radiance along d: the procedural sky evaluated, an image source sampled (the
+// lat–long image with explicit gradients, seamless across its wrap), or the plain background.
+fn world_radiance(d: vec3f) -> vec3f {
+    // Every derivative first, in uniform control flow.
+    let uv = latlong_uv(d);
+    let duv_dx = latlong_gradient(dpdx(uv));
+    let duv_dy = latlong_gradient(dpdy(uv));
+    let dd_dx = dpdx(d);
+    let dd_dy = dpdy(d);
+    let source = environment.source;
+    if source == ENV_SKY {
+        return environment.intensity * sky_radiance(environment, d);
+    }
+    if source == ENV_LATLONG {
+        return textureSampleGrad(env_latlong, env_sampler, uv, duv_dx, duv_dy).rgb;
+    }
+    if source == ENV_CUBE || source == ENV_SPHERE {
+        return textureSampleGrad(env_cube, env_sampler, d, dd_dx, dd_dy).rgb;
+    }
+    return environment.background;
 }

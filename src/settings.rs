@@ -27,6 +27,9 @@ pub struct RenderSettings {
     pub transparency: TransparencySettings,
     /// Planar mirrors by a mirrored camera (TECHNIQUES.md §6).
     pub mirrors: MirrorSettings,
+    /// Environment maps for curved mirrors, and the world drawn as the background (TECHNIQUES.md
+    /// §6).
+    pub environment: EnvironmentSettings,
     /// How the rasterizer spends its time: prepass, tessellation, render scale.
     pub raster: RasterSettings,
     /// The ray tracer's own settings.
@@ -102,6 +105,83 @@ impl Default for MirrorSettings {
         MirrorSettings { enabled: true, depth: 3, view: MirrorView::Off }
     }
 }
+
+/// Which map the rasterizer looks curved mirrors' reflections up in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum EnvironmentMap {
+    /// The six faces of a cube around the object: `r` picks the face and the texel.
+    Cube,
+    /// One image of a mirror ball seen along −Z in view space (OpenGL's sphere map).
+    Sphere,
+    /// Longitude and latitude of `r` (`α = a·u`, `β = b·v`).
+    Latlong,
+}
+
+/// Whose view a sphere map is made for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum SphereView {
+    /// Made once, for the camera of the first frame: turn the camera and the reflections turn
+    /// with it (the map belongs to one view direction).
+    Fixed,
+    /// Made again for every frame's camera.
+    Follow,
+}
+
+/// What the environment technique shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum EnvironmentView {
+    /// The scene.
+    Off,
+    /// The cube map of the first reflective object (or the world's) unfolded as a cross.
+    Cross,
+    /// The sphere map, as an image.
+    Sphere,
+    /// The latitude–longitude map, as an image.
+    Latlong,
+}
+
+/// Environment mapping (materials with `kps > 0` that are not planar mirrors) in the rasterizer.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct EnvironmentSettings {
+    /// Add `kps·MPS·L(r)` to curved mirrors' illumination model, `L(r)` looked up in a map;
+    /// off, they show their model alone. The world is drawn as the background either way.
+    pub enabled: bool,
+    /// The map `L(r)` is looked up in.
+    pub map: EnvironmentMap,
+    /// Cube maps rendered from each reflective object's centre (six 90° views of the rest of
+    /// the scene) instead of the world's environment alone.
+    pub dynamic: bool,
+    /// Texels on a side of every cube face made by the renderer.
+    pub cube_size: u32,
+    /// Dynamic cubes are drawn again every `refresh` frames; 0: only when something they see
+    /// changes.
+    pub refresh: u32,
+    /// Whose view the sphere map is made for.
+    pub sphere_view: SphereView,
+    /// Teaching views.
+    pub view: EnvironmentView,
+}
+
+impl Default for EnvironmentSettings {
+    fn default() -> Self {
+        EnvironmentSettings {
+            enabled: true,
+            map: EnvironmentMap::Cube,
+            dynamic: true,
+            cube_size: 256,
+            refresh: 0,
+            sphere_view: SphereView::Fixed,
+            view: EnvironmentView::Off,
+        }
+    }
+}
+
+/// The range of `environment.cube_size`.
+pub const CUBE_SIZES: std::ops::RangeInclusive<u32> = 16..=2048;
 
 /// The deepest `mirrors.depth`.
 pub const MAX_MIRROR_DEPTH: u32 = 8;
@@ -447,6 +527,7 @@ impl Default for RenderSettings {
             shadows: ShadowSettings::default(),
             transparency: TransparencySettings::default(),
             mirrors: MirrorSettings::default(),
+            environment: EnvironmentSettings::default(),
             raster: RasterSettings::default(),
             trace: TraceSettings::default(),
         }
@@ -538,6 +619,14 @@ impl RenderSettings {
             return Err(SettingsError::Invalid(format!(
                 "mirrors.depth must lie in 0..={MAX_MIRROR_DEPTH}, got {}",
                 self.mirrors.depth
+            )));
+        }
+        let cube = self.environment.cube_size;
+        if !CUBE_SIZES.contains(&cube) {
+            return Err(SettingsError::Invalid(format!(
+                "environment.cube_size must lie in {}..={}, got {cube}",
+                CUBE_SIZES.start(),
+                CUBE_SIZES.end()
             )));
         }
         let scale = self.raster.render_scale;

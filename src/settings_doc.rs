@@ -16,8 +16,8 @@ use clap::ValueEnum;
 use serde::Serialize;
 
 use crate::settings::{
-    AccelKind, AntiAliasing, BumpView, MirrorView, Prepass, ShadowFilter, ShadowFit, ShadowMethod, ShadowView,
-    TangentSource, TextureFilter, TracerLod, TransparencySort,
+    AccelKind, AntiAliasing, BumpView, EnvironmentMap, EnvironmentView, MirrorView, Prepass, ShadowFilter, ShadowFit,
+    ShadowMethod, ShadowView, SphereView, TangentSource, TextureFilter, TracerLod, TransparencySort,
 };
 
 /// One value an enum setting can take.
@@ -215,6 +215,28 @@ pub fn describe(key: &str) -> Option<FieldDoc> {
         ),
         "mirrors.view" => choice::<MirrorView>(
             "Teaching views: the first mirror camera's own image, or each mirrored camera's view volume drawn in the scene.",
+        ),
+        "environment" => doc(
+            "Environment maps (TECHNIQUES.md §6): curved mirrors look kps·MPS·L(r) up in a cube, sphere or latitude–longitude map; the world's environment is the background.",
+        ),
+        "environment.enabled" => {
+            doc("Off: curved mirrors show their illumination model alone, without the kps·MPS·L(r) term.")
+        }
+        "environment.map" => choice::<EnvironmentMap>(
+            "Where r = reflect(−v, n) is looked up: a cube's face and texel, a sphere map (view space), or longitude and latitude.",
+        ),
+        "environment.dynamic" => doc(
+            "Cube maps rendered from each reflective object's centre, so it reflects the scene; off: the world's environment alone.",
+        ),
+        "environment.cube_size" => number("Texels on a side of each cube face the renderer makes.", 16.0, 2048.0),
+        "environment.refresh" => {
+            number("Draw the dynamic cubes again every N frames; 0: only when something they see changes.", 0.0, 600.0)
+        }
+        "environment.sphere_view" => choice::<SphereView>(
+            "The sphere map belongs to one view direction: fixed keeps the first frame's, follow makes it again for every frame.",
+        ),
+        "environment.view" => choice::<EnvironmentView>(
+            "Teaching views: the cube map unfolded as a cross, the sphere map, or the latitude–longitude map.",
         ),
         "raster" => doc(
             "How the rasterizer spends its time. None of these changes what a technique computes; each trades time for a measured difference.",

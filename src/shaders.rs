@@ -7,6 +7,7 @@ pub const COMMON: &[(&str, &str)] = &[
     ("common/lighting.wgsl", include_str!("../shaders/common/lighting.wgsl")),
     ("common/bump.wgsl", include_str!("../shaders/common/bump.wgsl")),
     ("common/shadow.wgsl", include_str!("../shaders/common/shadow.wgsl")),
+    ("common/environment.wgsl", include_str!("../shaders/common/environment.wgsl")),
 ];
 
 /// The scene pass and the transparent surfaces' entry points: one module, so that every variant
@@ -21,6 +22,7 @@ pub const MIPMAP: &str = include_str!("../shaders/mipmap.wgsl");
 pub const SHADOW: &str = include_str!("../shaders/shadow.wgsl");
 pub const SHADOW_PROJECTED: &str = include_str!("../shaders/shadow_projected.wgsl");
 pub const OVERLAYS: &str = include_str!("../shaders/overlays.wgsl");
+pub const ENVIRONMENT: &str = include_str!("../shaders/environment.wgsl");
 
 /// Every pass's own file, by name, for tests that validate them all.
 pub const PASSES: &[(&str, &str)] = &[
@@ -30,6 +32,7 @@ pub const PASSES: &[(&str, &str)] = &[
     ("shadow", SHADOW),
     ("shadow_projected", SHADOW_PROJECTED),
     ("overlays", OVERLAYS),
+    ("environment", ENVIRONMENT),
 ];
 
 /// The full source of a pass: the common files, then the pass's own.

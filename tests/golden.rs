@@ -51,6 +51,14 @@ fn facing_mirrors() {
     common::assert_golden("mirrors", &common::raster(&scene, &scene.settings), TOLERANCE);
 }
 
+/// Environment maps: the chrome ball and copper torus under the sky, with dynamic cubes.
+#[test]
+fn environment_stage_with_dynamic_cubes() {
+    let mut scene = common::load("scenes/environment.toml");
+    (scene.camera.width, scene.camera.height) = (480, 270);
+    common::assert_golden("environment", &common::raster(&scene, &scene.settings), TOLERANCE);
+}
+
 #[test]
 fn shadow_stage_with_shadow_maps() {
     let scene = common::load("scenes/shadows.toml");

@@ -9,7 +9,9 @@ use std::mem::{offset_of, size_of};
 use mirador::raster::scene_pass::{self, CONSTANT_NAMES, SHADOW_FILTER_NAMES, shadow_filter_code};
 use mirador::raster::shadow::views::MAX_LAYERS;
 use mirador::raster::shadow::{GpuShadowLayer, GpuShadows};
-use mirador::raster::uniforms::{self, GpuFrame, GpuInstance, GpuLight, GpuMaterial, GpuPresent, GpuView};
+use mirador::raster::uniforms::{
+    self, GpuEnvironment, GpuFrame, GpuInstance, GpuLight, GpuMaterial, GpuPresent, GpuView,
+};
 use mirador::shaders;
 
 fn parse(source: &str) -> naga::Module {
@@ -98,7 +100,7 @@ fn gpu_structs_match_their_wgsl_twins_field_by_field() {
         &scene,
         "View",
         size_of::<GpuView>(),
-        &fields!(GpuView { clip_from_world, eye, orthographic, view_axis, mirrored, clip_plane }),
+        &fields!(GpuView { clip_from_world, world_from_clip, eye, orthographic, view_axis, mirrored, clip_plane }),
     );
     check_struct(
         &scene,
@@ -133,6 +135,25 @@ fn gpu_structs_match_their_wgsl_twins_field_by_field() {
         size_of::<GpuShadowLayer>(),
         &fields!(GpuShadowLayer { clip_from_world, texel_size, perspective }),
     );
+    check_struct(
+        &scene,
+        "Environment",
+        size_of::<GpuEnvironment>(),
+        &fields!(GpuEnvironment {
+            sphere_from_world,
+            world_from_map,
+            zenith,
+            source,
+            horizon,
+            intensity,
+            ground,
+            sun_cos_outer,
+            sun_direction,
+            sun_cos_inner,
+            sun_color,
+            background,
+        }),
+    );
     check_struct(&scene, "Shadows", size_of::<GpuShadows>(), &fields!(GpuShadows { layers, map_size, normal_offset }));
     let present = structs(&parse(&shaders::compose(shaders::PRESENT)));
     check_struct(&present, "Present", size_of::<GpuPresent>(), &fields!(GpuPresent { exposure, scale }));
@@ -157,14 +178,18 @@ fn instance_attributes_match_the_wgsl_locations() {
     let rust: Vec<u32> = GpuInstance::ATTRIBUTES.iter().map(|a| a.shader_location).collect();
     assert_eq!(wgsl, rust);
     let offsets: Vec<u64> = GpuInstance::ATTRIBUTES.iter().map(|a| a.offset).collect();
-    assert_eq!(offsets, [0, 16, 32, 48, 64, 76, 88], "the matrix columns, then the normal matrix's");
-    assert_eq!(size_of::<GpuInstance>(), 100);
+    assert_eq!(
+        offsets,
+        [0, 16, 32, 48, 64, 76, 88, 100],
+        "the matrix columns, the normal matrix's, then the environment layer"
+    );
+    assert_eq!(size_of::<GpuInstance>(), 104);
 }
 
 #[test]
 fn codes_shared_by_rust_and_wgsl_agree() {
     let module = parse(&shaders::compose(shaders::SCENE));
-    let codes: [(&str, f64); 24] = [
+    let codes: [(&str, f64); 35] = [
         ("MAX_LIGHTS", uniforms::MAX_LIGHTS as f64),
         ("MAX_SHADOW_LAYERS", MAX_LAYERS as f64),
         ("LIGHT_POINT", uniforms::LIGHT_POINT.into()),
@@ -188,6 +213,17 @@ fn codes_shared_by_rust_and_wgsl_agree() {
         ("ALPHA_OPAQUE", uniforms::ALPHA_OPAQUE.into()),
         ("ALPHA_MASK", uniforms::ALPHA_MASK.into()),
         ("ALPHA_BLEND", uniforms::ALPHA_BLEND.into()),
+        ("ENV_LAYER_WORLD", uniforms::ENV_LAYER_WORLD.into()),
+        ("ENV_LAYER_NONE", uniforms::ENV_LAYER_NONE.into()),
+        ("ENV_NONE", uniforms::ENV_NONE.into()),
+        ("ENV_SKY", uniforms::ENV_SKY.into()),
+        ("ENV_LATLONG", uniforms::ENV_LATLONG.into()),
+        ("ENV_CUBE", uniforms::ENV_CUBE.into()),
+        ("ENV_SPHERE", uniforms::ENV_SPHERE.into()),
+        ("ENV_MAP_CUBE", scene_pass::ENV_MAP_CUBE.into()),
+        ("ENV_MAP_SPHERE", scene_pass::ENV_MAP_SPHERE.into()),
+        ("ENV_MAP_LATLONG", scene_pass::ENV_MAP_LATLONG.into()),
+        ("ENV_MAP_DYNAMIC", scene_pass::ENV_MAP_DYNAMIC.into()),
         ("MIP_PALETTE_LAST", (mirador::texture::mipmap::LEVEL_PALETTE.len() - 1) as f64),
     ];
     for (name, rust) in codes {

@@ -44,6 +44,8 @@ struct Light {
 // buffer, chosen by a dynamic offset, so a frame can draw from many cameras.
 struct View {
     clip_from_world: mat4x4f,
+    // Its inverse: the world-space ray through a pixel, for the background.
+    world_from_clip: mat4x4f,
     eye: vec3f,
     // 1 for an orthographic camera: then every view ray runs along -view_axis.
     orthographic: u32,
@@ -120,7 +122,13 @@ struct Instance {
     @location(8) normal_from_local_0: vec3f,
     @location(9) normal_from_local_1: vec3f,
     @location(10) normal_from_local_2: vec3f,
+    // Layer of the object's own cube among the dynamic environment cubes; ENV_LAYER_WORLD: the
+    // world's; ENV_LAYER_NONE: no lookup (planar mirrors reflect through their mirrored camera).
+    @location(11) env_layer: i32,
 }
+
+const ENV_LAYER_WORLD: i32 = -1;
+const ENV_LAYER_NONE: i32 = -2;
 
 fn instance_world_from_local(i: Instance) -> mat4x4f {
     return mat4x4f(i.world_from_local_0, i.world_from_local_1, i.world_from_local_2, i.world_from_local_3);

@@ -117,21 +117,31 @@ impl MipmapGenerator {
 
     /// Records into `encoder` the passes that fill levels `1..` of `texture` from level 0, each
     /// level from the unrounded level above (kept in a scratch chain made for this call and
-    /// released with the command buffer). Submit the encoder to run them; nothing else is needed
-    /// before sampling the texture in a later submission (or later in the same encoder).
+    /// released with the command buffer), for every array layer (a cube's six faces each get
+    /// their own chain). Submit the encoder to run them; nothing else is needed before sampling
+    /// the texture in a later submission (or later in the same encoder).
     ///
-    /// Panics (a programmer error) unless `texture` is 2D, single-layer, single-sample, and has
+    /// Panics (a programmer error) unless `texture` is 2D, single-sample, and has
     /// `TEXTURE_BINDING | RENDER_ATTACHMENT` usage with a renderable float format.
     pub fn record(&self, device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture) {
+        self.record_layers(device, encoder, texture, 0..texture.depth_or_array_layers());
+    }
+
+    /// [`MipmapGenerator::record`] for the array layers `layers` alone.
+    pub fn record_layers(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        texture: &wgpu::Texture,
+        layers: std::ops::Range<u32>,
+    ) {
         let levels = texture.mip_level_count();
-        if levels <= 1 {
+        if levels <= 1 || layers.is_empty() {
             return;
         }
         assert!(
-            texture.dimension() == wgpu::TextureDimension::D2
-                && texture.depth_or_array_layers() == 1
-                && texture.sample_count() == 1,
-            "mipmaps are generated for single-layer, single-sample 2D textures"
+            texture.dimension() == wgpu::TextureDimension::D2 && texture.sample_count() == 1,
+            "mipmaps are generated for single-sample 2D textures"
         );
         assert!(
             texture.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT),
@@ -139,8 +149,9 @@ impl MipmapGenerator {
         );
         let format = texture.format();
         let pipeline = self.pipeline(device, format);
-        let level1 = texture.size().mip_level_size(1, wgpu::TextureDimension::D2);
-        // Scratch level i holds texture level i + 1 before rounding.
+        let level1 =
+            wgpu::Extent3d { depth_or_array_layers: 1, ..texture.size().mip_level_size(1, wgpu::TextureDimension::D2) };
+        // Scratch level i holds texture level i + 1 before rounding; the layers take turns in it.
         let scratch = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("mipmap::scratch"),
             size: level1,
@@ -151,40 +162,49 @@ impl MipmapGenerator {
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
             view_formats: &[],
         });
-        let level_view = |texture: &wgpu::Texture, level: u32| {
+        let level_view = |texture: &wgpu::Texture, level: u32, layer: u32| {
             texture.create_view(&wgpu::TextureViewDescriptor {
                 label: Some("mipmap::level_view"),
                 format: Some(texture.format()),
                 dimension: Some(wgpu::TextureViewDimension::D2),
                 base_mip_level: level,
                 mip_level_count: Some(1),
+                base_array_layer: layer,
+                array_layer_count: Some(1),
                 ..Default::default()
             })
         };
         encoder.push_debug_group("mipmap");
-        for level in 1..levels {
-            let source = if level == 1 { level_view(texture, 0) } else { level_view(&scratch, level - 2) };
-            let targets = [level_view(&scratch, level - 1), level_view(texture, level)];
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("mipmap::bind_group"),
-                layout: &self.layout,
-                entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&source) }],
-            });
-            // Every texel is drawn, so the old contents need not be loaded.
-            let attachment = |view| Some(layout::color_attachment(view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)));
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("mipmap::pass"),
-                color_attachments: &[attachment(&targets[0]), attachment(&targets[1])],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.push_debug_group("mipmap level");
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &group, &[]);
-            pass.draw(0..3, 0..1);
-            pass.pop_debug_group();
+        for layer in layers {
+            for level in 1..levels {
+                let source =
+                    if level == 1 { level_view(texture, 0, layer) } else { level_view(&scratch, level - 2, 0) };
+                let targets = [level_view(&scratch, level - 1, 0), level_view(texture, level, layer)];
+                let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("mipmap::bind_group"),
+                    layout: &self.layout,
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&source),
+                    }],
+                });
+                // Every texel is drawn, so the old contents need not be loaded.
+                let attachment =
+                    |view| Some(layout::color_attachment(view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)));
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("mipmap::pass"),
+                    color_attachments: &[attachment(&targets[0]), attachment(&targets[1])],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.push_debug_group("mipmap level");
+                pass.set_pipeline(&pipeline);
+                pass.set_bind_group(0, &group, &[]);
+                pass.draw(0..3, 0..1);
+                pass.pop_debug_group();
+            }
         }
         encoder.pop_debug_group();
     }

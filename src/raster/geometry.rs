@@ -22,7 +22,7 @@ use std::ops::Range;
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
-use super::uniforms::{GpuInstance, Vertex};
+use super::uniforms::{ENV_LAYER_NONE, ENV_LAYER_WORLD, GpuInstance, Vertex};
 use crate::scene::{Camera, Mesh, Object, Projection, Scene, Shape};
 use crate::texture::tangents::tangents_or_generate;
 
@@ -170,13 +170,16 @@ pub struct Batch {
     pub material: usize,
     /// The material lets light through (kt > 0): it tints shadows rather than casting them.
     pub transparent: bool,
-    /// A planar mirror (its object's index) is a batch of its own: it shows its own reflection.
-    pub mirror: Option<usize>,
+    /// An object drawn alone (its index): a planar mirror, which shows its own reflection, or an
+    /// object with its own environment cube, which is left out of its cube's views.
+    pub alone: Option<usize>,
+    /// The object drawn alone is a planar mirror.
+    pub mirror: bool,
     pub instances: Range<u32>,
 }
 
-/// One object in the draw list: (transparent, material, mirror, mesh, instance, object index,
-/// world from mesh).
+/// One object in the draw list: (transparent, material, drawn alone, mesh, instance, object
+/// index, world from mesh).
 type Entry = (bool, usize, Option<usize>, MeshKey, GpuInstance, usize, Mat4);
 
 /// A transparent object, as the transparency pass draws it: alone, in an order of its choosing.
@@ -201,6 +204,8 @@ struct ObjectInfo {
     material: usize,
     transparent: bool,
     mirror: bool,
+    /// Its layer among the dynamic environment cubes.
+    env_layer: Option<u32>,
     curved_bounds: Option<(Vec3, Vec3)>,
 }
 
@@ -229,8 +234,9 @@ fn next_version() -> u64 {
 }
 
 impl SceneGeometry {
-    /// The geometry of `scene`, in which the objects listed in `mirrors` are planar mirrors.
-    pub fn new(scene: &Scene, mirrors: &[usize]) -> SceneGeometry {
+    /// The geometry of `scene`, in which the objects listed in `mirrors` are planar mirrors and
+    /// `env_objects[k]` has the dynamic environment cube `k`.
+    pub fn new(scene: &Scene, mirrors: &[usize], env_objects: &[usize]) -> SceneGeometry {
         let objects = scene
             .objects
             .iter()
@@ -239,6 +245,7 @@ impl SceneGeometry {
                 material: object.material.0,
                 transparent: scene.materials[object.material.0].is_transparent(),
                 mirror: mirrors.contains(&index),
+                env_layer: env_objects.iter().position(|&o| o == index).map(|k| k as u32),
                 curved_bounds: object.shape.curved_bounds(),
             })
             .collect();
@@ -290,19 +297,20 @@ impl SceneGeometry {
             .enumerate()
             .map(|(index, ((object, info), &n))| {
                 let (key, world_from_mesh) = instance_of(object, n);
-                let mirror = info.mirror.then_some(index);
+                let alone = (info.mirror || info.env_layer.is_some()).then_some(index);
                 (
                     info.transparent,
                     info.material,
-                    mirror,
+                    alone,
                     key,
-                    GpuInstance::new(world_from_mesh),
+                    GpuInstance::new(world_from_mesh, env_layer(info)),
                     index,
                     world_from_mesh,
                 )
             })
             .collect();
-        // Opaque first, then by material, mirror and mesh: runs of equal keys become one draw.
+        // Opaque first, then by material, object drawn alone and mesh: runs of equal keys become
+        // one draw.
         entries.sort_by(|a, b| {
             (a.0, a.1, a.2).cmp(&(b.0, b.1, b.2)).then_with(|| mesh_order(&a.3).cmp(&mesh_order(&b.3)))
         });
@@ -314,13 +322,13 @@ impl SceneGeometry {
         }
         self.batches.clear();
         self.transparent.clear();
-        for (index, (transparent, material, mirror, key, ..)) in entries.iter().enumerate() {
+        for (index, (transparent, material, alone, key, ..)) in entries.iter().enumerate() {
             let index = index as u32;
             match self.batches.last_mut() {
                 Some(b)
                     if b.transparent == *transparent
                         && b.material == *material
-                        && b.mirror == *mirror
+                        && b.alone == *alone
                         && b.mesh == *key =>
                 {
                     b.instances.end = index + 1;
@@ -329,7 +337,8 @@ impl SceneGeometry {
                     mesh: *key,
                     material: *material,
                     transparent: *transparent,
-                    mirror: *mirror,
+                    alone: *alone,
+                    mirror: alone.is_some_and(|o| self.objects[o].mirror),
                     instances: index..index + 1,
                 }),
             }
@@ -421,6 +430,15 @@ impl SceneGeometry {
 
     pub fn has_transparent(&self) -> bool {
         self.objects.iter().any(|o| o.transparent)
+    }
+}
+
+/// What an object's environment lookups read (`GpuInstance::env_layer`).
+fn env_layer(info: &ObjectInfo) -> i32 {
+    match (info.mirror, info.env_layer) {
+        (true, _) => ENV_LAYER_NONE,
+        (false, Some(layer)) => layer as i32,
+        (false, None) => ENV_LAYER_WORLD,
     }
 }
 

@@ -15,6 +15,7 @@
 //! Later techniques slot in where DESIGN.md puts them: environment captures and mirror views
 //! (more views, drawn by the same scene pass) before `opaque`; the sky after it.
 
+pub mod environment;
 pub mod geometry;
 pub mod mirror;
 pub mod overlays;
@@ -33,7 +34,8 @@ use crate::gpu::mipmap::MipmapGenerator;
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::{Gpu, readback};
 use crate::scene::Scene;
-use crate::settings::{MirrorView, Prepass, RenderSettings, ShadowMethod};
+use crate::settings::{EnvironmentView, MirrorView, Prepass, RenderSettings, ShadowMethod, TransparencySettings};
+use environment::{EnvironmentMaps, EnvironmentPass, capture_key, capture_range, cube_face_view, object_centre};
 use mirror::pass::{children, plan, volumes};
 use overlays::Overlays;
 use present::{PresentInput, PresentPass};
@@ -61,12 +63,15 @@ pub struct Renderer {
     transparency: TransparencyPass,
     overlays: Overlays,
     present: PresentPass,
+    environment: EnvironmentPass,
+    /// The target of the dynamic environment cubes' views, one face at a time.
+    capture_targets: Option<FrameTargets>,
     /// The targets of the mirrored views (`mirror::pass`), one per view of the largest frame so
     /// far.
     mirror_targets: Vec<MirrorTarget>,
-    /// The lighting inputs (group 2), and the (shadow maps, frame targets) generations they were
-    /// made for.
-    lighting: Option<((u64, u64), wgpu::BindGroup)>,
+    /// The lighting inputs (group 2), and the (shadow maps, frame targets, environment maps)
+    /// generations they were made for.
+    lighting: Option<((u64, u64, u64), wgpu::BindGroup)>,
     /// Submit and time each pass on its own (`render --stats`): slower, but it says where the
     /// frame's time goes.
     pub profile: bool,
@@ -104,6 +109,11 @@ pub struct FrameReport {
     pub transparency: TransparencyReport,
     /// Mirrored cameras drawn (planar mirrors and their reflections in each other).
     pub mirror_views: u32,
+    /// Faces of dynamic environment cubes drawn this frame (six per reflective object when they
+    /// were due, else none).
+    pub environment_faces: u32,
+    /// The sphere map was made this frame.
+    pub sphere_map_made: bool,
 }
 
 /// The frame's command encoder. When profiling, each pass is submitted and waited for on its
@@ -159,6 +169,8 @@ impl Renderer {
             transparency: TransparencyPass::new(device, &layouts),
             overlays: Overlays::new(device, &layouts),
             present: PresentPass::new(device, output_format),
+            environment: EnvironmentPass::new(device),
+            capture_targets: None,
             mirror_targets: Vec::new(),
             layouts,
             lighting: None,
@@ -191,6 +203,37 @@ impl Renderer {
         self.shadow.invalidate();
     }
 
+    /// Makes the environment maps `settings` ask for, writes their uniform and decides whether
+    /// the dynamic cubes are drawn this frame. Returns (cubes due, sphere map made).
+    fn prepare_environment(
+        &mut self,
+        gpu: &Gpu,
+        scene: &Scene,
+        scene_gpu: &mut SceneGpu,
+        settings: &RenderSettings,
+    ) -> (bool, bool) {
+        let env = &settings.environment;
+        if scene_gpu.environment.as_ref().is_none_or(|maps| maps.cube_size != env.cube_size) {
+            scene_gpu.environment = Some(EnvironmentMaps::new(
+                &gpu.device,
+                &gpu.queue,
+                &self.environment,
+                &self.mipmaps,
+                scene,
+                env.cube_size,
+                scene_gpu.env_objects.len(),
+            ));
+        }
+        let maps = scene_gpu.environment.as_mut().expect("made just above");
+        let rotation = environment::view_rotation(&scene.camera);
+        let sphere_made = maps.prepare(&gpu.device, &gpu.queue, &self.environment, &self.mipmaps, settings, rotation);
+        let drawn = env.enabled && env.dynamic && env.map == crate::settings::EnvironmentMap::Cube;
+        let cubes_due = (drawn || env.view == EnvironmentView::Cross)
+            && !scene_gpu.env_objects.is_empty()
+            && maps.capture_due(capture_key(scene, settings), env.refresh);
+        (cubes_due, sphere_made)
+    }
+
     /// Records and submits one frame of `scene` into `output`. `targets` are remade when the
     /// output's size times the render scale no longer matches them.
     pub fn render(
@@ -219,12 +262,14 @@ impl Renderer {
             settings.sphere_segments,
             settings.raster.adaptive_tessellation,
         );
-        let scene_gpu = &*scene_gpu;
         let shadows = &settings.shadows;
         let layout = shadow_layout_in(scene, scene_gpu.geometry.bounds, shadows);
         let main_view = View::of_camera(&scene.camera);
         scene_gpu.views.write(queue, ViewSlot::Main, &main_view);
         scene_gpu.update_frame(queue, scene, &layout.first_layer, settings);
+        let (cubes_due, sphere_map_made) = self.prepare_environment(gpu, scene, scene_gpu, settings);
+        let scene_gpu = &*scene_gpu;
+        let world = scene.environment.is_some();
 
         let projected = shadows.enabled && shadows.method == ShadowMethod::Projected;
         let prepass = projected
@@ -257,11 +302,16 @@ impl Renderer {
             scene_gpu.views.write(queue, ViewSlot::Mirror(k as u32), &node.view);
             self.mirror_targets[k].targets.scissor = Some(mirror::pass::scissor(node.window, size));
         }
-        // Object-precision shadows are a mask of the main view's pixels: mirrored views go without.
+        // Object-precision shadows are a mask of the main view's pixels: mirrored views and cube
+        // faces go without.
         let mirror_key = if projected { FrameKey { shadow_method: SHADOWS_OFF, ..frame_key } } else { frame_key };
         self.scene.prepare(device, frame_key, scene_gpu, prepass, !nodes.is_empty());
-        if !nodes.is_empty() {
-            self.scene.prepare(device, mirror_key, scene_gpu, false, true);
+        if !nodes.is_empty() || cubes_due {
+            self.scene.prepare(device, mirror_key, scene_gpu, false, !nodes.is_empty());
+        }
+        let cube_size = settings.environment.cube_size;
+        if cubes_due && self.capture_targets.as_ref().is_none_or(|t| t.size != (cube_size, cube_size)) {
+            self.capture_targets = Some(self.targets(device, (cube_size, cube_size)));
         }
 
         // Object precision draws no maps: its light views have no layers to fill.
@@ -271,7 +321,73 @@ impl Renderer {
         let maps = self.shadow.record(device, queue, &mut frame.encoder, scene_gpu, map_layout, shadows);
         let shadow_layers_drawn = maps.layers_drawn;
         frame.end("shadow maps");
-        let lighting = lighting_group(&mut self.lighting, device, &self.layouts, &maps, targets);
+        let env_maps = scene_gpu.environment.as_ref().expect("prepare_environment made them");
+        let lighting = lighting_group(
+            &mut self.lighting,
+            device,
+            &self.layouts,
+            &maps,
+            targets,
+            env_maps,
+            &self.environment.sampler,
+        );
+        // Dynamic environment cubes: six views from each reflective object's centre, the object
+        // itself left out, each copied into its layer; then their mip chains.
+        let mut environment_faces = 0;
+        if cubes_due {
+            let capture = self.capture_targets.as_ref().expect("made above when cubes are due");
+            // Per object the transparent surfaces are sorted as objects (one can be left out).
+            let transparency = TransparencySettings { ..settings.transparency };
+            for (k, &object) in scene_gpu.env_objects.iter().enumerate() {
+                let (centre, inner) = object_centre(scene, object);
+                let (near, far) = capture_range(inner, scene_gpu.geometry.bounds);
+                let images = MirrorImages { images: HashMap::new(), skip: Some(object) };
+                for face in 0..6 {
+                    let layer = (6 * k + face) as u32;
+                    let slot = ViewSlot::Cube(layer);
+                    let view = cube_face_view(centre, face, near, far);
+                    scene_gpu.views.write(queue, slot, &view);
+                    let capture_scene_targets = SceneTargets {
+                        hdr: &capture.hdr.view,
+                        depth: &capture.depth.view,
+                        background: scene.background,
+                        world,
+                        scissor: None,
+                    };
+                    self.scene.record_opaque(
+                        &mut frame.encoder,
+                        scene_gpu,
+                        lighting,
+                        slot,
+                        mirror_key,
+                        &capture_scene_targets,
+                        false,
+                        sorted_transparency,
+                        &images,
+                    );
+                    if sorted_transparency {
+                        self.transparency.record(
+                            device,
+                            queue,
+                            &mut frame.encoder,
+                            &self.scene,
+                            scene,
+                            scene_gpu,
+                            lighting,
+                            mirror_key,
+                            (slot, &view),
+                            capture,
+                            &transparency,
+                            Some(object),
+                        );
+                    }
+                    env_maps.store_capture(&mut frame.encoder, &capture.hdr.texture, layer);
+                    environment_faces += 1;
+                }
+            }
+            self.mipmaps.record(device, &mut frame.encoder, &env_maps.dynamic.texture);
+            frame.end("environment cubes");
+        }
         // Deepest first: every view's mirrors find their images drawn.
         let images_of = children(&nodes);
         for (k, node) in nodes.iter().enumerate().rev() {
@@ -283,6 +399,7 @@ impl Renderer {
                 hdr: &node_targets.hdr.view,
                 depth: &node_targets.depth.view,
                 background: scene.background,
+                world,
                 scissor: node_targets.scissor,
             };
             self.scene.record_opaque(
@@ -309,6 +426,7 @@ impl Renderer {
                     (slot, &node.view),
                     node_targets,
                     &settings.transparency,
+                    None,
                 );
             }
         }
@@ -336,6 +454,7 @@ impl Renderer {
             hdr: &targets.hdr.view,
             depth: &targets.depth.view,
             background: scene.background,
+            world,
             scissor: None,
         };
         self.scene.record_opaque(
@@ -364,12 +483,19 @@ impl Renderer {
                 (ViewSlot::Main, &main_view),
                 targets,
                 &settings.transparency,
+                None,
             );
             frame.end("transparency");
         }
         self.overlays.record(device, queue, &mut frame.encoder, shadows, scene_gpu, map_layout, &maps, targets);
         if mirrors.view == MirrorView::Camera && !nodes.is_empty() {
             self.overlays.record_volumes(device, &mut frame.encoder, scene_gpu, &volumes(&nodes), targets);
+        }
+        // The environment's teaching views, over the frame.
+        let env_view = settings.environment.view;
+        if env_view != EnvironmentView::Off {
+            let dynamic = settings.environment.dynamic;
+            env_maps.record_view(device, &mut frame.encoder, &self.environment, env_view, dynamic, &targets.hdr.view);
         }
         // The first mirror camera's own image, in place of the frame.
         let shown = match nodes.first() {
@@ -386,6 +512,8 @@ impl Renderer {
             drawn_size: size,
             transparency,
             mirror_views: nodes.len() as u32,
+            environment_faces,
+            sphere_map_made,
         }
     }
 }
@@ -415,13 +543,15 @@ fn mirror_images(
 /// Group 2 of the scene pass, built from the shadow pass's outputs and the frame's projected
 /// shadow mask; remade only when either is recreated.
 fn lighting_group<'c>(
-    cache: &'c mut Option<((u64, u64), wgpu::BindGroup)>,
+    cache: &'c mut Option<((u64, u64, u64), wgpu::BindGroup)>,
     device: &wgpu::Device,
     layouts: &SceneLayouts,
     maps: &ShadowMaps,
     targets: &FrameTargets,
+    environment: &EnvironmentMaps,
+    env_sampler: &wgpu::Sampler,
 ) -> &'c wgpu::BindGroup {
-    let key = (maps.generation, targets.generation);
+    let key = (maps.generation, targets.generation, environment.generation);
     if cache.as_ref().is_none_or(|(k, _)| *k != key) {
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("frame::lighting_group"),
@@ -434,6 +564,24 @@ fn lighting_group<'c>(
                 wgpu::BindGroupEntry {
                     binding: 4,
                     resource: wgpu::BindingResource::TextureView(&targets.shadow_mask.view),
+                },
+                wgpu::BindGroupEntry { binding: 5, resource: environment.params.binding() },
+                wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(env_sampler) },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: wgpu::BindingResource::TextureView(&environment.cube.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 8,
+                    resource: wgpu::BindingResource::TextureView(&environment.dynamic.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 9,
+                    resource: wgpu::BindingResource::TextureView(&environment.sphere.view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 10,
+                    resource: wgpu::BindingResource::TextureView(&environment.latlong.view),
                 },
             ],
         });

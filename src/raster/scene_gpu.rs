@@ -24,7 +24,7 @@ pub struct SceneLayouts {
     pub frame: wgpu::BindGroupLayout,
     /// Group 1: a material's uniform, textures and colour sampler.
     pub material: wgpu::BindGroupLayout,
-    /// Group 2: the shadow pass's outputs and how to read them.
+    /// Group 2: the shadow pass's outputs and how to read them, and the environment maps.
     pub lighting: wgpu::BindGroupLayout,
 }
 
@@ -50,6 +50,7 @@ impl SceneLayouts {
             ],
         });
         let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
+        let filterable = wgpu::TextureSampleType::Float { filterable: true };
         let lighting = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::lighting_layout"),
             entries: &[
@@ -58,6 +59,12 @@ impl SceneLayouts {
                 layout::sampler(2, wgpu::SamplerBindingType::Comparison),
                 layout::texture(3, unfilterable, wgpu::TextureViewDimension::D2Array),
                 layout::texture(4, unfilterable, wgpu::TextureViewDimension::D2),
+                layout::uniform(5, wgpu::ShaderStages::FRAGMENT),
+                layout::sampler(6, wgpu::SamplerBindingType::Filtering),
+                layout::texture(7, filterable, wgpu::TextureViewDimension::Cube),
+                layout::texture(8, filterable, wgpu::TextureViewDimension::CubeArray),
+                layout::texture(9, filterable, wgpu::TextureViewDimension::D2),
+                layout::texture(10, filterable, wgpu::TextureViewDimension::D2),
             ],
         });
         SceneLayouts { frame, material, lighting }
@@ -83,6 +90,10 @@ pub struct SceneGpu {
     pub transmittance: Vec<glam::Vec3>,
     /// The scene's planar mirrors (`super::mirror`).
     pub mirrors: Vec<Mirror>,
+    /// The objects with a dynamic environment cube, by layer (`super::environment`).
+    pub env_objects: Vec<usize>,
+    /// The environment maps, made by the renderer at the first frame (their size is a setting).
+    pub environment: Option<super::environment::EnvironmentMaps>,
     pub geometry: SceneGeometry,
 }
 
@@ -128,6 +139,11 @@ impl SceneGpu {
             }
             !transparent
         });
+        let mirror_objects: Vec<usize> = mirrors.iter().map(|m| m.object).collect();
+        let (env_objects, warnings) = super::environment::reflective_objects(scene, &mirror_objects);
+        for warning in warnings {
+            log::warn!("{warning}");
+        }
         // Every texture gets its whole mip chain, averaged in linear space (TECHNIQUES.md §2).
         let textures: Vec<GpuTexture> = scene
             .textures
@@ -173,8 +189,10 @@ impl SceneGpu {
             active: 0,
             material_keys: scene.materials.iter().map(MaterialKey::of).collect(),
             transmittance: scene.materials.iter().map(super::uniforms::transmittance).collect(),
-            geometry: SceneGeometry::new(scene, &mirrors.iter().map(|m| m.object).collect::<Vec<_>>()),
+            geometry: SceneGeometry::new(scene, &mirror_objects, &env_objects),
             mirrors,
+            env_objects,
+            environment: None,
         }
     }
 

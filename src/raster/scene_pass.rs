@@ -25,7 +25,10 @@ use super::view::ViewSlot;
 use super::{DEPTH_FORMAT, HDR_FORMAT};
 use crate::gpu::layout;
 use crate::scene::{Material, ProceduralHeight};
-use crate::settings::{BumpView, RenderSettings, ShadowFilter, ShadowMethod, ShadowView, TangentSource, TextureFilter};
+use crate::settings::{
+    BumpView, EnvironmentMap, EnvironmentSettings, RenderSettings, ShadowFilter, ShadowMethod, ShadowView,
+    TangentSource, TextureFilter,
+};
 use crate::shaders;
 
 /// The frame's toggles that switch shader code on or off (the `override`s of
@@ -42,7 +45,16 @@ pub struct FrameKey {
     pub tangents_per_vertex: bool,
     pub bump_analytic: bool,
     pub flat_colour: bool,
+    /// `ENV_MAP_*`: where curved mirrors look their reflection up; 0: nowhere.
+    pub environment: u32,
 }
+
+/// `ENVIRONMENT` codes: the world's cube, its sphere map, its lat–long map, or each reflective
+/// object's own dynamic cube (the world's for objects without one).
+pub const ENV_MAP_CUBE: u32 = 1;
+pub const ENV_MAP_SPHERE: u32 = 2;
+pub const ENV_MAP_LATLONG: u32 = 3;
+pub const ENV_MAP_DYNAMIC: u32 = 4;
 
 /// `SHADOW_METHOD`: no shadows at all (no light casts one, or shadows are off).
 pub const SHADOWS_OFF: u32 = 0;
@@ -73,7 +85,19 @@ impl FrameKey {
             tangents_per_vertex: settings.bump.tangents == TangentSource::PerVertex,
             bump_analytic: settings.bump.analytic,
             flat_colour: settings.raster.flat_colour,
+            environment: environment_code(&settings.environment),
         }
+    }
+}
+
+/// The `ENVIRONMENT` code of the environment settings.
+pub fn environment_code(settings: &EnvironmentSettings) -> u32 {
+    match (settings.enabled, settings.map, settings.dynamic) {
+        (false, ..) => 0,
+        (true, EnvironmentMap::Cube, false) => ENV_MAP_CUBE,
+        (true, EnvironmentMap::Cube, true) => ENV_MAP_DYNAMIC,
+        (true, EnvironmentMap::Sphere, _) => ENV_MAP_SPHERE,
+        (true, EnvironmentMap::Latlong, _) => ENV_MAP_LATLONG,
     }
 }
 
@@ -134,7 +158,7 @@ pub const HEIGHT_SINE: u32 = 2;
 pub const HEIGHT_NOISE: u32 = 3;
 
 /// The names of the pipeline constants, in the order [`constants`] gives their values.
-pub const CONSTANT_NAMES: [&str; 14] = [
+pub const CONSTANT_NAMES: [&str; 15] = [
     "SHADOW_METHOD",
     "SHADOW_FILTER",
     "SHADOW_TRANSMISSION",
@@ -145,6 +169,7 @@ pub const CONSTANT_NAMES: [&str; 14] = [
     "TANGENTS_PER_VERTEX",
     "BUMP_ANALYTIC",
     "FLAT_COLOUR",
+    "ENVIRONMENT",
     "COLOR_TEXTURE",
     "HEIGHT_KIND",
     "NORMAL_MAP",
@@ -152,8 +177,7 @@ pub const CONSTANT_NAMES: [&str; 14] = [
 ];
 
 /// The pipeline constants of one variant.
-/// The pipeline constants of one variant.
-pub fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f64); 14] {
+pub fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f64); 15] {
     let flag = |b: bool| f64::from(u8::from(b));
     let values = [
         f64::from(frame.shadow_method),
@@ -166,6 +190,7 @@ pub fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f6
         flag(frame.tangents_per_vertex),
         flag(frame.bump_analytic),
         flag(frame.flat_colour),
+        f64::from(frame.environment),
         flag(material.color_texture),
         f64::from(material.height_kind),
         flag(material.normal_map),
@@ -193,6 +218,9 @@ pub struct ScenePass {
     /// The prepass of cut-out materials (`ALPHA_MASK`): depth only where the surface is.
     prepass_masked: wgpu::RenderPipeline,
     shading: HashMap<ShadingKey, wgpu::RenderPipeline>,
+    /// The world where no surface is (`fs_background`), and its (empty) group 1.
+    background: wgpu::RenderPipeline,
+    empty_group: wgpu::BindGroup,
 }
 
 /// What tells shading variants apart: the depth test, the frame's toggles, the material's inputs
@@ -218,6 +246,8 @@ pub struct SceneTargets<'a> {
     pub depth: &'a wgpu::TextureView,
     /// Linear radiance where nothing is drawn.
     pub background: glam::Vec3,
+    /// Draw the world's environment where nothing is drawn (`fs_background`), over `background`.
+    pub world: bool,
     /// Draw only inside `[x, y, width, height]`; `None`: everywhere.
     pub scissor: Option<[u32; 4]>,
 }
@@ -280,9 +310,48 @@ impl ScenePass {
             ],
             immediate_size: 0,
         });
+        // Group 1 is an empty group, not a gap: lavapipe (Mesa 22) crashes compiling a shader
+        // that samples 2D textures of group 2 under a layout with no group 1.
+        let empty_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene::empty_layout"),
+            entries: &[],
+        });
+        let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene::empty_group"),
+            layout: &empty_layout,
+            entries: &[],
+        });
+        let background = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("scene::background_pipeline"),
+            layout: Some(&device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("scene::background_layout"),
+                bind_group_layouts: &[Some(&layouts.frame), Some(&empty_layout), Some(&layouts.lighting)],
+                immediate_size: 0,
+            })),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_background"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            // At the far plane, where nothing was drawn.
+            depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::LessEqual, false),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_background"),
+                compilation_options: Default::default(),
+                targets: &[Some(HDR_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
         ScenePass {
             module,
             layout,
+            background,
+            empty_group,
             mirror_group_layout,
             mirror_layout,
             prepass,
@@ -304,7 +373,7 @@ impl ScenePass {
         let depth = if after_prepass { DepthMode::Equal } else { DepthMode::Write };
         for batch in &scene.geometry.batches {
             let material = scene.material_keys[batch.material];
-            let variants: &[bool] = if mirrors && batch.mirror.is_some() { &[false, true] } else { &[false] };
+            let variants: &[bool] = if mirrors && batch.mirror { &[false, true] } else { &[false] };
             for &mirror in variants {
                 let key = (depth, frame, material, mirror);
                 if !self.shading.contains_key(&key) {
@@ -317,6 +386,8 @@ impl ScenePass {
 
     fn shading_pipeline(&self, device: &wgpu::Device, key: ShadingKey) -> wgpu::RenderPipeline {
         let (depth, frame, material, mirror) = key;
+        // A mirror drawn with its image reflects through it, not through an environment map.
+        let frame = if mirror { FrameKey { environment: 0, ..frame } } else { frame };
         let constants = constants(&frame, &material);
         let depth_state = match depth {
             DepthMode::Write => layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less, true),
@@ -439,12 +510,12 @@ impl ScenePass {
         // Batches come sorted by material: the pipeline changes only where the variant does.
         let mut current = None;
         for batch in scene.geometry.batches.iter().filter(|b| !(opaque_only && b.transparent)) {
-            if batch.mirror.is_some() && batch.mirror == mirrors.skip {
+            if batch.alone.is_some() && batch.alone == mirrors.skip {
                 continue;
             }
             pass.set_bind_group(1, &scene.materials()[batch.material], &[]);
             let material = scene.material_keys[batch.material];
-            let Some(object) = batch.mirror else {
+            let Some(object) = batch.alone.filter(|_| batch.mirror) else {
                 let key = (depth_mode, frame, material, false);
                 if current != Some(key) {
                     pass.set_pipeline(&self.shading[&key]);
@@ -468,6 +539,11 @@ impl ScenePass {
                 let count = scene.geometry.index_count(batch.mesh);
                 scene.geometry.draw_part(&mut pass, batch.mesh, part.unwrap_or(0..count), batch.instances.clone());
             }
+        }
+        if targets.world {
+            pass.set_pipeline(&self.background);
+            pass.set_bind_group(1, &self.empty_group, &[]);
+            pass.draw(0..3, 0..1);
         }
         pass.pop_debug_group();
     }

@@ -162,6 +162,7 @@ impl TransparencyPass {
         (slot, view): (ViewSlot, &View),
         targets: &FrameTargets,
         settings: &TransparencySettings,
+        skip: Option<usize>,
     ) -> TransparencyReport {
         let mut report = TransparencyReport::default();
         if scene_gpu.geometry.transparent.is_empty() {
@@ -173,10 +174,13 @@ impl TransparencyPass {
             object,
             winding: if objects[object].flipped != view.mirrored { faces.swapped() } else { faces },
         };
-        let draws: Vec<Draw> = match settings.sort {
-            TransparencySort::Unsorted => (0..objects.len()).map(|object| object_draw(object, Faces::Both)).collect(),
+        // An environment cube's views leave out the object they are drawn from (sorted per object).
+        let kept = (0..objects.len()).filter(|&i| Some(objects[i].object) != skip);
+        let sort = if skip.is_some() { TransparencySort::Object } else { settings.sort };
+        let draws: Vec<Draw> = match sort {
+            TransparencySort::Unsorted => kept.map(|object| object_draw(object, Faces::Both)).collect(),
             TransparencySort::Object => {
-                let mut order: Vec<usize> = (0..objects.len()).collect();
+                let mut order: Vec<usize> = kept.collect();
                 // Farthest first; a stable sort keeps the scene's order between equals.
                 order.sort_by(|&a, &b| {
                     let depth = |i: usize| (objects[i].centre - view.eye).dot(forward);
@@ -579,7 +583,7 @@ impl TriangleList {
             vertices: buffer("transparency::vertices", bytemuck::cast_slice(&vertices), wgpu::BufferUsages::VERTEX),
             identity: buffer(
                 "transparency::identity_instance",
-                bytemuck::bytes_of(&GpuInstance::new(Mat4::IDENTITY)),
+                bytemuck::bytes_of(&GpuInstance::new(Mat4::IDENTITY, super::uniforms::ENV_LAYER_WORLD)),
                 wgpu::BufferUsages::VERTEX,
             ),
             triangles,

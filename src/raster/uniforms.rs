@@ -201,6 +201,11 @@ impl Material {
     }
 }
 
+/// `Instance.env_layer` of objects that look the world's environment up.
+pub const ENV_LAYER_WORLD: i32 = -1;
+/// `Instance.env_layer` of objects that look nothing up (planar mirrors).
+pub const ENV_LAYER_NONE: i32 = -2;
+
 /// Per object: its transforms, as instance attributes (vertex buffer 1, `Instance` in
 /// `shaders/common/types.wgsl`).
 #[repr(C)]
@@ -209,12 +214,14 @@ pub struct GpuInstance {
     pub world_from_local: [[f32; 4]; 4],
     /// Inverse transpose of `world_from_local`'s upper 3×3, by columns.
     pub normal_from_local: [[f32; 3]; 3],
+    /// Layer of the object's own cube among the dynamic environment cubes; −1: the world's.
+    pub env_layer: i32,
 }
 
 impl GpuInstance {
-    pub const ATTRIBUTES: [wgpu::VertexAttribute; 7] = wgpu::vertex_attr_array![
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 8] = wgpu::vertex_attr_array![
         4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4,
-        8 => Float32x3, 9 => Float32x3, 10 => Float32x3,
+        8 => Float32x3, 9 => Float32x3, 10 => Float32x3, 11 => Sint32,
     ];
 
     pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
@@ -223,10 +230,14 @@ impl GpuInstance {
         attributes: &Self::ATTRIBUTES,
     };
 
-    pub fn new(world_from_local: Mat4) -> GpuInstance {
+    /// An instance whose environment lookups read `env_layer`: a dynamic cube's layer, or
+    /// [`ENV_LAYER_WORLD`], or [`ENV_LAYER_NONE`] for planar mirrors (their mirrored camera
+    /// reflects for them, and past `mirrors.depth` nothing does, as the tracer's `max_depth`).
+    pub fn new(world_from_local: Mat4, env_layer: i32) -> GpuInstance {
         GpuInstance {
             world_from_local: world_from_local.to_cols_array_2d(),
             normal_from_local: Mat3::from_mat4(world_from_local).inverse().transpose().to_cols_array_2d(),
+            env_layer,
         }
     }
 }
@@ -236,11 +247,47 @@ impl GpuInstance {
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuView {
     pub clip_from_world: [[f32; 4]; 4],
+    pub world_from_clip: [[f32; 4]; 4],
     pub eye: [f32; 3],
     pub orthographic: u32,
     pub view_axis: [f32; 3],
     pub mirrored: u32,
     pub clip_plane: [f32; 4],
+}
+
+/// `Environment.source` codes (`ENV_*` in `shaders/common/environment.wgsl`).
+pub const ENV_NONE: u32 = 0;
+pub const ENV_SKY: u32 = 1;
+pub const ENV_LATLONG: u32 = 2;
+pub const ENV_CUBE: u32 = 3;
+pub const ENV_SPHERE: u32 = 4;
+
+/// The world's environment and the sphere map's rotations (`Environment` in
+/// `shaders/common/environment.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct GpuEnvironment {
+    /// World to the sphere map's view space, for lookups (columns padded to four).
+    pub sphere_from_world: [[f32; 4]; 3],
+    /// Sphere-map view space to world, for making the map.
+    pub world_from_map: [[f32; 4]; 3],
+    pub zenith: [f32; 3],
+    pub source: u32,
+    pub horizon: [f32; 3],
+    pub intensity: f32,
+    pub ground: [f32; 3],
+    pub sun_cos_outer: f32,
+    pub sun_direction: [f32; 3],
+    pub sun_cos_inner: f32,
+    pub sun_color: [f32; 3],
+    pub _pad0: f32,
+    pub background: [f32; 3],
+    pub _pad1: f32,
+}
+
+/// A 3×3 matrix as WGSL's `mat3x3f` lays it out: columns of four floats.
+pub fn mat3_columns(m: Mat3) -> [[f32; 4]; 3] {
+    [m.x_axis.extend(0.0).to_array(), m.y_axis.extend(0.0).to_array(), m.z_axis.extend(0.0).to_array()]
 }
 
 #[repr(C)]

@@ -55,6 +55,7 @@ impl View {
     pub fn to_gpu(&self) -> GpuView {
         GpuView {
             clip_from_world: self.clip_from_world.to_cols_array_2d(),
+            world_from_clip: self.clip_from_world.inverse().to_cols_array_2d(),
             eye: self.eye.to_array(),
             orthographic: u32::from(self.orthographic),
             view_axis: self.view_axis.to_array(),
@@ -73,6 +74,8 @@ pub enum ViewSlot {
     ShadowLayer(u32),
     /// The `n`th mirrored camera of the frame (`super::mirror`).
     Mirror(u32),
+    /// Face `n % 6` of dynamic environment cube `n / 6` (`super::environment`).
+    Cube(u32),
 }
 
 impl ViewSlot {
@@ -81,12 +84,16 @@ impl ViewSlot {
             ViewSlot::Main => 0,
             ViewSlot::ShadowLayer(layer) => 1 + u64::from(layer),
             ViewSlot::Mirror(n) => 1 + super::shadow::views::MAX_LAYERS as u64 + u64::from(n),
+            ViewSlot::Cube(n) => 1 + super::shadow::views::MAX_LAYERS as u64 + MAX_MIRROR_VIEWS as u64 + u64::from(n),
         }
     }
 }
 
 /// Slots for every view a frame can hold.
-pub const VIEW_SLOTS: u64 = 1 + super::shadow::views::MAX_LAYERS as u64 + MAX_MIRROR_VIEWS as u64;
+pub const VIEW_SLOTS: u64 = 1
+    + super::shadow::views::MAX_LAYERS as u64
+    + MAX_MIRROR_VIEWS as u64
+    + 6 * super::environment::MAX_ENV_CUBES as u64;
 
 /// The most mirrored cameras one frame draws (mirrors that see each other, at every depth).
 pub const MAX_MIRROR_VIEWS: u32 = 32;

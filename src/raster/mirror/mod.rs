@@ -214,9 +214,9 @@ pub struct Mirror {
 ///
 /// A box with `kps > 0` is six planar mirrors, one per face (its `indices`).
 ///
-/// Warned about and skipped: curved shapes (spheres, tori, rounded boxes) and meshes that are not
-/// flat, for which environment maps are the technique; and mirrors with no area
-/// ([`DEGENERATE_AREA`]).
+/// Skipped: curved shapes (spheres, tori, rounded boxes), for which environment maps are the
+/// technique (`super::environment`); warned about and skipped: meshes that are not flat (they
+/// reflect through environment maps too) and mirrors with no area ([`DEGENERATE_AREA`]).
 pub fn find_mirrors(scene: &Scene) -> (Vec<Mirror>, Vec<String>) {
     let mut mirrors = Vec::new();
     let mut warnings = Vec::new();
@@ -227,12 +227,11 @@ pub fn find_mirrors(scene: &Scene) -> (Vec<Mirror>, Vec<String>) {
             continue;
         }
         let name = &object.name;
-        let curved = "environment maps are the technique for curved mirrors, so the rasterizer \
-                      draws it without its reflection";
+        let curved = "it reflects through an environment map instead";
         match object.shape {
-            Shape::Sphere { .. } | Shape::Torus { .. } | Shape::RoundedBox { .. } => warnings.push(format!(
-                "object `{name}`: a curved mirror (kps = {kps}) has no single mirrored camera; {curved}"
-            )),
+            // Curved mirrors have no single mirrored camera: environment maps reflect for them
+            // (`super::environment`).
+            Shape::Sphere { .. } | Shape::Torus { .. } | Shape::RoundedBox { .. } => {}
             // Each face of a box is a planar mirror of its own (`Mesh::cuboid` draws face `f` with
             // indices 6f..6f + 6).
             Shape::Cuboid { .. } => {
@@ -632,7 +631,7 @@ mod tests {
     }
 
     #[test]
-    fn a_rotated_plane_and_a_boxs_faces_are_mirrors_and_curved_shapes_warn() {
+    fn a_rotated_plane_and_a_boxs_faces_are_mirrors_and_curved_shapes_are_not() {
         let scene = scene(
             r#"
             [[objects]]
@@ -698,9 +697,10 @@ mod tests {
         let [a, b, c, _] = mirror.corners;
         assert!((b - a).cross(c - b).dot(mirror.plane.normal) > 0.0, "corners clockwise");
 
-        assert_eq!(warnings.len(), 2, "{warnings:#?}");
-        assert!(warnings[0].contains("`ball`") && warnings[0].contains("environment maps"), "{}", warnings[0]);
-        assert!(warnings[1].contains("`ring`") && warnings[1].contains("environment maps"), "{}", warnings[1]);
+        // The ball and the ring are no planar mirrors, and no mistake: environment maps reflect
+        // for them.
+        assert!(warnings.is_empty(), "{warnings:#?}");
+        assert!(mirrors.iter().all(|m| m.object != 2 && m.object != 4));
     }
 
     #[test]

@@ -1,0 +1,642 @@
+//! Environment maps (TECHNIQUES.md §6, seed 000 §1.5): the rasterizer cannot trace the mirror term
+//! `kps·MPS·L(r)` of a curved mirror, so it looks `L(r)` up in a map of the radiance arriving from
+//! every direction, made beforehand:
+//!
+//! - a **cube map**: six 90° images around a centre; `r` picks the face by its largest component
+//!   and the texel by the other two (the GPU's cube sampling, seamless across faces);
+//! - a **sphere map**: one image of a mirror ball seen along −Z, for one view (`r` in that view's
+//!   space picks the texel); made here from the cube, again for every frame or kept (then turning
+//!   the camera turns the reflections with it);
+//! - a **latitude–longitude map** (`α = a·u`, `β = b·v`), sampled with explicit gradients so its
+//!   wrap and its poles get the mip level of their neighbours.
+//!
+//! The world's environment (`[world.environment]`: the procedural sky, or a lat–long, cube or
+//! sphere-map image; `src/scene/environment.rs`) is turned into each form by one triangle per
+//! target (`shaders/environment.wgsl`), mipmapped by the same generator as the textures, and
+//! drawn as the background by the scene pass. **Dynamic cubes** are drawn from each reflective
+//! object's centre (six views of the rest of the scene, with the techniques that are on), so
+//! the object reflects its neighbours as well as the world; they are drawn again only when
+//! something they see changes, or every `refresh` frames.
+//!
+//! What the map cannot know: the cube holds the radiance arriving at one point, so a reflection
+//! of something near the object (parallax) is wrong away from the centre; reflections of the
+//! object in itself are missing; and a dynamic cube seen in another object's cube is a frame
+//! old (the first frame, it holds the world alone).
+
+use std::hash::{Hash, Hasher};
+
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+
+use super::uniforms::{ENV_CUBE, ENV_LATLONG, ENV_NONE, ENV_SKY, ENV_SPHERE, GpuEnvironment, mat3_columns};
+use super::view::View;
+use crate::gpu::layout;
+use crate::gpu::mipmap::{MipmapGenerator, mip_level_count};
+use crate::gpu::uniform::UniformBuffer;
+use crate::scene::environment::cube_direction;
+use crate::scene::{Camera, EnvImage, EnvironmentSource, Scene};
+use crate::settings::{EnvironmentMap, EnvironmentView, RenderSettings, SphereView};
+use crate::shaders;
+
+/// The most objects with a dynamic cube of their own (six views each); the others reflect the
+/// world's.
+pub const MAX_ENV_CUBES: usize = 8;
+
+/// Every environment map's format: linear radiance, filterable, up to 65,504.
+pub const ENV_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The largest lat–long and sphere maps made from a cube.
+const MAX_MADE_SIZE: u32 = 4096;
+
+/// The objects that get a dynamic cube: curved mirrors (`kps·MPS` non-zero) that are not planar
+/// mirrors, in the scene's order, at most [`MAX_ENV_CUBES`]; and warnings for those left out.
+pub fn reflective_objects(scene: &Scene, planar_mirrors: &[usize]) -> (Vec<usize>, Vec<String>) {
+    let mut objects: Vec<usize> = (0..scene.objects.len())
+        .filter(|&i| {
+            let material = &scene.materials[scene.objects[i].material.0];
+            material.mirror > 0.0 && material.mirror_color != Vec3::ZERO && !planar_mirrors.contains(&i)
+        })
+        .collect();
+    let mut warnings = Vec::new();
+    if objects.len() > MAX_ENV_CUBES {
+        warnings.push(format!(
+            "{} curved mirrors: the first {MAX_ENV_CUBES} get dynamic environment cubes, the others reflect the world's",
+            objects.len()
+        ));
+        objects.truncate(MAX_ENV_CUBES);
+    }
+    (objects, warnings)
+}
+
+/// The camera of cube face `face` (+X −X +Y −Y +Z −Z) at `centre`: 90° square, its image's
+/// columns along the face's `u` and its rows along `v`, as the cube lookup reads them. The
+/// faces' frame is left-handed (the cube is seen from inside), so the view is a mirrored one.
+pub fn cube_face_view(centre: Vec3, face: usize, near: f32, far: f32) -> View {
+    let forward = cube_direction(face, Vec2::splat(0.5));
+    // The face's edges, on the plane one unit along `forward`, from its centre.
+    let edge = |uv: Vec2| {
+        let d = cube_direction(face, uv);
+        d / d.dot(forward) - forward
+    };
+    let right = edge(Vec2::new(1.0, 0.5)).normalize();
+    let up = edge(Vec2::new(0.5, 0.0)).normalize();
+    let eye_frame = Mat3::from_cols(right, up, -forward);
+    let view_from_world = Mat4::from_mat3(eye_frame.transpose()) * Mat4::from_translation(-centre);
+    // The scene camera's perspective (src/scene/camera.rs) with a 90° square window: 2n wide.
+    let clip_from_view = Mat4::from_cols(
+        Vec4::new(1.0, 0.0, 0.0, 0.0),
+        Vec4::new(0.0, 1.0, 0.0, 0.0),
+        Vec4::new(0.0, 0.0, far / (near - far), -1.0),
+        Vec4::new(0.0, 0.0, near * far / (near - far), 0.0),
+    );
+    View {
+        clip_from_world: clip_from_view * view_from_world,
+        eye: centre,
+        orthographic: false,
+        view_axis: -forward,
+        mirrored: eye_frame.determinant() < 0.0,
+        clip_plane: None,
+    }
+}
+
+/// The world-to-view rotation of a camera: the sphere map's view space.
+pub fn view_rotation(camera: &Camera) -> Mat3 {
+    let frame = camera.frame();
+    Mat3::from_cols(frame.xe, frame.ye, frame.ze).transpose()
+}
+
+/// Where an object's dynamic cube is drawn from, the centre of its bounding box, and the
+/// distance from there to the box's nearest face (what lies nearer is inside the object).
+pub fn object_centre(scene: &Scene, object: usize) -> (Vec3, f32) {
+    let object = &scene.objects[object];
+    let local = object.shape.curved_bounds().unwrap_or_else(|| {
+        let mesh = scene.tessellate(object);
+        mesh.positions
+            .iter()
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+    });
+    let corners = (0..8).map(|k| {
+        let pick = |bit: usize, axis: usize| if k & bit == 0 { local.0[axis] } else { local.1[axis] };
+        object.world_from_local.transform_point3(Vec3::new(pick(1, 0), pick(2, 1), pick(4, 2)))
+    });
+    let (lo, hi) = corners
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (object.world_from_local.transform_point3(Vec3::ZERO), 0.0);
+    }
+    ((lo + hi) / 2.0, ((hi - lo) / 2.0).min_element())
+}
+
+/// The near and far planes of the cube views from inside an object whose box reaches `inner`
+/// from the centre, in a scene within `bounds`: the near plane half way to the object's surface
+/// (nothing the cube should see is nearer), the far one past the whole scene.
+pub fn capture_range(inner: f32, bounds: Option<(Vec3, Vec3)>) -> (f32, f32) {
+    let diagonal = bounds.map_or(1.0, |(lo, hi)| (hi - lo).length()).max(1e-3);
+    ((0.5 * inner).max(1e-5 * diagonal), 4.0 * diagonal)
+}
+
+/// The passes that make maps and draw the teaching views. Built once per device.
+pub struct EnvironmentPass {
+    group_layout: wgpu::BindGroupLayout,
+    to_cube: wgpu::RenderPipeline,
+    to_latlong: wgpu::RenderPipeline,
+    to_sphere: wgpu::RenderPipeline,
+    view_cross: wgpu::RenderPipeline,
+    view_sphere: wgpu::RenderPipeline,
+    view_latlong: wgpu::RenderPipeline,
+    /// Trilinear; u repeats (the lat–long map's wrap), v clamps.
+    pub sampler: wgpu::Sampler,
+}
+
+impl EnvironmentPass {
+    pub fn new(device: &wgpu::Device) -> EnvironmentPass {
+        let module = shaders::module(device, "environment::shader", shaders::ENVIRONMENT);
+        let filterable = wgpu::TextureSampleType::Float { filterable: true };
+        let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("environment::group_layout"),
+            entries: &[
+                layout::uniform(0, wgpu::ShaderStages::FRAGMENT),
+                layout::sampler(1, wgpu::SamplerBindingType::Filtering),
+                layout::texture(2, filterable, wgpu::TextureViewDimension::D2),
+                layout::texture(3, filterable, wgpu::TextureViewDimension::Cube),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("environment::layout"),
+            bind_group_layouts: &[Some(&group_layout)],
+            immediate_size: 0,
+        });
+        let pipeline = |fragment: &str, format: wgpu::TextureFormat| {
+            layout::fullscreen_pipeline(
+                device,
+                "environment::pipeline",
+                &pipeline_layout,
+                &module,
+                ("vs_convert", fragment),
+                &[Some(format.into())],
+            )
+        };
+        let hdr = super::HDR_FORMAT;
+        EnvironmentPass {
+            to_cube: pipeline("fs_to_cube", ENV_FORMAT),
+            to_latlong: pipeline("fs_to_latlong", ENV_FORMAT),
+            to_sphere: pipeline("fs_to_sphere", ENV_FORMAT),
+            view_cross: pipeline("fs_view_cross", hdr),
+            view_sphere: pipeline("fs_view_sphere", hdr),
+            view_latlong: pipeline("fs_view_latlong", hdr),
+            group_layout,
+            sampler: device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some("environment::sampler"),
+                address_mode_u: wgpu::AddressMode::Repeat,
+                address_mode_v: wgpu::AddressMode::ClampToEdge,
+                address_mode_w: wgpu::AddressMode::ClampToEdge,
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                mipmap_filter: wgpu::MipmapFilterMode::Linear,
+                ..Default::default()
+            }),
+        }
+    }
+
+    fn group(
+        &self,
+        device: &wgpu::Device,
+        params: &UniformBuffer<GpuEnvironment>,
+        source_2d: &wgpu::TextureView,
+        source_cube: &wgpu::TextureView,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("environment::group"),
+            layout: &self.group_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params.binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(source_2d) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(source_cube) },
+            ],
+        })
+    }
+
+    /// Draws `pipeline` over `target` once per instance in `instances` (a cube's faces).
+    fn draw(
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::RenderPipeline,
+        group: &wgpu::BindGroup,
+        target: &wgpu::TextureView,
+        instance: u32,
+    ) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("environment::pass"),
+            color_attachments: &[Some(layout::color_attachment(target, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, group, &[]);
+        pass.draw(0..3, instance..instance + 1);
+    }
+}
+
+/// A map texture and the view the scene pass samples it through.
+pub struct MapTexture {
+    pub texture: wgpu::Texture,
+    pub view: wgpu::TextureView,
+}
+
+impl MapTexture {
+    /// A map of `layers` layers (6 per cube) with a full mip chain, viewed as `dimension`.
+    fn new(
+        device: &wgpu::Device,
+        label: &str,
+        (width, height): (u32, u32),
+        layers: u32,
+        dimension: wgpu::TextureViewDimension,
+    ) -> MapTexture {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
+            mip_level_count: mip_level_count(width, height),
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: ENV_FORMAT,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some(label),
+            dimension: Some(dimension),
+            ..Default::default()
+        });
+        MapTexture { texture, view }
+    }
+
+    /// A 2D map holding `image` times `intensity` (clamped to what half floats hold).
+    fn upload(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, images: &[&EnvImage], intensity: f32) -> Self {
+        let (width, height) = (images[0].width, images[0].height);
+        let dimension =
+            if images.len() == 6 { wgpu::TextureViewDimension::Cube } else { wgpu::TextureViewDimension::D2 };
+        let map = MapTexture::new(device, label, (width, height), images.len() as u32, dimension);
+        for (layer, image) in images.iter().enumerate() {
+            let halves: Vec<u16> = image
+                .texels
+                .iter()
+                .flat_map(|&c| {
+                    let c = (c * intensity).clamp(Vec3::ZERO, Vec3::splat(65_000.0));
+                    [c.x, c.y, c.z, 1.0].map(|x| half::f16::from_f32(x).to_bits())
+                })
+                .collect();
+            queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &map.texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x: 0, y: 0, z: layer as u32 },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                bytemuck::cast_slice(&halves),
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(8 * width), rows_per_image: Some(height) },
+                wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            );
+        }
+        map
+    }
+
+    /// The view of one layer's level 0, to draw into.
+    fn layer(&self, layer: u32) -> wgpu::TextureView {
+        self.texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("environment::layer"),
+            dimension: Some(wgpu::TextureViewDimension::D2),
+            base_mip_level: 0,
+            mip_level_count: Some(1),
+            base_array_layer: layer,
+            array_layer_count: Some(1),
+            ..Default::default()
+        })
+    }
+
+    /// The six layers from `first` seen as one cube.
+    fn cube(&self, first: u32) -> wgpu::TextureView {
+        self.texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("environment::cube"),
+            dimension: Some(wgpu::TextureViewDimension::Cube),
+            base_array_layer: first,
+            array_layer_count: Some(6),
+            ..Default::default()
+        })
+    }
+
+    fn size(&self) -> u32 {
+        self.texture.width()
+    }
+}
+
+/// The scene's environment on the GPU: the world as a cube, a sphere map and a lat–long map, and
+/// the dynamic cubes of its reflective objects. Made at the first frame, again when
+/// `environment.cube_size` changes.
+pub struct EnvironmentMaps {
+    pub params: UniformBuffer<GpuEnvironment>,
+    /// The world's fields of the uniform (source, sky, background); the rotations change per frame.
+    world: GpuEnvironment,
+    pub cube: MapTexture,
+    pub sphere: MapTexture,
+    pub latlong: MapTexture,
+    /// Six layers per object of `SceneGpu::env_objects` (six for none, unused).
+    pub dynamic: MapTexture,
+    /// The sphere-map source image (a 1×1 stand-in for other sources).
+    sphere_source: MapTexture,
+    /// `environment.cube_size` when they were made.
+    pub cube_size: u32,
+    /// The view rotation the sphere map was last made for.
+    sphere_made_for: Option<Mat3>,
+    /// What the dynamic cubes were drawn from, and the frames since.
+    captured: Option<u64>,
+    frames_since_capture: u32,
+    /// Changes whenever a texture is remade: the scene pass's groups are remade with it.
+    pub generation: u64,
+}
+
+impl EnvironmentMaps {
+    /// Uploads the world's environment and makes its cube and lat–long forms; the dynamic cubes
+    /// start as copies of the world's cube.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        pass: &EnvironmentPass,
+        mipmaps: &MipmapGenerator,
+        scene: &Scene,
+        cube_size: u32,
+        dynamic_cubes: usize,
+    ) -> EnvironmentMaps {
+        let world = world_uniform(scene);
+        let params = UniformBuffer::new(device, "environment::params", &world);
+        let intensity = scene.environment.as_ref().map_or(1.0, |e| e.intensity);
+        let source = scene.environment.as_ref().map(|e| &e.source);
+        let (cube_face, map_size) = match source {
+            None => (4, 4),
+            Some(EnvironmentSource::Cube(faces)) => (faces[0].width, (2 * faces[0].width).min(MAX_MADE_SIZE / 2)),
+            Some(_) => (cube_size, (2 * cube_size).min(MAX_MADE_SIZE / 2)),
+        };
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("environment::encoder") });
+        let stand_in = |label| MapTexture::new(device, label, (1, 1), 1, wgpu::TextureViewDimension::D2);
+        let stand_in_cube =
+            MapTexture::new(device, "environment::no_cube", (1, 1), 6, wgpu::TextureViewDimension::Cube);
+        let sphere_source = match source {
+            Some(EnvironmentSource::Sphere(image)) => {
+                MapTexture::upload(device, queue, "environment::sphere_source", &[image], intensity)
+            }
+            _ => stand_in("environment::no_sphere_source"),
+        };
+        let latlong = match source {
+            Some(EnvironmentSource::LatLong(image)) => {
+                MapTexture::upload(device, queue, "environment::latlong", &[image], intensity)
+            }
+            _ => MapTexture::new(
+                device,
+                "environment::latlong",
+                (2 * map_size, map_size),
+                1,
+                wgpu::TextureViewDimension::D2,
+            ),
+        };
+        let cube = match source {
+            Some(EnvironmentSource::Cube(faces)) => {
+                let faces: Vec<&EnvImage> = faces.iter().collect();
+                MapTexture::upload(device, queue, "environment::cube", &faces, intensity)
+            }
+            _ => MapTexture::new(
+                device,
+                "environment::cube",
+                (cube_face, cube_face),
+                6,
+                wgpu::TextureViewDimension::Cube,
+            ),
+        };
+        // Sources first: their mip chains are what the conversions read.
+        mipmaps.record(device, &mut encoder, &sphere_source.texture);
+        let source_2d = match source {
+            Some(EnvironmentSource::Sphere(_)) => &sphere_source.view,
+            _ => &latlong.view,
+        };
+        match source {
+            Some(EnvironmentSource::LatLong(_)) => mipmaps.record(device, &mut encoder, &latlong.texture),
+            Some(EnvironmentSource::Cube(_)) => mipmaps.record(device, &mut encoder, &cube.texture),
+            _ => {}
+        }
+        if !matches!(source, Some(EnvironmentSource::Cube(_))) {
+            let group = pass.group(device, &params, source_2d, &stand_in_cube.view);
+            for face in 0..6 {
+                EnvironmentPass::draw(&mut encoder, &pass.to_cube, &group, &cube.layer(face), face);
+            }
+            mipmaps.record(device, &mut encoder, &cube.texture);
+        }
+        if !matches!(source, Some(EnvironmentSource::LatLong(_))) {
+            let group = pass.group(device, &params, &sphere_source.view, &cube.view);
+            EnvironmentPass::draw(&mut encoder, &pass.to_latlong, &group, &latlong.layer(0), 0);
+            mipmaps.record(device, &mut encoder, &latlong.texture);
+        }
+        let sphere =
+            MapTexture::new(device, "environment::sphere", (map_size, map_size), 1, wgpu::TextureViewDimension::D2);
+        let layers = 6 * dynamic_cubes.max(1) as u32;
+        let dynamic_size = if dynamic_cubes == 0 { 1 } else { cube_size };
+        let dynamic = MapTexture::new(
+            device,
+            "environment::dynamic",
+            (dynamic_size, dynamic_size),
+            layers,
+            wgpu::TextureViewDimension::CubeArray,
+        );
+        // Until it is drawn, each dynamic cube shows the world (a neighbour's cube seen in the
+        // first frame's captures is the world alone, not black).
+        if dynamic_cubes > 0 {
+            let group = pass.group(device, &params, source_2d, &cube.view);
+            for layer in 0..layers {
+                // The world's radiance at the dynamic cube's texels.
+                EnvironmentPass::draw(&mut encoder, &pass.to_cube, &group, &dynamic.layer(layer), layer % 6);
+            }
+            mipmaps.record(device, &mut encoder, &dynamic.texture);
+        }
+        queue.submit([encoder.finish()]);
+        EnvironmentMaps {
+            params,
+            world,
+            cube,
+            sphere,
+            latlong,
+            dynamic,
+            sphere_source,
+            cube_size,
+            sphere_made_for: None,
+            captured: None,
+            frames_since_capture: 0,
+            generation: next_generation(),
+        }
+    }
+
+    /// Writes the frame's uniform and makes the sphere map when it is due (submitted ahead of the
+    /// frame); returns whether it did.
+    /// `rotation` is the main camera's world-to-view rotation.
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        pass: &EnvironmentPass,
+        mipmaps: &MipmapGenerator,
+        settings: &RenderSettings,
+        rotation: Mat3,
+    ) -> bool {
+        let env = &settings.environment;
+        let wants_sphere = (env.enabled && env.map == EnvironmentMap::Sphere) || env.view == EnvironmentView::Sphere;
+        let remake = wants_sphere
+            && match (self.sphere_made_for, env.sphere_view) {
+                (None, _) => true,
+                (Some(made), SphereView::Follow) => made != rotation,
+                (Some(_), SphereView::Fixed) => false,
+            };
+        if remake {
+            self.sphere_made_for = Some(rotation);
+        }
+        let made_for = self.sphere_made_for.unwrap_or(rotation);
+        self.params.write(
+            queue,
+            &GpuEnvironment {
+                sphere_from_world: mat3_columns(rotation),
+                world_from_map: mat3_columns(made_for.transpose()),
+                ..self.world
+            },
+        );
+        if remake {
+            // The map is made from the world's cube, for the view `made_for`.
+            let mut encoder =
+                device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("environment::sphere") });
+            let group = pass.group(device, &self.params, &self.sphere_source.view, &self.cube.view);
+            EnvironmentPass::draw(&mut encoder, &pass.to_sphere, &group, &self.sphere.layer(0), 0);
+            mipmaps.record(device, &mut encoder, &self.sphere.texture);
+            queue.submit([encoder.finish()]);
+        }
+        remake
+    }
+
+    /// Whether the dynamic cubes are due for drawing, given what they would see (`key`); counts
+    /// the frame.
+    pub fn capture_due(&mut self, key: u64, refresh: u32) -> bool {
+        self.frames_since_capture += 1;
+        let due = self.captured != Some(key) || (refresh > 0 && self.frames_since_capture >= refresh);
+        if due {
+            self.captured = Some(key);
+            self.frames_since_capture = 0;
+        }
+        due
+    }
+
+    /// Forgets the dynamic cubes' contents, so the next frame draws them.
+    pub fn invalidate_captures(&mut self) {
+        self.captured = None;
+    }
+
+    /// Copies `image` (a capture target of the cube size) into layer `layer` of the dynamic cubes.
+    pub fn store_capture(&self, encoder: &mut wgpu::CommandEncoder, image: &wgpu::Texture, layer: u32) {
+        encoder.copy_texture_to_texture(
+            image.as_image_copy(),
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.dynamic.texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: 0, y: 0, z: layer },
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::Extent3d { width: self.dynamic.size(), height: self.dynamic.size(), depth_or_array_layers: 1 },
+        );
+    }
+
+    /// Draws the teaching view `view` over `target`: the cube unfolded (object 0's dynamic cube
+    /// when it has one, else the world's), the sphere map or the lat–long map.
+    pub fn record_view(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        pass: &EnvironmentPass,
+        view: EnvironmentView,
+        dynamic: bool,
+        target: &wgpu::TextureView,
+    ) {
+        let cube = if dynamic && self.dynamic.size() > 1 { self.dynamic.cube(0) } else { self.cube.cube(0) };
+        let (pipeline, source_2d) = match view {
+            EnvironmentView::Off => return,
+            EnvironmentView::Cross => (&pass.view_cross, &self.latlong.view),
+            EnvironmentView::Sphere => (&pass.view_sphere, &self.sphere.view),
+            EnvironmentView::Latlong => (&pass.view_latlong, &self.latlong.view),
+        };
+        let group = pass.group(device, &self.params, source_2d, &cube);
+        EnvironmentPass::draw(encoder, pipeline, &group, target, 0);
+    }
+}
+
+/// The world's part of the environment uniform.
+fn world_uniform(scene: &Scene) -> GpuEnvironment {
+    let identity = mat3_columns(Mat3::IDENTITY);
+    let mut gpu = GpuEnvironment {
+        sphere_from_world: identity,
+        world_from_map: identity,
+        zenith: [0.0; 3],
+        source: ENV_NONE,
+        horizon: [0.0; 3],
+        intensity: 1.0,
+        ground: [0.0; 3],
+        sun_cos_outer: 1.0,
+        sun_direction: [0.0, 1.0, 0.0],
+        sun_cos_inner: 1.0,
+        sun_color: [0.0; 3],
+        _pad0: 0.0,
+        background: scene.background.to_array(),
+        _pad1: 0.0,
+    };
+    let Some(environment) = &scene.environment else { return gpu };
+    gpu.intensity = environment.intensity;
+    gpu.source = match &environment.source {
+        EnvironmentSource::Sky(sky) => {
+            gpu.zenith = sky.zenith.to_array();
+            gpu.horizon = sky.horizon.to_array();
+            gpu.ground = sky.ground.to_array();
+            gpu.sun_direction = sky.sun_direction.normalize().to_array();
+            gpu.sun_color = sky.sun_color.to_array();
+            gpu.sun_cos_inner = sky.sun_radius.cos();
+            gpu.sun_cos_outer = (1.5 * sky.sun_radius).cos();
+            ENV_SKY
+        }
+        EnvironmentSource::LatLong(_) => ENV_LATLONG,
+        EnvironmentSource::Cube(_) => ENV_CUBE,
+        EnvironmentSource::Sphere(_) => ENV_SPHERE,
+    };
+    gpu
+}
+
+fn next_generation() -> u64 {
+    static GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    GENERATION.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// What the dynamic cubes see, hashed: every object's transform, every material, light and
+/// setting (the camera is left out: the cubes do not depend on it).
+pub fn capture_key(scene: &Scene, settings: &RenderSettings) -> u64 {
+    let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    for object in &scene.objects {
+        object.world_from_local.to_cols_array().map(f32::to_bits).hash(&mut hasher);
+        object.material.0.hash(&mut hasher);
+    }
+    for material in &scene.materials {
+        bytemuck::bytes_of(&material.to_gpu()).hash(&mut hasher);
+    }
+    for light in &scene.lights {
+        bytemuck::bytes_of(&light.to_gpu()).hash(&mut hasher);
+    }
+    scene.ambient.to_array().map(f32::to_bits).hash(&mut hasher);
+    let settings = RenderSettings {
+        environment: crate::settings::EnvironmentSettings { view: EnvironmentView::Off, ..settings.environment },
+        ..settings.clone()
+    };
+    format!("{settings:?}").hash(&mut hasher);
+    hasher.finish()
+}
