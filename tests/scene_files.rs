@@ -684,7 +684,10 @@ fn the_showcase_loads_with_its_textures_lights_and_placed_mirror() {
     let c = &scene.camera;
     assert_eq!((c.eye, c.center), (Vec3::new(4.2, 1.8, 7.0), Vec3::new(-0.3, 0.7, 0.0)));
     assert_eq!((c.fovy_degrees, c.near, c.far, c.width, c.height), (50.0, 0.1, 400.0, 1280, 720));
-    assert_eq!(scene.background, Vec3::new(0.45, 0.6, 0.8));
+    // The world is a sky: what rays that hit nothing see, straight up, is its zenith.
+    let sky = scene.environment.as_ref().expect("the showcase's sky");
+    assert!(matches!(sky.source, mirador::scene::EnvironmentSource::Sky(_)));
+    assert!(scene.environment_radiance(Vec3::Y).abs_diff_eq(Vec3::new(0.3, 0.48, 0.8), 1e-6));
     assert_eq!(scene.objects.len(), 6);
     assert_eq!(scene.materials.len(), 6);
 
