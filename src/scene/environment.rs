@@ -28,7 +28,6 @@ use glam::{Vec2, Vec3};
 
 use super::SceneError;
 use crate::output::srgb_decode;
-use crate::scene::camera::Camera;
 
 /// A linear-radiance image, row 0 at the top, texel (x, y) at `texels[y * width + x]`.
 #[derive(Clone, Debug, PartialEq)]
@@ -385,11 +384,7 @@ pub fn from_image(path: &Path, image: image::DynamicImage) -> EnvImage {
     let linear = matches!(image, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
     let mut rgb = image.into_rgb32f();
     let (width, height) = rgb.dimensions();
-    let largest = width.max(height);
-    if largest > Camera::MAX_SIDE {
-        let scale = Camera::MAX_SIDE as f64 / largest as f64;
-        let fit = |side: u32| ((side as f64 * scale).round() as u32).clamp(1, Camera::MAX_SIDE);
-        let (w, h) = (fit(width), fit(height));
+    if let Some((w, h)) = super::texture::fitted_size(width, height) {
         log::warn!(
             "{}: the environment image is {width}×{height}, larger than the largest texture; downscaled to {w}×{h}",
             path.display()

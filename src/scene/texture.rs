@@ -32,11 +32,7 @@ pub fn load(path: &Path, color_space: ColorSpace) -> Result<Texture, SceneError>
 pub fn from_image(path: &Path, image: image::DynamicImage, color_space: ColorSpace) -> Texture {
     let mut rgba = image.into_rgba8();
     let (width, height) = rgba.dimensions();
-    let largest = width.max(height);
-    if largest > Camera::MAX_SIDE {
-        let scale = Camera::MAX_SIDE as f64 / largest as f64;
-        let fit = |side: u32| ((side as f64 * scale).round() as u32).clamp(1, Camera::MAX_SIDE);
-        let (w, h) = (fit(width), fit(height));
+    if let Some((w, h)) = fitted_size(width, height) {
         log::warn!(
             "{}: the image is {width}×{height}, larger than the largest texture; downscaled to {w}×{h}",
             path.display()
@@ -50,6 +46,18 @@ pub fn from_image(path: &Path, image: image::DynamicImage, color_space: ColorSpa
         rgba8: rgba.into_raw(),
         color_space,
     }
+}
+
+/// The size an image of `width × height` is downscaled to so that it fits the largest texture
+/// (its aspect kept), or `None` when it fits already.
+pub fn fitted_size(width: u32, height: u32) -> Option<(u32, u32)> {
+    let largest = width.max(height);
+    if largest <= Camera::MAX_SIDE {
+        return None;
+    }
+    let scale = Camera::MAX_SIDE as f64 / largest as f64;
+    let fit = |side: u32| ((side as f64 * scale).round() as u32).clamp(1, Camera::MAX_SIDE);
+    Some((fit(width), fit(height)))
 }
 
 /// The largest image side decoded at all: twice the largest texture (then downscaled).
