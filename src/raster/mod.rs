@@ -331,13 +331,23 @@ impl Renderer {
             env_maps,
             &self.environment.sampler,
         );
+        // Every view other than the main camera's draws the opaque surfaces (no prepass) and the
+        // transparent ones into its own targets.
+        let views = SecondaryViews {
+            device,
+            queue,
+            scene,
+            scene_gpu,
+            lighting,
+            frame: mirror_key,
+            transparency: sorted_transparency.then_some(&settings.transparency),
+            world,
+        };
         // Dynamic environment cubes: six views from each reflective object's centre, the object
         // itself left out, each copied into its layer; then their mip chains.
         let mut environment_faces = 0;
         if cubes_due {
             let capture = self.capture_targets.as_ref().expect("made above when cubes are due");
-            // Per object the transparent surfaces are sorted as objects (one can be left out).
-            let transparency = TransparencySettings { ..settings.transparency };
             for (k, &object) in scene_gpu.env_objects.iter().enumerate() {
                 let (centre, inner) = object_centre(scene, object);
                 let (near, far) = capture_range(inner, scene_gpu.geometry.bounds);
@@ -347,40 +357,14 @@ impl Renderer {
                     let slot = ViewSlot::Cube(layer);
                     let view = cube_face_view(centre, face, near, far);
                     scene_gpu.views.write(queue, slot, &view);
-                    let capture_scene_targets = SceneTargets {
-                        hdr: &capture.hdr.view,
-                        depth: &capture.depth.view,
-                        background: scene.background,
-                        world,
-                        scissor: None,
-                    };
-                    self.scene.record_opaque(
+                    views.record(
                         &mut frame.encoder,
-                        scene_gpu,
-                        lighting,
-                        slot,
-                        mirror_key,
-                        &capture_scene_targets,
-                        false,
-                        sorted_transparency,
+                        (&self.scene, &mut self.transparency),
+                        (slot, &view),
+                        capture,
                         &images,
+                        Some(object),
                     );
-                    if sorted_transparency {
-                        self.transparency.record(
-                            device,
-                            queue,
-                            &mut frame.encoder,
-                            &self.scene,
-                            scene,
-                            scene_gpu,
-                            lighting,
-                            mirror_key,
-                            (slot, &view),
-                            capture,
-                            &transparency,
-                            Some(object),
-                        );
-                    }
                     env_maps.store_capture(&mut frame.encoder, &capture.hdr.texture, layer);
                     environment_faces += 1;
                 }
@@ -391,44 +375,18 @@ impl Renderer {
         // Deepest first: every view's mirrors find their images drawn.
         let images_of = children(&nodes);
         for (k, node) in nodes.iter().enumerate().rev() {
-            let node_targets = &self.mirror_targets[k].targets;
             let mut images = mirror_images(scene_gpu, &self.mirror_targets, images_of.get(&Some(k)));
             images.skip = Some(scene_gpu.mirrors[node.mirror].object);
             let slot = ViewSlot::Mirror(k as u32);
-            let node_scene_targets = SceneTargets {
-                hdr: &node_targets.hdr.view,
-                depth: &node_targets.depth.view,
-                background: scene.background,
-                world,
-                scissor: node_targets.scissor,
-            };
-            self.scene.record_opaque(
+            let node_targets = &self.mirror_targets[k].targets;
+            views.record(
                 &mut frame.encoder,
-                scene_gpu,
-                lighting,
-                slot,
-                mirror_key,
-                &node_scene_targets,
-                false,
-                sorted_transparency,
+                (&self.scene, &mut self.transparency),
+                (slot, &node.view),
+                node_targets,
                 &images,
+                None,
             );
-            if sorted_transparency {
-                self.transparency.record(
-                    device,
-                    queue,
-                    &mut frame.encoder,
-                    &self.scene,
-                    scene,
-                    scene_gpu,
-                    lighting,
-                    mirror_key,
-                    (slot, &node.view),
-                    node_targets,
-                    &settings.transparency,
-                    None,
-                );
-            }
         }
         if !nodes.is_empty() {
             frame.end("mirror views");
@@ -514,6 +472,63 @@ impl Renderer {
             mirror_views: nodes.len() as u32,
             environment_faces,
             sphere_map_made,
+        }
+    }
+}
+
+/// What every view of a frame other than the main camera's (mirrored cameras, cube faces) is
+/// drawn with.
+struct SecondaryViews<'a> {
+    device: &'a wgpu::Device,
+    queue: &'a wgpu::Queue,
+    scene: &'a Scene,
+    scene_gpu: &'a SceneGpu,
+    lighting: &'a wgpu::BindGroup,
+    frame: FrameKey,
+    /// How transparent surfaces are sorted; `None`: they are drawn as opaque ones.
+    transparency: Option<&'a TransparencySettings>,
+    /// Draw the world's environment where nothing is.
+    world: bool,
+}
+
+impl SecondaryViews<'_> {
+    /// Draws the scene from `view` (in `slot`) into `targets`: opaque surfaces with the
+    /// reflections in `images` (no prepass), then the transparent ones, `skip` left out of them.
+    fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        (scene_pass, transparency): (&ScenePass, &mut TransparencyPass),
+        (slot, view): (ViewSlot, &View),
+        targets: &FrameTargets,
+        images: &MirrorImages,
+        skip: Option<usize>,
+    ) {
+        let scene_targets = SceneTargets {
+            hdr: &targets.hdr.view,
+            depth: &targets.depth.view,
+            background: self.scene.background,
+            world: self.world,
+            scissor: targets.scissor,
+        };
+        let sorted = self.transparency.is_some();
+        let (scene_gpu, lighting) = (self.scene_gpu, self.lighting);
+        scene_pass.record_opaque(encoder, scene_gpu, lighting, slot, self.frame, &scene_targets, false, sorted, images);
+        if let Some(settings) = self.transparency {
+            let scene = self.scene;
+            transparency.record(
+                self.device,
+                self.queue,
+                encoder,
+                scene_pass,
+                scene,
+                scene_gpu,
+                lighting,
+                self.frame,
+                (slot, view),
+                targets,
+                settings,
+                skip,
+            );
         }
     }
 }
