@@ -107,19 +107,11 @@ fn fs_view_cross(in: ConvertOut) -> @location(0) vec4f {
     return vec4f(radiance, 1.0);
 }
 
+// A 2D map (the sphere map, the lat–long map) as it is, at its own aspect.
 @fragment
-fn fs_view_sphere(in: ConvertOut) -> @location(0) vec4f {
-    let p = letterbox(in.uv, 1.0);
-    let radiance = textureSampleLevel(source_2d, env_sampler, p, 0.0).rgb;
-    if any(p < vec2f(0.0)) || any(p > vec2f(1.0)) {
-        return OUTSIDE;
-    }
-    return vec4f(radiance, 1.0);
-}
-
-@fragment
-fn fs_view_latlong(in: ConvertOut) -> @location(0) vec4f {
-    let p = letterbox(in.uv, 2.0);
+fn fs_view_image(in: ConvertOut) -> @location(0) vec4f {
+    let size = vec2f(textureDimensions(source_2d));
+    let p = letterbox(in.uv, size.x / size.y);
     let radiance = textureSampleLevel(source_2d, env_sampler, p, 0.0).rgb;
     if any(p < vec2f(0.0)) || any(p > vec2f(1.0)) {
         return OUTSIDE;

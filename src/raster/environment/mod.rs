@@ -141,8 +141,8 @@ pub struct EnvironmentPass {
     to_latlong: wgpu::RenderPipeline,
     to_sphere: wgpu::RenderPipeline,
     view_cross: wgpu::RenderPipeline,
-    view_sphere: wgpu::RenderPipeline,
-    view_latlong: wgpu::RenderPipeline,
+    /// A sphere or lat–long map shown as an image.
+    view_image: wgpu::RenderPipeline,
     /// Trilinear; u repeats (the lat–long map's wrap), v clamps.
     pub sampler: wgpu::Sampler,
 }
@@ -181,8 +181,7 @@ impl EnvironmentPass {
             to_latlong: pipeline("fs_to_latlong", ENV_FORMAT),
             to_sphere: pipeline("fs_to_sphere", ENV_FORMAT),
             view_cross: pipeline("fs_view_cross", hdr),
-            view_sphere: pipeline("fs_view_sphere", hdr),
-            view_latlong: pipeline("fs_view_latlong", hdr),
+            view_image: pipeline("fs_view_image", hdr),
             group_layout,
             sampler: device.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some("environment::sampler"),
@@ -566,8 +565,8 @@ impl EnvironmentMaps {
         let (pipeline, source_2d) = match view {
             EnvironmentView::Off => return,
             EnvironmentView::Cross => (&pass.view_cross, &self.latlong.view),
-            EnvironmentView::Sphere => (&pass.view_sphere, &self.sphere.view),
-            EnvironmentView::Latlong => (&pass.view_latlong, &self.latlong.view),
+            EnvironmentView::Sphere => (&pass.view_image, &self.sphere.view),
+            EnvironmentView::Latlong => (&pass.view_image, &self.latlong.view),
         };
         let group = pass.group(device, &self.params, source_2d, &cube);
         EnvironmentPass::draw(encoder, pipeline, &group, target, 0);
