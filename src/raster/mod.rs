@@ -453,7 +453,7 @@ impl Renderer {
         let env_view = settings.environment.view;
         if env_view != EnvironmentView::Off {
             let dynamic = settings.environment.dynamic;
-            env_maps.record_view(device, &mut frame.encoder, &self.environment, env_view, dynamic, &targets.hdr.view);
+            env_maps.record_view(&mut frame.encoder, &self.environment, env_view, dynamic, &targets.hdr.view);
         }
         // The first mirror camera's own image, in place of the frame.
         let shown = match nodes.first() {

@@ -337,6 +337,11 @@ impl MapTexture {
 /// `environment.cube_size` changes.
 pub struct EnvironmentMaps {
     pub params: UniformBuffer<GpuEnvironment>,
+    /// The conversion group that reads the world's source and its cube: the lat–long and sphere
+    /// maps are made through it.
+    reads_world: wgpu::BindGroup,
+    /// The teaching views' groups, made with the maps.
+    views: ViewGroups,
     /// The world's fields of the uniform (source, sky, background); the rotations change per frame.
     world: GpuEnvironment,
     pub cube: MapTexture,
@@ -344,8 +349,6 @@ pub struct EnvironmentMaps {
     pub latlong: MapTexture,
     /// Six layers per object of `SceneGpu::env_objects` (six for none, unused).
     pub dynamic: MapTexture,
-    /// The sphere-map source image (a 1×1 stand-in for other sources).
-    sphere_source: MapTexture,
     /// `environment.cube_size` when they were made.
     pub cube_size: u32,
     /// The view rotation the sphere map was last made for.
@@ -432,9 +435,10 @@ impl EnvironmentMaps {
             }
             mipmaps.record(device, &mut encoder, &cube.texture);
         }
+        // Reads the source, or the world's cube made from it (what the sphere map is made from).
+        let reads_world = pass.group(device, &params, &sphere_source.view, &cube.view);
         if !matches!(source, Some(EnvironmentSource::LatLong(_))) {
-            let group = pass.group(device, &params, &sphere_source.view, &cube.view);
-            EnvironmentPass::draw(&mut encoder, &pass.to_latlong, &group, &latlong.layer(0), 0);
+            EnvironmentPass::draw(&mut encoder, &pass.to_latlong, &reads_world, &latlong.layer(0), 0);
             mipmaps.record(device, &mut encoder, &latlong.texture);
         }
         let sphere =
@@ -459,14 +463,22 @@ impl EnvironmentMaps {
             mipmaps.record(device, &mut encoder, &dynamic.texture);
         }
         queue.submit([encoder.finish()]);
+        let dynamic_or_world = if dynamic_cubes > 0 { dynamic.cube(0) } else { cube.cube(0) };
+        let views = ViewGroups {
+            cross_world: pass.group(device, &params, &latlong.view, &cube.view),
+            cross_dynamic: pass.group(device, &params, &latlong.view, &dynamic_or_world),
+            sphere: pass.group(device, &params, &sphere.view, &cube.view),
+            latlong: pass.group(device, &params, &latlong.view, &cube.view),
+        };
         EnvironmentMaps {
+            reads_world,
+            views,
             params,
             world,
             cube,
             sphere,
             latlong,
             dynamic,
-            sphere_source,
             cube_size,
             sphere_made_for: None,
             captured: None,
@@ -511,8 +523,7 @@ impl EnvironmentMaps {
             // The map is made from the world's cube, for the view `made_for`.
             let mut encoder =
                 device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("environment::sphere") });
-            let group = pass.group(device, &self.params, &self.sphere_source.view, &self.cube.view);
-            EnvironmentPass::draw(&mut encoder, &pass.to_sphere, &group, &self.sphere.layer(0), 0);
+            EnvironmentPass::draw(&mut encoder, &pass.to_sphere, &self.reads_world, &self.sphere.layer(0), 0);
             mipmaps.record(device, &mut encoder, &self.sphere.texture);
             queue.submit([encoder.finish()]);
         }
@@ -554,23 +565,30 @@ impl EnvironmentMaps {
     /// when it has one, else the world's), the sphere map or the lat–long map.
     pub fn record_view(
         &self,
-        device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         pass: &EnvironmentPass,
         view: EnvironmentView,
         dynamic: bool,
         target: &wgpu::TextureView,
     ) {
-        let cube = if dynamic && self.dynamic.size() > 1 { self.dynamic.cube(0) } else { self.cube.cube(0) };
-        let (pipeline, source_2d) = match view {
+        let (pipeline, group) = match view {
             EnvironmentView::Off => return,
-            EnvironmentView::Cross => (&pass.view_cross, &self.latlong.view),
-            EnvironmentView::Sphere => (&pass.view_image, &self.sphere.view),
-            EnvironmentView::Latlong => (&pass.view_image, &self.latlong.view),
+            EnvironmentView::Cross if dynamic => (&pass.view_cross, &self.views.cross_dynamic),
+            EnvironmentView::Cross => (&pass.view_cross, &self.views.cross_world),
+            EnvironmentView::Sphere => (&pass.view_image, &self.views.sphere),
+            EnvironmentView::Latlong => (&pass.view_image, &self.views.latlong),
         };
-        let group = pass.group(device, &self.params, source_2d, &cube);
-        EnvironmentPass::draw(encoder, pipeline, &group, target, 0);
+        EnvironmentPass::draw(encoder, pipeline, group, target, 0);
     }
+}
+
+/// What each teaching view reads: the cube unfolded (the world's, or the first reflective
+/// object's), the sphere map, the lat–long map.
+struct ViewGroups {
+    cross_world: wgpu::BindGroup,
+    cross_dynamic: wgpu::BindGroup,
+    sphere: wgpu::BindGroup,
+    latlong: wgpu::BindGroup,
 }
 
 /// The world's part of the environment uniform.
