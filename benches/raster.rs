@@ -12,7 +12,11 @@
 //!    layer.
 //! 4. Planar mirrors (`assets/scenes/mirrors.toml`): one mirror, two facing mirrors at depths 1
 //!    to 4, each as a ratio to the frame with mirrors off, and the cost of each mirrored view.
-//! 5. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
+//! 5. Environment maps (`assets/scenes/environment.toml`, two curved mirrors): the frame with
+//!    each lookup (world cube, lat–long, sphere map, dynamic cubes kept) as a ratio to the frame
+//!    without lookups; a dynamic capture (six views per object) drawn every frame, and a sphere
+//!    map made every frame for a turning camera, as ratios to one plain frame.
+//! 6. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
 //!    about a million triangles: upload, frame, triangles, beside `trace` of the same scene.
 //!
 //! Times are wall-clock from submit to the queue being idle (the median of several frames after
@@ -26,7 +30,7 @@ use mirador::gpu::texture::GpuTexture;
 use mirador::raster::{FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer, drawn_size};
 use mirador::scene::sphereflake::{sphere_count, sphereflake_toml};
 use mirador::scene::{Attenuation, Light, LightKind, Mesh, Object, Shape};
-use mirador::settings::{Prepass, ShadowFit, TransparencySort};
+use mirador::settings::{EnvironmentMap, Prepass, ShadowFit, SphereView, TransparencySort};
 use mirador::trace::{RenderControl, Tracer};
 use mirador::{RenderSettings, Scene};
 
@@ -378,12 +382,92 @@ fn mirror_costs(gpu: &Gpu) {
     }
 }
 
+/// One case of an interleaved comparison: a name, the settings, and whether the camera turns a
+/// little every frame.
+struct EnvCase {
+    name: &'static str,
+    settings: RenderSettings,
+    turning: bool,
+}
+
+fn environment_costs(gpu: &Gpu) {
+    let mut scene = Scene::load(&mirador::scene::builtin_path("environment.toml")).expect("the environment scene");
+    scene.camera.width = 1280;
+    scene.camera.height = 720;
+    let base = scene.settings.clone();
+    let with = |f: &dyn Fn(&mut mirador::settings::EnvironmentSettings)| {
+        let mut s = base.clone();
+        f(&mut s.environment);
+        s
+    };
+    let still = |name, settings| EnvCase { name, settings, turning: false };
+    let turning = |name, settings| EnvCase { name, settings, turning: true };
+    let cases = [
+        still("no lookups (enabled = false)", with(&|e| e.enabled = false)),
+        still("world cube", with(&|e| e.dynamic = false)),
+        still("lat–long map", with(&|e| (e.map, e.dynamic) = (EnvironmentMap::Latlong, false))),
+        still("sphere map (fixed)", with(&|e| (e.map, e.dynamic) = (EnvironmentMap::Sphere, false))),
+        still("dynamic cubes, kept", with(&|e| e.dynamic = true)),
+        still("dynamic cubes, drawn every frame", with(&|e| (e.dynamic, e.refresh) = (true, 1))),
+        still("  the same at cube_size 128", with(&|e| (e.dynamic, e.refresh, e.cube_size) = (true, 1, 128))),
+        still("  the same at cube_size 512", with(&|e| (e.dynamic, e.refresh, e.cube_size) = (true, 1, 512))),
+        turning("sphere map (fixed), turning camera", with(&|e| (e.map, e.dynamic) = (EnvironmentMap::Sphere, false))),
+        turning(
+            "sphere map made every frame (follow), turning",
+            with(&|e| (e.map, e.dynamic, e.sphere_view) = (EnvironmentMap::Sphere, false, SphereView::Follow)),
+        ),
+    ];
+    // Interleaved rounds, as for the mirrors: the VM's speed drifts over seconds.
+    let mut benches: Vec<Bench> = cases.iter().map(|_| Bench::new(gpu, &scene)).collect();
+    let mut times = vec![Vec::new(); cases.len()];
+    let mut faces = vec![0; cases.len()];
+    let mut spheres = vec![0; cases.len()];
+    for round in 0..FRAMES + 2 {
+        let mut turned = scene.clone();
+        turned.camera.eye = glam::Quat::from_rotation_y(0.02 * (round + 1) as f32) * scene.camera.eye;
+        for (k, case) in cases.iter().enumerate() {
+            let (t, report) = benches[k].frame(if case.turning { &turned } else { &scene }, &case.settings);
+            if round >= 2 {
+                times[k].push(t);
+                faces[k] += report.environment_faces;
+                spheres[k] += u32::from(report.sphere_map_made);
+            }
+        }
+    }
+    let medians: Vec<f64> = times.into_iter().map(|t| median(t).as_secs_f64()).collect();
+    let plain = medians[0];
+    println!(
+        "\nenvironment maps, 1280×720, two curved mirrors, frames of every case interleaved, ratios to the frame \
+         without lookups"
+    );
+    for (k, case) in cases.iter().enumerate() {
+        let made = match (faces[k], spheres[k]) {
+            (0, 0) => String::new(),
+            (f, 0) => format!("   {} faces a frame", f as usize / FRAMES),
+            (_, m) => format!("   sphere map made in {m} of {FRAMES} frames"),
+        };
+        println!("{:>48} {:>9.1} ms {:>7.2}×{made}", case.name, medians[k] * 1e3, medians[k] / plain);
+    }
+    let name = |n: &str| cases.iter().position(|c| c.name == n).expect("a case of that name");
+    let capture = medians[name("dynamic cubes, drawn every frame")] - medians[name("dynamic cubes, kept")];
+    let objects = f64::from(faces[name("dynamic cubes, drawn every frame")]) / FRAMES as f64 / 6.0;
+    println!(
+        "{:>48} {:>9.1} ms {:>7.2}× a plain frame",
+        "one capture (six views of one object)",
+        capture / objects * 1e3,
+        capture / objects / plain
+    );
+    let sphere = medians[name("sphere map made every frame (follow), turning")]
+        - medians[name("sphere map (fixed), turning camera")];
+    println!("{:>48} {:>9.1} ms {:>7.2}× a plain frame", "one sphere-map generation", sphere * 1e3, sphere / plain);
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let quick = args.iter().any(|a| a == "--quick");
     // Section names on the command line run those sections alone:
     // `cargo bench --bench raster -- transparency`.
-    const SECTIONS: [&str; 5] = ["showcase", "shadows", "transparency", "mirrors", "growing"];
+    const SECTIONS: [&str; 6] = ["showcase", "shadows", "transparency", "mirrors", "environment", "growing"];
     let chosen: Vec<&str> = SECTIONS.into_iter().filter(|s| args.iter().any(|a| a == s)).collect();
     let run = |section: &str| chosen.is_empty() || chosen.contains(&section);
     let gpu = Gpu::headless().expect("the benchmark needs a graphics adapter");
@@ -399,6 +483,9 @@ fn main() {
     }
     if run("mirrors") {
         mirror_costs(&gpu);
+    }
+    if run("environment") {
+        environment_costs(&gpu);
     }
     if run("growing") {
         growing_scenes(&gpu, quick);

@@ -54,7 +54,8 @@ fn main() -> anyhow::Result<()> {
         raster("lat-long map", &scene, variant(&|s| s.environment.map = EnvironmentMap::Latlong)),
         Panel::new("ray traced", mirador::trace::render_image(&scene, &base)),
     ];
-    let view = |v: EnvironmentView| variant(&|s| s.environment.view = v);
+    // The maps over the whole panel (not inset), so the sheet shows them at their largest.
+    let view = |v: EnvironmentView| variant(&|s| (s.environment.view, s.environment.inset) = (v, false));
     // A sphere map made for the first camera, then seen from a turned one.
     let mut turned = scene.clone();
     turned.camera.eye = Vec3::new(1.5, 5.5, 3.5);

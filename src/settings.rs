@@ -164,6 +164,10 @@ pub struct EnvironmentSettings {
     pub sphere_view: SphereView,
     /// Teaching views.
     pub view: EnvironmentView,
+    /// Draw the teaching view in the frame's lower-right corner, the scene around it (in the
+    /// viewer, the lat–long view then marks the reflected direction under the cursor); off: over
+    /// the whole frame.
+    pub inset: bool,
 }
 
 impl Default for EnvironmentSettings {
@@ -176,6 +180,7 @@ impl Default for EnvironmentSettings {
             refresh: 0,
             sphere_view: SphereView::Fixed,
             view: EnvironmentView::Off,
+            inset: true,
         }
     }
 }

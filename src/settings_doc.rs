@@ -238,6 +238,9 @@ pub fn describe(key: &str) -> Option<FieldDoc> {
         "environment.view" => choice::<EnvironmentView>(
             "Teaching views: the cube map unfolded as a cross, the sphere map, or the latitude–longitude map.",
         ),
+        "environment.inset" => doc(
+            "Draw the teaching view in the frame's lower-right corner with the scene around it (in the viewer the latitude–longitude view then marks the reflected direction under the cursor); off: over the whole frame.",
+        ),
         "raster" => doc(
             "How the rasterizer spends its time. None of these changes what a technique computes; each trades time for a measured difference.",
         ),

@@ -128,6 +128,7 @@ fn the_cube_made_from_a_latlong_image_on_the_gpu_matches_the_cpu_lookup() {
     (scene.camera.width, scene.camera.height) = (400, 300);
     let mut settings = with_map(&scene, EnvironmentMap::Cube, false);
     settings.environment.view = EnvironmentView::Cross;
+    settings.environment.inset = false;
     settings.environment.cube_size = 128;
     let gpu = common::raster(&scene, &settings);
     // The CPU reference: each pixel of the cross, the cell's face and the pixel's place in it,

@@ -263,3 +263,82 @@ fn a_scene_file_changed_on_disk_is_reloaded() {
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(stderr.contains("changed on disk"), "the edited scene was reloaded: {stderr}");
 }
+
+/// Where the lat–long view's marker sits in a screenshot: the centroid of its magenta pixels
+/// inside the map's rectangle `map` (window pixels), or `None` when there are none.
+fn marker_centre(image: &image::RgbaImage, [x, y, w, h]: [u32; 4]) -> Option<glam::Vec2> {
+    let mut sum = glam::Vec2::ZERO;
+    let mut count = 0.0;
+    for j in y..y + h {
+        for i in x..x + w {
+            let [r, g, b, _] = image.get_pixel(i, j).0;
+            if r > 200 && g < 80 && b > 200 {
+                sum += glam::Vec2::new(i as f32 + 0.5, j as f32 + 0.5);
+                count += 1.0;
+            }
+        }
+    }
+    (count > 0.0).then(|| sum / count)
+}
+
+#[test]
+fn the_latlong_view_marks_the_direction_seen_under_the_cursor() {
+    use mirador::raster::environment::view_rect;
+    use mirador::scene::Shape;
+    use mirador::scene::environment::latlong_uv;
+
+    let dir = scratch("latlong");
+    let shots = [dir.join("ball.png"), dir.join("sky.png")];
+    // The cursor over the chrome ball (right of and above its centre), then over the sky.
+    let cursors = [glam::Vec2::new(280.5, 260.5), glam::Vec2::new(200.5, 40.5)];
+    let scene_path = mirador::scene::builtin_path("environment.toml");
+    let mut args: Vec<String> = ["--size", "1000x600", "--frames", "2"].map(String::from).to_vec();
+    args.push(scene_path.display().to_string());
+    for step in ["set environment.view=\"latlong\"".to_string(), "overlay off".to_string()].into_iter().chain(
+        cursors.iter().zip(&shots).flat_map(|(c, shot)| {
+            [format!("cursor {} {}", c.x, c.y), "wait 1".to_string(), format!("screenshot {}", shot.display())]
+        }),
+    ) {
+        args.extend(["--step".to_string(), step]);
+    }
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let output = viewer(&args, &dir);
+    succeeded(&output);
+    let views = views(&output);
+    assert_eq!(views.len(), 2, "two screenshots: {views:?}");
+
+    let mut scene = Scene::load(&scene_path).expect("the environment scene");
+    let view = views[0].1;
+    (scene.camera.width, scene.camera.height) = (view[2], view[3]);
+    let [mx, my, mw, mh] = view_rect((view[2], view[3]), 2.0, true);
+    let map = [view[0] + mx as u32, view[1] + my as u32, mw as u32, mh as u32];
+    let ball = scene.objects.iter().find(|o| o.name == "chrome ball").expect("the chrome ball");
+    let Shape::Sphere { center, radius } = ball.shape else { panic!("the chrome ball is a sphere") };
+    let center = ball.world_from_local.transform_point3(center);
+
+    // Expected directions, from the camera and the sphere alone: a reflection off the exact
+    // sphere, and the view ray itself over the background.
+    let expected = cursors.map(|c| {
+        let ray = scene.camera.ray_through(c.x, c.y);
+        let oc = ray.origin - center;
+        let b = oc.dot(ray.direction);
+        let disc = b * b - (oc.length_squared() - radius * radius);
+        if disc < 0.0 {
+            return ray.direction;
+        }
+        let p = ray.origin + (-b - disc.sqrt()) * ray.direction;
+        let n = (p - center).normalize();
+        ray.direction - 2.0 * ray.direction.dot(n) * n
+    });
+    assert!(expected[0].dot(expected[1]) < 0.95, "the two cursors see different directions");
+    for (k, (shot, d)) in shots.iter().zip(expected).enumerate() {
+        let image = image::open(shot).expect("the screenshot").into_rgba8();
+        let uv = latlong_uv(d);
+        let want = glam::Vec2::new(map[0] as f32 + uv.x * map[2] as f32, map[1] as f32 + uv.y * map[3] as f32);
+        let found = marker_centre(&image, map).unwrap_or_else(|| panic!("no marker on the map in {}", shot.display()));
+        assert!(
+            found.distance(want) < 2.0,
+            "cursor {k}: the marker is at {found}, the direction {d} maps to {want} (map {map:?})"
+        );
+    }
+}

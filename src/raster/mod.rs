@@ -452,8 +452,17 @@ impl Renderer {
         // The environment's teaching views, over the frame.
         let env_view = settings.environment.view;
         if env_view != EnvironmentView::Off {
-            let dynamic = settings.environment.dynamic;
-            env_maps.record_view(&mut frame.encoder, &self.environment, env_view, dynamic, &targets.hdr.view);
+            let env = &settings.environment;
+            let size = (targets.hdr.texture.width(), targets.hdr.texture.height());
+            env_maps.record_view(
+                &mut frame.encoder,
+                &self.environment,
+                env_view,
+                env.dynamic,
+                env.inset,
+                &targets.hdr.view,
+                size,
+            );
         }
         // The first mirror camera's own image, in place of the frame.
         let shown = match nodes.first() {

@@ -407,6 +407,7 @@ impl Viewer {
             Step::Help(on) => self.view.help_open = on,
             Step::Panel(on) => self.view.panel_open = on,
             Step::Overlay(on) => self.view.overlay_open = on,
+            Step::Cursor(pixel) => self.view.scripted_cursor = Some(pixel),
             Step::Wait(frames) => self.script.wait_frames = frames,
             Step::WaitTraced => self.script.wait_traced_since = Some(Instant::now()),
             Step::Screenshot(path) => self.screenshot = Some(path),

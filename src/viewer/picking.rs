@@ -1,8 +1,9 @@
 //! Picking: the object under a clicked pixel, found by casting that pixel's primary ray with the
 //! ray tracer's own geometry and accelerator — exact shapes, the same nearest-hit rule, so the
-//! object picked is the one both renderers draw there.
+//! object picked is the one both renderers draw there. The same ray gives the direction an
+//! environment map is read in at that pixel (the lat–long view's marker).
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 
 use crate::scene::Scene;
 use crate::trace::accel::{self, AccelKind, Accelerator};
@@ -38,4 +39,28 @@ impl Picker {
         let primitive = &self.primitives[hit.primitive as usize];
         Some(Picked { object: primitive.object(), material: primitive.material().0 })
     }
+
+    /// The direction the environment is seen in at image point `pixel`: `r = reflect(d, n)` at
+    /// the surface the primary ray `d` hits there (its shading normal turned to the viewer, as
+    /// the shaders turn it), or `d` itself where the ray hits nothing and the world is drawn.
+    pub fn seen_direction(&self, scene: &Scene, pixel: Vec2) -> SeenDirection {
+        let ray = scene.camera.ray_through(pixel.x, pixel.y);
+        let Some(hit) = self.accelerator.closest(&self.primitives, &ray, 0.0, f32::INFINITY) else {
+            return SeenDirection { direction: ray.direction, object: None };
+        };
+        let primitive = &self.primitives[hit.primitive as usize];
+        let surface = primitive.surface(&ray, hit.t);
+        let n = if surface.normal.dot(ray.direction) > 0.0 { -surface.normal } else { surface.normal };
+        let r = ray.direction - 2.0 * ray.direction.dot(n) * n;
+        SeenDirection { direction: r.normalize(), object: Some(primitive.object()) }
+    }
+}
+
+/// What [`Picker::seen_direction`] found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SeenDirection {
+    /// Unit, in world space.
+    pub direction: Vec3,
+    /// The object reflecting it (`Scene::objects`); `None` over the background.
+    pub object: Option<usize>,
 }

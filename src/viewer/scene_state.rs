@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant, SystemTime};
 
-use super::picking::{Picked, Picker};
+use super::picking::{Picked, Picker, SeenDirection};
 use crate::scene::Camera;
 use crate::{RenderSettings, Scene};
 
@@ -121,12 +121,22 @@ impl SceneState {
     /// Picks the object under `pixel` of the current camera's image, building the picker once
     /// per scene.
     pub fn pick(&mut self, pixel: glam::Vec2) -> Option<Picked> {
-        if self.picker.is_none() {
-            self.picker = Some(Picker::new(&self.scene));
-        }
-        let picker = self.picker.as_ref().expect("built just above");
-        self.picked = picker.pick(&self.scene, pixel);
-        self.picked
+        let picker = self.picker.get_or_insert_with(|| Picker::new(&self.scene));
+        let picked = picker.pick(&self.scene, pixel);
+        self.picked = picked;
+        picked
+    }
+
+    /// The direction the environment is seen in at `pixel` of an image of `size` pixels taken
+    /// by the current camera.
+    pub fn seen_direction(&mut self, pixel: glam::Vec2, size: (u32, u32)) -> SeenDirection {
+        let mut scene_camera = self.scene.camera.clone();
+        (scene_camera.width, scene_camera.height) = size;
+        let rendered = std::mem::replace(&mut self.scene.camera, scene_camera);
+        let picker = self.picker.get_or_insert_with(|| Picker::new(&self.scene));
+        let seen = picker.seen_direction(&self.scene, pixel);
+        self.scene.camera = rendered;
+        seen
     }
 
     /// The diagonal of the scene's bounds (1 for an empty scene): the scale of fly speeds.

@@ -12,6 +12,7 @@
 //! navigate fly | navigate orbit
 //! walk 0 0 1                    fly by (right, up, forward) scene units
 //! pick 320 200                  click the 3D view at this pixel (selects the object)
+//! cursor 320 200                 hold the mouse over this pixel (the lat–long view's marker)
 //! material kd=0.2               edit the picked object's material
 //! load FILE                     as if FILE were dropped on the window
 //! scale 0.5                     the render scale while the camera moves
@@ -44,6 +45,7 @@ pub enum Step {
     Navigate(Navigation),
     Walk(Vec3),
     Pick(Vec2),
+    Cursor(Vec2),
     Material(String),
     Load(PathBuf),
     Scale(f32),
@@ -100,12 +102,13 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
             }
             Step::Split(x)
         }
-        "orbit" | "pan" | "pick" => {
+        "orbit" | "pan" | "pick" | "cursor" => {
             let [x, y] = numbers(args).ok_or_else(|| fail("expected two numbers: x y in pixels"))?;
             let v = Vec2::new(x, y);
             match verb {
                 "orbit" => Step::Orbit(v),
                 "pan" => Step::Pan(v),
+                "cursor" => Step::Cursor(v),
                 _ => Step::Pick(v),
             }
         }

@@ -246,6 +246,12 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
             }
         },
     }
+    if model.view.mode == ViewMode::Raster {
+        let cursor = response.hover_pos().map(|p| (p - rect.min) * ppp).map(|p| Vec2::new(p.x, p.y));
+        if let Some(pixel) = model.view.scripted_cursor.or(cursor) {
+            latlong_marker(&painter, model, rect, ppp, pixel);
+        }
+    }
     if model.view.overlay_open {
         overlay(ui, model, rect);
     }
@@ -289,6 +295,52 @@ fn camera_input(ui: &egui::Ui, response: &egui::Response, rect: Rect, ppp: f32, 
         let p = (pos - rect.min) * ppp;
         output.pick = Some(Vec2::new(p.x, p.y));
     }
+}
+
+/// The colour of the lat–long view's marker: no sky, ground or environment map is magenta.
+pub const MARKER_COLOUR: Color32 = Color32::from_rgb(255, 0, 255);
+
+/// On the inset lat–long view (`environment.view = "latlong"`, `environment.inset`), marks the
+/// direction the environment is seen in at view pixel `pixel`: the reflected direction of the
+/// surface there, or the view ray over the background. The map is the world's, in world
+/// coordinates, so the mark lands where the mirror reads it (a dynamic cube reads the same
+/// direction from its own images).
+fn latlong_marker(painter: &egui::Painter, model: &mut UiModel, rect: Rect, ppp: f32, pixel: Vec2) {
+    use crate::settings::EnvironmentView;
+    let env = &model.settings.environment;
+    if env.view != EnvironmentView::Latlong || !env.inset {
+        return;
+    }
+    let size = ((rect.width() * ppp).round() as u32, (rect.height() * ppp).round() as u32);
+    if pixel.x < 0.0 || pixel.y < 0.0 || pixel.x >= size.0 as f32 || pixel.y >= size.1 as f32 {
+        return;
+    }
+    let [x, y, w, h] = crate::raster::environment::view_rect(size, 2.0, true);
+    let map = Rect::from_min_size(rect.min + egui::vec2(x, y) / ppp, egui::vec2(w, h) / ppp);
+    let at = rect.min + egui::vec2(pixel.x, pixel.y) / ppp;
+    if map.contains(at) {
+        return;
+    }
+    let seen = model.scene.seen_direction(pixel, size);
+    let uv = crate::scene::environment::latlong_uv(seen.direction);
+    let mark = map.min + egui::vec2(uv.x * map.width(), uv.y * map.height());
+    let stroke = |width: f32, colour: Color32| egui::Stroke::new(width, colour);
+    for (width, colour) in [(4.0, Color32::BLACK), (2.0, MARKER_COLOUR)] {
+        painter.circle_stroke(mark, 7.0, stroke(width, colour));
+        painter.line_segment([mark - egui::vec2(12.0, 0.0), mark - egui::vec2(4.0, 0.0)], stroke(width, colour));
+        painter.line_segment([mark + egui::vec2(4.0, 0.0), mark + egui::vec2(12.0, 0.0)], stroke(width, colour));
+    }
+    painter.circle_stroke(at, 4.0, stroke(2.0, MARKER_COLOUR));
+    let d = seen.direction;
+    let what = match seen.object.and_then(|o| model.scene.scene.objects.get(o)) {
+        Some(object) => format!("r reflected by `{}`", object.name),
+        None => "the view ray (background)".to_string(),
+    };
+    let text = format!("{what}\n({:+.2}, {:+.2}, {:+.2})", d.x, d.y, d.z);
+    let font = egui::FontId::proportional(12.0);
+    let anchor = Pos2::new(map.min.x + 4.0, map.min.y - 4.0);
+    painter.text(anchor + egui::vec2(1.0, 1.0), egui::Align2::LEFT_BOTTOM, &text, font.clone(), Color32::BLACK);
+    painter.text(anchor, egui::Align2::LEFT_BOTTOM, &text, font, Color32::WHITE);
 }
 
 /// The split view's divider: a line you can drag.

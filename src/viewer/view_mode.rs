@@ -53,6 +53,8 @@ pub struct ViewState {
     pub help_open: bool,
     /// The frame times in the view's corner.
     pub overlay_open: bool,
+    /// Where a script holds the mouse, in pixels of the view (over the real mouse).
+    pub scripted_cursor: Option<glam::Vec2>,
 }
 
 impl Default for ViewState {
@@ -64,6 +66,7 @@ impl Default for ViewState {
             panel_open: true,
             help_open: false,
             overlay_open: true,
+            scripted_cursor: None,
         }
     }
 }

@@ -223,18 +223,51 @@ impl EnvironmentPass {
         target: &wgpu::TextureView,
         instance: u32,
     ) {
+        Self::draw_into(encoder, pipeline, group, target, instance, None);
+    }
+
+    /// [`Self::draw`], into the rectangle `viewport` (`[x, y, w, h]` in pixels) over what the
+    /// target holds, or over the whole target, cleared, when `None`.
+    fn draw_into(
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::RenderPipeline,
+        group: &wgpu::BindGroup,
+        target: &wgpu::TextureView,
+        instance: u32,
+        viewport: Option<[f32; 4]>,
+    ) {
+        let load = if viewport.is_some() { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(wgpu::Color::BLACK) };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("environment::pass"),
-            color_attachments: &[Some(layout::color_attachment(target, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))],
+            color_attachments: &[Some(layout::color_attachment(target, load))],
             depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
+        if let Some([x, y, w, h]) = viewport {
+            pass.set_viewport(x, y, w, h, 0.0, 1.0);
+        }
         pass.set_pipeline(pipeline);
         pass.set_bind_group(0, group, &[]);
         pass.draw(0..3, instance..instance + 1);
     }
+}
+
+/// Where a teaching view of a map `aspect` times as wide as it is high sits in a frame of
+/// `size` pixels, as `[x, y, w, h]` in pixels: with `inset`, in the frame's lower-right corner,
+/// 40 % of its width (at most 60 % of its height) and at the map's own aspect, so the scene
+/// stays in view around it; otherwise the whole frame (the view letterboxes itself). The viewer
+/// marks directions on the lat–long view with the same rectangle.
+pub fn view_rect(size: (u32, u32), aspect: f32, inset: bool) -> [f32; 4] {
+    let (width, height) = (size.0 as f32, size.1 as f32);
+    if !inset {
+        return [0.0, 0.0, width, height];
+    }
+    let margin = (0.02 * width).round();
+    let w = (0.4 * width).min(0.6 * height * aspect).round().max(1.0);
+    let h = (w / aspect).round().max(1.0);
+    [(width - margin - w).max(0.0), (height - margin - h).max(0.0), w, h]
 }
 
 /// A map texture and the view the scene pass samples it through.
@@ -561,24 +594,30 @@ impl EnvironmentMaps {
         );
     }
 
-    /// Draws the teaching view `view` over `target`: the cube unfolded (object 0's dynamic cube
-    /// when it has one, else the world's), the sphere map or the lat–long map.
+    /// Draws the teaching view `view` over `target` (a frame of `size` pixels), inset in its
+    /// corner or over all of it ([`view_rect`]): the cube unfolded (object 0's dynamic cube when
+    /// it has one, else the world's), the sphere map or the lat–long map.
+    #[allow(clippy::too_many_arguments)]
     pub fn record_view(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         pass: &EnvironmentPass,
         view: EnvironmentView,
         dynamic: bool,
+        inset: bool,
         target: &wgpu::TextureView,
+        size: (u32, u32),
     ) {
-        let (pipeline, group) = match view {
+        let aspect = |map: &MapTexture| map.texture.width() as f32 / map.texture.height() as f32;
+        let (pipeline, group, aspect) = match view {
             EnvironmentView::Off => return,
-            EnvironmentView::Cross if dynamic => (&pass.view_cross, &self.views.cross_dynamic),
-            EnvironmentView::Cross => (&pass.view_cross, &self.views.cross_world),
-            EnvironmentView::Sphere => (&pass.view_image, &self.views.sphere),
-            EnvironmentView::Latlong => (&pass.view_image, &self.views.latlong),
+            EnvironmentView::Cross if dynamic => (&pass.view_cross, &self.views.cross_dynamic, 4.0 / 3.0),
+            EnvironmentView::Cross => (&pass.view_cross, &self.views.cross_world, 4.0 / 3.0),
+            EnvironmentView::Sphere => (&pass.view_image, &self.views.sphere, aspect(&self.sphere)),
+            EnvironmentView::Latlong => (&pass.view_image, &self.views.latlong, aspect(&self.latlong)),
         };
-        EnvironmentPass::draw(encoder, pipeline, group, target, 0);
+        let viewport = inset.then(|| view_rect(size, aspect, true));
+        EnvironmentPass::draw_into(encoder, pipeline, group, target, 0, viewport);
     }
 }
 
