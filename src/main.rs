@@ -357,7 +357,7 @@ fn ray_trace(
         println!("{}", tracer.accelerator_stats());
         println!("{trace_stats}");
     }
-    Ok(radiance.to_rgba8(scene.settings.exposure))
+    Ok(radiance.to_rgba8(mirador::output::OutputTransform::of(&scene.settings)))
 }
 
 fn trace(args: SceneArgs, trace_args: TraceArgs, output_path: &Path) -> anyhow::Result<()> {

@@ -1,9 +1,13 @@
-//! The output transform both renderers share: linear radiance × exposure, clamped to [0, 1],
-//! encoded as sRGB 8-bit. The rasterizer runs it in `shaders/present.wgsl` (the clamp in the
-//! shader, the encoding by the `Rgba8UnormSrgb` target); the ray tracer runs it here.
-//! `tests/output_transform.rs` checks that both give the same bytes.
+//! The output transform both renderers share: linear radiance × exposure, through a tone curve
+//! ([`ToneMap`]: the course's clamp to [0, 1] by default), encoded as sRGB 8-bit. The rasterizer
+//! runs it in `shaders/present.wgsl` (the curve in the shader, the encoding by the
+//! `Rgba8UnormSrgb` target); the ray tracer runs it here. `tests/output_transform.rs` checks that
+//! both give the same bytes for every curve.
 
 use glam::Vec3;
+
+use crate::RenderSettings;
+use crate::settings::ToneMap;
 
 /// The sRGB transfer function (IEC 61966-2-1) of a linear value in [0, 1].
 pub fn srgb_encode(linear: f32) -> f32 {
@@ -15,21 +19,80 @@ pub fn srgb_decode(encoded: f32) -> f32 {
     if encoded <= 0.040_45 { encoded / 12.92 } else { ((encoded + 0.055) / 1.055).powf(2.4) }
 }
 
-/// One pixel through the output transform. NaN maps to 0.
+/// Exposure and tone curve: what turns linear radiance into display values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OutputTransform {
+    pub exposure: f32,
+    pub tone_map: ToneMap,
+}
+
+impl OutputTransform {
+    /// The course's transform: × `exposure`, then the clamp.
+    pub fn clamp(exposure: f32) -> OutputTransform {
+        OutputTransform { exposure, tone_map: ToneMap::Clamp }
+    }
+
+    pub fn of(settings: &RenderSettings) -> OutputTransform {
+        OutputTransform { exposure: settings.exposure, tone_map: settings.tone_map }
+    }
+
+    /// Linear display values in [0, 1] for `radiance`. NaN maps to 0, negative values to 0.
+    pub fn display(&self, radiance: Vec3) -> Vec3 {
+        let c = (radiance * self.exposure).to_array().map(|c| if c.is_nan() { 0.0 } else { c.max(0.0) });
+        tone_map(Vec3::from(c), self.tone_map)
+    }
+
+    /// One pixel, encoded.
+    pub fn to_srgb8(&self, radiance: Vec3) -> [u8; 3] {
+        self.display(radiance).to_array().map(|c| (srgb_encode(c) * 255.0).round() as u8)
+    }
+}
+
+/// The tone curve `curve` at exposed, non-negative radiance `c`; the result lies in [0, 1].
+pub fn tone_map(c: Vec3, curve: ToneMap) -> Vec3 {
+    let mapped = match curve {
+        ToneMap::Clamp => c,
+        ToneMap::Reinhard => c / (Vec3::ONE + c),
+        // Narkowicz (2015), "ACES Filmic Tone Mapping Curve": a rational fit of the ACES
+        // reference rendering and output transforms, applied per channel.
+        ToneMap::Aces => (c * (2.51 * c + 0.03)) / (c * (2.43 * c + 0.59) + 0.14),
+        ToneMap::PbrNeutral => pbr_neutral(c),
+    };
+    mapped.clamp(Vec3::ZERO, Vec3::ONE)
+}
+
+/// Khronos PBR Neutral (Khronos 3D Commerce, 2024): a small toe offset, identity up to
+/// `1 − 0.24` on the brightest channel, then a rational shoulder towards 1 that keeps the hue and
+/// desaturates towards white as it compresses.
+fn pbr_neutral(c: Vec3) -> Vec3 {
+    const START_COMPRESSION: f32 = 0.8 - 0.04;
+    const DESATURATION: f32 = 0.15;
+    let x = c.min_element();
+    let offset = if x < 0.08 { x - 6.25 * x * x } else { 0.04 };
+    let c = c - Vec3::splat(offset);
+    let peak = c.max_element();
+    if peak < START_COMPRESSION {
+        return c;
+    }
+    let d = 1.0 - START_COMPRESSION;
+    let new_peak = 1.0 - d * d / (peak + d - START_COMPRESSION);
+    let c = c * (new_peak / peak);
+    let g = 1.0 - 1.0 / (DESATURATION * (peak - new_peak) + 1.0);
+    c.lerp(Vec3::splat(new_peak), g)
+}
+
+/// One pixel through the course's transform (exposure, clamp, sRGB).
 pub fn to_srgb8(radiance: Vec3, exposure: f32) -> [u8; 3] {
-    (radiance * exposure).to_array().map(|c| {
-        let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
-        (srgb_encode(c) * 255.0).round() as u8
-    })
+    OutputTransform::clamp(exposure).to_srgb8(radiance)
 }
 
 /// A whole image of linear radiance, row-major from the top, to an RGBA8 image.
-pub fn encode_image(width: u32, height: u32, radiance: &[Vec3], exposure: f32) -> image::RgbaImage {
+pub fn encode_image(width: u32, height: u32, radiance: &[Vec3], transform: OutputTransform) -> image::RgbaImage {
     assert_eq!(radiance.len(), (width * height) as usize, "one radiance value per pixel");
     let bytes = radiance
         .iter()
         .flat_map(|&c| {
-            let [r, g, b] = to_srgb8(c, exposure);
+            let [r, g, b] = transform.to_srgb8(c);
             [r, g, b, 255]
         })
         .collect();
@@ -69,6 +132,45 @@ mod tests {
         for i in 0..=255 {
             let encoded = i as f32 / 255.0;
             assert!((srgb_encode(srgb_decode(encoded)) - encoded).abs() < 1e-5);
+        }
+    }
+
+    fn curve(c: f32, tone_map: ToneMap) -> f32 {
+        super::tone_map(Vec3::splat(c), tone_map).x
+    }
+
+    #[test]
+    fn tone_curves_at_known_points() {
+        // Clamp: the identity on [0, 1], white above.
+        assert_eq!(curve(0.5, ToneMap::Clamp), 0.5);
+        assert_eq!(curve(3.0, ToneMap::Clamp), 1.0);
+        // Reinhard: c / (1 + c).
+        assert_eq!(curve(1.0, ToneMap::Reinhard), 0.5);
+        assert!((curve(0.18, ToneMap::Reinhard) - 0.18 / 1.18).abs() < 1e-7);
+        assert!(curve(1e6, ToneMap::Reinhard) < 1.0);
+        // ACES fit: 0 at 0, (2.51 + 0.03) / (2.43 + 0.59 + 0.14) at 1, white from about 10.
+        assert_eq!(curve(0.0, ToneMap::Aces), 0.0);
+        assert!((curve(1.0, ToneMap::Aces) - 2.54 / 3.16).abs() < 1e-6);
+        assert!(curve(0.18, ToneMap::Aces) > 0.25 && curve(0.18, ToneMap::Aces) < 0.27);
+        assert_eq!(curve(12.0, ToneMap::Aces), 1.0);
+        // PBR Neutral: grey 0.5 passes minus the 0.04 offset; the shoulder starts at 0.76 + 0.04;
+        // its limit is 1.
+        assert!((curve(0.5, ToneMap::PbrNeutral) - 0.46).abs() < 1e-6);
+        assert!((curve(0.79, ToneMap::PbrNeutral) - 0.75).abs() < 1e-6);
+        let at_one = curve(1.0, ToneMap::PbrNeutral);
+        assert!(at_one > 0.8 && at_one < 0.9, "{at_one}");
+        assert!(curve(100.0, ToneMap::PbrNeutral) > 0.99);
+        // A saturated highlight desaturates towards white: its weakest channel rises.
+        let red = super::tone_map(Vec3::new(8.0, 0.5, 0.5), ToneMap::PbrNeutral);
+        assert!(red.y > 0.46 + 0.05, "{red}");
+        // Every curve is monotonic and stays in [0, 1].
+        for tone_map in [ToneMap::Clamp, ToneMap::Reinhard, ToneMap::Aces, ToneMap::PbrNeutral] {
+            let mut last = 0.0;
+            for i in 0..=2000 {
+                let y = curve(i as f32 * 0.01, tone_map);
+                assert!((0.0..=1.0).contains(&y) && y >= last - 1e-6, "{tone_map:?} at {}: {y}", i as f32 * 0.01);
+                last = y;
+            }
         }
     }
 }

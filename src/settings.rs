@@ -14,6 +14,8 @@ pub struct RenderSettings {
     pub terms: TermSettings,
     /// Exposure applied to linear radiance before the output transform.
     pub exposure: f32,
+    /// The curve from exposed radiance to the display's [0, 1], before the sRGB encoding.
+    pub tone_map: ToneMap,
     /// Slices around a tessellated sphere (the rasterizer's; the tracer's spheres are exact).
     pub sphere_segments: u32,
     /// Texture filtering: mipmaps and the sampling modes (TECHNIQUES.md §2).
@@ -34,6 +36,25 @@ pub struct RenderSettings {
     pub raster: RasterSettings,
     /// The ray tracer's own settings.
     pub trace: TraceSettings,
+}
+
+/// The output transform's curve from exposed linear radiance `c` to the display's [0, 1], per
+/// channel unless said otherwise; the sRGB encoding follows. Both renderers run the same curve
+/// (`src/output.rs`, `shaders/present.wgsl`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum ToneMap {
+    /// min(max(c, 0), 1): the course's output; everything above 1 is white.
+    Clamp,
+    /// c / (1 + c) (Reinhard's global operator): nothing is ever white, highlights keep detail,
+    /// mid-tones darken (0.18 shows as 0.15).
+    Reinhard,
+    /// Narkowicz's fit of the ACES filmic curve: contrast in the mid-tones, a soft shoulder,
+    /// white near c = 10.
+    Aces,
+    /// Khronos PBR Neutral: base colours up to 0.76 pass unchanged (a colour-accurate product
+    /// shot), brighter values compress towards white and desaturate.
+    PbrNeutral,
 }
 
 /// The order the rasterizer draws transparent surfaces in. `I = Im + kt·Mt·I` depends on it:
@@ -526,6 +547,7 @@ impl Default for RenderSettings {
         RenderSettings {
             terms: TermSettings::default(),
             exposure: 1.0,
+            tone_map: ToneMap::Clamp,
             sphere_segments: 96,
             textures: TextureSettings::default(),
             bump: BumpSettings::default(),

@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use crate::settings::{
     AccelKind, AntiAliasing, BumpView, EnvironmentMap, EnvironmentView, MirrorView, Prepass, ShadowFilter, ShadowFit,
-    ShadowMethod, ShadowView, SphereView, TangentSource, TextureFilter, TracerLod, TransparencySort,
+    ShadowMethod, ShadowView, SphereView, TangentSource, TextureFilter, ToneMap, TracerLod, TransparencySort,
 };
 
 /// One value an enum setting can take.
@@ -84,9 +84,12 @@ pub fn describe(key: &str) -> Option<FieldDoc> {
         }
         "terms.emission" => doc("ME, the material's own emitted radiance, added whatever the lights."),
         "exposure" => number(
-            "Multiplies linear radiance before the clamp to [0, 1] and the sRGB encoding (the shared output transform).",
+            "Multiplies linear radiance before the tone curve and the sRGB encoding (the output transform both renderers share).",
             0.01,
             16.0,
+        ),
+        "tone_map" => choice::<ToneMap>(
+            "The curve from exposed radiance to the display: clamp (the course's), Reinhard, ACES (fitted) or Khronos PBR Neutral.",
         ),
         "sphere_segments" => number(
             "Slices around the rasterizer's tessellated spheres, tori and rounded boxes; the tracer's shapes are exact, so few slices show polygonal silhouettes in the difference view.",

@@ -121,7 +121,8 @@ fn lights_and_camera_sit_at_their_nodes() {
     assert_close3(position, Vec3::new(1.0, 7.0, 3.0), "bulb position");
     assert_eq!(bulb.attenuation, Attenuation::InverseSquare);
     assert_eq!(bulb.color, Vec3::new(1.0, 0.9, 0.8));
-    assert_eq!(bulb.intensity, 50.0);
+    // 50 cd, converted to the course model's units: 50 / (683·π).
+    assert!((bulb.intensity - 0.023_302).abs() < 1e-6, "{}", bulb.intensity);
 
     let torch = &import.lights[1];
     let LightKind::Spot { position, direction, inner, outer } = torch.kind else { panic!("torch: {:?}", torch.kind) };
@@ -129,7 +130,7 @@ fn lights_and_camera_sit_at_their_nodes() {
     // The node turns −90° about x, so its −z points down.
     assert_close3(direction, Vec3::NEG_Y, "torch direction");
     assert_eq!((inner, outer), (0.3, 0.6));
-    assert_eq!(torch.intensity, 100.0);
+    assert!((torch.intensity - 0.046_604).abs() < 1e-6, "{}", torch.intensity);
 
     assert_eq!(import.cameras.len(), 1);
     let camera = &import.cameras[0];

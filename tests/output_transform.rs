@@ -6,8 +6,10 @@ mod common;
 
 use glam::Vec3;
 use mirador::gpu::{readback, texture::GpuTexture};
+use mirador::output::OutputTransform;
 use mirador::raster::present::PresentPass;
 use mirador::raster::{HDR_FORMAT, OUTPUT_FORMAT};
+use mirador::settings::ToneMap;
 use wgpu::util::DeviceExt;
 
 /// IEEE half-precision bits of a non-negative value in the normal range (truncating).
@@ -32,8 +34,9 @@ fn f16_value(bits: u16) -> f32 {
 #[test]
 fn gpu_present_pass_matches_the_rust_transform() {
     let gpu = common::gpu();
-    let (width, height) = (256u32, 3u32);
-    // Rows: a ramp over [0, 1.25] in each channel at once, then per channel, then tiny values.
+    let (width, height) = (256u32, 5u32);
+    // Rows: a ramp over [0, 1.25] in each channel at once, then per channel, then tiny values,
+    // then highlights up to 32 (the tone curves' shoulders), grey and saturated.
     let radiance: Vec<Vec3> = (0..height)
         .flat_map(|row| {
             (0..width).map(move |i| {
@@ -41,7 +44,9 @@ fn gpu_present_pass_matches_the_rust_transform() {
                 match row {
                     0 => Vec3::splat(t),
                     1 => Vec3::new(t, t * 0.5, t * 0.25),
-                    _ => Vec3::splat(1e-4 + t * 0.01),
+                    2 => Vec3::splat(1e-4 + t * 0.01),
+                    3 => Vec3::splat(2f32.powf(t * 4.0) - 1.0),
+                    _ => Vec3::new(2f32.powf(t * 4.0), 0.3, 0.05 * t),
                 }
             })
         })
@@ -68,13 +73,15 @@ fn gpu_present_pass_matches_the_rust_transform() {
     let output = GpuTexture::target(&gpu.device, "output_transform::output", (width, height), OUTPUT_FORMAT);
     let present = PresentPass::new(&gpu.device, OUTPUT_FORMAT);
     let input = present.bind(&gpu.device, &hdr_view);
-    for exposure in [1.0, 2.0] {
+    let curves = [ToneMap::Clamp, ToneMap::Reinhard, ToneMap::Aces, ToneMap::PbrNeutral];
+    for (exposure, tone_map) in [1.0, 2.0].into_iter().flat_map(|e| curves.map(|c| (e, c))) {
+        let transform = OutputTransform { exposure, tone_map };
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        present.record(&gpu.queue, &mut encoder, &input, &output.view, exposure);
+        present.record(&gpu.queue, &mut encoder, &input, &output.view, transform);
         gpu.queue.submit([encoder.finish()]);
         let bytes = readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture).expect("reading the output back");
-        let cpu = mirador::output::encode_image(width, height, &exact, exposure);
+        let cpu = mirador::output::encode_image(width, height, &exact, transform);
         let worst = bytes.iter().zip(cpu.as_raw()).map(|(&g, &c)| g.abs_diff(c)).max().unwrap();
-        assert!(worst <= 1, "exposure {exposure}: GPU and CPU output transforms differ by up to {worst}/255");
+        assert!(worst <= 1, "{transform:?}: GPU and CPU output transforms differ by up to {worst}/255");
     }
 }

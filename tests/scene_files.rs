@@ -966,7 +966,11 @@ fn a_gltf_object_is_placed_with_its_lights_and_camera() {
     // eye and center; the table still gives the image size.
     let c = &scene.camera;
     assert_close3(c.eye, Vec3::new(11.0, 2.0, 13.0), "camera eye");
-    assert_close3(c.center - c.eye, Vec3::NEG_Z, "camera direction");
+    assert_close3((c.center - c.eye).normalize(), Vec3::NEG_Z, "camera direction");
+    // glTF gives no target: `center` sits on the view axis at the depth of the scene's centre.
+    let (lo, hi) = scene.bounds().expect("the scene has objects");
+    let depth = ((lo + hi) / 2.0 - c.eye).dot(Vec3::NEG_Z);
+    assert!(((c.center - c.eye).length() - depth).abs() < 1e-4, "{} ≠ {depth}", (c.center - c.eye).length());
     assert!((c.fovy_degrees - 0.8f32.to_degrees()).abs() < 1e-4, "{}", c.fovy_degrees);
     assert_eq!((c.near, c.far, c.width, c.height), (0.1, 100.0, 640, 480));
     assert_eq!(scene.materials[scene.objects[0].material.0].name, "painted");

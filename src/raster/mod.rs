@@ -33,6 +33,7 @@ use std::time::{Duration, Instant};
 use crate::gpu::mipmap::MipmapGenerator;
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::{Gpu, readback};
+use crate::output::OutputTransform;
 use crate::scene::Scene;
 use crate::settings::{EnvironmentView, MirrorView, Prepass, RenderSettings, ShadowMethod, TransparencySettings};
 use environment::{EnvironmentMaps, EnvironmentPass, capture_key, capture_range, cube_face_view, object_centre};
@@ -469,7 +470,7 @@ impl Renderer {
             Some(_) if mirrors.view == MirrorView::Image => &self.mirror_targets[0].targets.present_input,
             _ => &targets.present_input,
         };
-        self.present.record(queue, &mut frame.encoder, shown, output, settings.exposure);
+        self.present.record(queue, &mut frame.encoder, shown, output, OutputTransform::of(settings));
         frame.end("overlays + present");
         FrameReport {
             passes: frame.finish(),

@@ -1,5 +1,5 @@
 //! The present pass: the output transform of `src/output.rs` on the GPU. Reads the linear HDR
-//! target texel for texel, applies exposure and the clamp, and writes an sRGB target (a window's
+//! target texel for texel, applies exposure and the tone curve, and writes an sRGB target (a window's
 //! surface, or an offscreen texture for screenshots), whose format does the sRGB encoding. A frame
 //! drawn at a render scale below 1 is upscaled here (bilinear), so the viewer can trade
 //! resolution for frame rate while the camera moves.
@@ -7,6 +7,8 @@
 use super::uniforms::GpuPresent;
 use crate::gpu::layout;
 use crate::gpu::uniform::UniformBuffer;
+use crate::output::OutputTransform;
+use crate::settings::ToneMap;
 use crate::shaders;
 
 /// The HDR image the pass reads, bound, and its size.
@@ -51,7 +53,7 @@ impl PresentPass {
             &[Some(output_format.into())],
         );
         let uniform =
-            UniformBuffer::new(device, "present::uniform", &GpuPresent { exposure: 1.0, _pad: 0.0, scale: [1.0; 2] });
+            UniformBuffer::new(device, "present::uniform", &GpuPresent { exposure: 1.0, tone_map: 0, scale: [1.0; 2] });
         PresentPass { pipeline, layout, uniform }
     }
 
@@ -76,11 +78,17 @@ impl PresentPass {
         encoder: &mut wgpu::CommandEncoder,
         input: &PresentInput,
         output: &wgpu::TextureView,
-        exposure: f32,
+        transform: OutputTransform,
     ) {
         let out = output.texture().size();
         let scale = [input.size.0 as f32 / out.width as f32, input.size.1 as f32 / out.height as f32];
-        self.uniform.write(queue, &GpuPresent { exposure, _pad: 0.0, scale });
+        let tone_map = match transform.tone_map {
+            ToneMap::Clamp => 0,
+            ToneMap::Reinhard => 1,
+            ToneMap::Aces => 2,
+            ToneMap::PbrNeutral => 3,
+        };
+        self.uniform.write(queue, &GpuPresent { exposure: transform.exposure, tone_map, scale });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("present::pass"),
             color_attachments: &[Some(layout::color_attachment(output, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))],

@@ -294,7 +294,8 @@ pub fn mat3_columns(m: Mat3) -> [[f32; 4]; 3] {
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct GpuPresent {
     pub exposure: f32,
-    pub _pad: f32,
+    /// `TONE_MAP_*` in `shaders/present.wgsl`, [`crate::settings::ToneMap`] in order.
+    pub tone_map: u32,
     /// The HDR image's size over the output's.
     pub scale: [f32; 2],
 }

@@ -518,7 +518,7 @@ impl<'a> Builder<'a> {
             // A model's camera takes the view; the [camera] table still sets the image size.
             (table, Some((gltf, span))) => {
                 let (width, height) = table.map_or((1280, 720), |c| (c.width, c.height));
-                let camera = camera_from_gltf(&gltf, width, height);
+                let camera = camera_from_gltf(&gltf, width, height, self.scene.bounds());
                 camera.validate().map_err(|e| self.error(format!("glTF camera `{}`: {e}", gltf.name), span))?;
                 camera
             }
@@ -941,9 +941,14 @@ fn camera_from(d: CameraDesc) -> Camera {
     }
 }
 
-fn camera_from_gltf(c: &GltfCamera, width: u32, height: u32) -> Camera {
+/// A glTF camera as the course's camera. glTF gives no target, so `center` is put on the view
+/// axis at the depth of the scene's centre (`bounds`): the viewer orbits around the model, and
+/// shadow maps fitted to the view reach as far as the model does.
+fn camera_from_gltf(c: &GltfCamera, width: u32, height: u32, bounds: Option<(Vec3, Vec3)>) -> Camera {
     let eye = c.world_from_camera.transform_point3(Vec3::ZERO);
     let forward = c.world_from_camera.transform_vector3(Vec3::NEG_Z);
+    let depth = bounds.map_or(1.0, |(lo, hi)| ((lo + hi) / 2.0 - eye).dot(forward.normalize_or_zero()));
+    let forward = forward * if depth.is_finite() && depth > 0.0 { depth / forward.length() } else { 1.0 };
     let up = c.world_from_camera.transform_vector3(Vec3::Y);
     let (projection, fovy_degrees, near, far, ortho_height) = match c.projection {
         GltfProjection::Perspective { yfov_radians, znear, zfar } => {
@@ -1003,16 +1008,27 @@ fn empty_scene(path: &Path) -> Scene {
     }
 }
 
+/// The world a bare model with its own (physical) lights is shown in: a uniform grey of this
+/// radiance, as ambient light and background. glTF carries no world; this is the one Blender's
+/// start-up file has, so a model exported from Blender looks as its author saw it there (the
+/// ambient term has no occlusion, where Blender's world light is shadowed).
+pub const PHYSICAL_WORLD: f32 = 0.0509;
+
 /// A bare model: its own camera if it has one, else one framing it; its own lights if it has
-/// any, else a white directional light from over the viewer's shoulder.
+/// any (then in [`PHYSICAL_WORLD`]), else a white directional light from over the viewer's
+/// shoulder.
 fn load_bare_gltf(path: &Path) -> Result<Scene, SceneError> {
     let import = super::gltf::import(path)?;
     let mut scene = empty_scene(path);
+    if !import.lights.is_empty() {
+        scene.ambient = Vec3::splat(PHYSICAL_WORLD);
+        scene.background = Vec3::splat(PHYSICAL_WORLD);
+    }
     let camera = import.cameras.first().cloned();
     let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("model").to_string();
     add_gltf(&mut scene, import, Mat4::IDENTITY, true, &name);
     scene.camera = match camera {
-        Some(c) => camera_from_gltf(&c, 1280, 720),
+        Some(c) => camera_from_gltf(&c, 1280, 720, scene.bounds()),
         None => frame_scene(&scene),
     };
     scene.camera.validate().map_err(|e| SceneError::Invalid { path: path.into(), message: format!("camera: {e}") })?;

@@ -15,9 +15,11 @@
 //! Zero-area triangles are removed with a warning.
 //!
 //! `KHR_lights_punctual` lights become [`Light`]s at their node's world position, shining down the
-//! node's world −z. glTF lights are physical, so point and spot lights fall off as 1/d². Their
-//! intensities are copied unconverted (candela for point and spot lights, lux for directional
-//! ones, multiplied straight onto the colour), and `range` is ignored. Camera nodes become
+//! node's world −z. glTF lights are physical, so point and spot lights fall off as 1/d², and
+//! their photometric intensities (candela for point and spot lights, lux for directional ones)
+//! are converted to the course model's by [`light::from_photometric`]: ÷ (683·π), which makes a
+//! file exported from Blender render with the radiance Blender renders it with (at exposure 1,
+//! Blender's Standard view at exposure 0). `range` is ignored. Camera nodes become
 //! [`GltfCamera`]s.
 //!
 //! # Materials: metallic-roughness onto Mirador's Phong-style model
@@ -96,7 +98,7 @@ use gltf::mesh::{Mode, Semantic};
 use gltf::scene::Transform;
 
 use super::material::{AlphaMode, ColorSpace, Wrap};
-use super::{Attenuation, Light, LightKind, Material, Mesh, SceneError, Texture, TextureId, texture};
+use super::{Attenuation, Light, LightKind, Material, Mesh, SceneError, Texture, TextureId, light, texture};
 
 /// What one glTF file contributes to a scene, in the glTF file's own world coordinates.
 #[derive(Clone, Debug, Default)]
@@ -882,6 +884,7 @@ impl<'d> Importer<'d> {
                 (LightKind::Spot { position, direction: direction()?, inner, outer }, Attenuation::InverseSquare)
             }
         };
+        let intensity = light::from_photometric(intensity);
         self.out.lights.push(Light { name, kind, color, intensity, attenuation });
         Ok(())
     }

@@ -8,6 +8,25 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+/// Lumens per watt at 555 nm: the luminous efficacy that turns photometric units back into the
+/// radiometric ones Blender renders in (its glTF exporter and importer use the same constant).
+pub const LUMENS_PER_WATT: f32 = 683.0;
+
+/// The course model's light intensity for a physical light of `photometric` candela (point and
+/// spot lights: lm/sr) or lux (directional lights: lm/m²), as `KHR_lights_punctual` gives them.
+///
+/// A white Lambertian surface (albedo ρ) at distance `d` from a point light of `I` candela,
+/// facing it, receives the illuminance `E = I/d²` and sends back the luminance `ρ·E/π`; in the
+/// radiometric units a renderer such as Blender writes, that is `ρ·E/(683·π)`. The course's
+/// diffuse term `kd·C·S·(n·l)`, with the light's `1/d²`, gives `ρ·S/d²`, so
+/// `S = I / (683·π)`: the 683 converts lumens to watts, the π is Lambert's, which the course
+/// model leaves to the light. The same holds for lux and directional lights. Blender's exporter
+/// writes a point light of `P` watts as `P·683/(4π)` cd, so such a light ends up with
+/// `S = P/(4π²)`, exactly what Cycles renders (tests/data/blender).
+pub fn from_photometric(photometric: f32) -> f32 {
+    photometric / (LUMENS_PER_WATT * std::f32::consts::PI)
+}
+
 /// How a positional light's radiance falls off with distance `d`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]

@@ -37,7 +37,8 @@ use whitted::{RayCounts, Whitted};
 pub struct Tracer<'s> {
     pub scene: &'s Scene,
     pub settings: TraceSettings,
-    pub exposure: f32,
+    /// The output transform: adaptive anti-aliasing measures differences after it.
+    pub output: crate::output::OutputTransform,
     pub whitted: Whitted<'s>,
     /// The ray cone every primary ray carries (one pixel, see [`primary_cone`]).
     pub primary_cone: RayCone,
@@ -59,7 +60,7 @@ impl<'s> Tracer<'s> {
         Tracer {
             scene,
             settings: settings.trace.clone(),
-            exposure: settings.exposure,
+            output: crate::output::OutputTransform::of(settings),
             whitted: Whitted {
                 scene,
                 primitives,
@@ -91,5 +92,5 @@ impl<'s> Tracer<'s> {
 pub fn render_image(scene: &Scene, settings: &RenderSettings) -> image::RgbaImage {
     let tracer = Tracer::new(scene, settings);
     let (radiance, _) = tracer.render(&RenderControl::default()).expect("nothing can cancel this render");
-    radiance.to_rgba8(settings.exposure)
+    radiance.to_rgba8(crate::output::OutputTransform::of(settings))
 }

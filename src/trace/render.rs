@@ -26,8 +26,8 @@ pub struct RadianceImage {
 
 impl RadianceImage {
     /// Through the output transform shared with the rasterizer.
-    pub fn to_rgba8(&self, exposure: f32) -> image::RgbaImage {
-        crate::output::encode_image(self.width, self.height, &self.pixels, exposure)
+    pub fn to_rgba8(&self, transform: crate::output::OutputTransform) -> image::RgbaImage {
+        crate::output::encode_image(self.width, self.height, &self.pixels, transform)
     }
 }
 
@@ -142,7 +142,7 @@ impl Tracer<'_> {
                     return values.iter().sum::<Vec3>() / 4.0;
                 }
                 let mut shoot = |p: Vec2| self.primary(p, counts);
-                subdivide(&mut shoot, corner, 1.0, values, 0, settings, self.exposure)
+                subdivide(&mut shoot, corner, 1.0, values, 0, settings, self.output)
             }
         }
     }

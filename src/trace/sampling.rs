@@ -20,7 +20,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::output::srgb_encode;
+use crate::output::{OutputTransform, srgb_encode};
 use crate::settings::{AntiAliasing, TraceSettings};
 
 /// Sub-pixel offsets of the `regular` pattern.
@@ -59,8 +59,8 @@ fn unit_float(bits: u64) -> f32 {
 }
 
 /// How different four corner values look after the output transform.
-fn spread(corners: &[Vec3; 4], exposure: f32) -> f32 {
-    let shown = corners.map(|c| (c * exposure).clamp(Vec3::ZERO, Vec3::ONE).to_array().map(srgb_encode));
+fn spread(corners: &[Vec3; 4], output: OutputTransform) -> f32 {
+    let shown = corners.map(|c| output.display(c).to_array().map(srgb_encode));
     let mut largest = 0.0f32;
     for channel in 0..3 {
         let values = shown.map(|c| c[channel]);
@@ -79,9 +79,9 @@ pub fn subdivide(
     corners: [Vec3; 4],
     level: u32,
     settings: &TraceSettings,
-    exposure: f32,
+    output: OutputTransform,
 ) -> Vec3 {
-    if level >= settings.adaptive_max_level || spread(&corners, exposure) <= settings.adaptive_threshold {
+    if level >= settings.adaptive_max_level || spread(&corners, output) <= settings.adaptive_threshold {
         return (corners[0] + corners[1] + corners[2] + corners[3]) / 4.0;
     }
     let h = size / 2.0;
@@ -97,7 +97,7 @@ pub fn subdivide(
         (origin + Vec2::new(0.0, h), [left, centre, bl, bottom]),
         (origin + Vec2::new(h, h), [centre, right, bottom, br]),
     ];
-    quads.into_iter().map(|(o, c)| subdivide(shoot, o, h, c, level + 1, settings, exposure)).sum::<Vec3>() / 4.0
+    quads.into_iter().map(|(o, c)| subdivide(shoot, o, h, c, level + 1, settings, output)).sum::<Vec3>() / 4.0
 }
 
 /// Whether a mode starts from the shared grid of pixel-corner rays.
@@ -137,7 +137,7 @@ mod tests {
             edge(p)
         };
         let corners = [Vec3::ZERO, Vec3::ONE, Vec3::ZERO, Vec3::ONE];
-        let value = subdivide(&mut shoot, Vec2::ZERO, 1.0, corners, 0, &settings, 1.0);
+        let value = subdivide(&mut shoot, Vec2::ZERO, 1.0, corners, 0, &settings, OutputTransform::clamp(1.0));
         // Level 1 splits at 0.5, level 2 at 0.25, level 3 resolves to 1/8: coverage of white is
         // 0.7, estimated to within one eighth of a pixel.
         assert!((value.x - 0.7).abs() <= 0.125, "{value}");
@@ -155,7 +155,7 @@ mod tests {
             [Vec3::ONE; 4],
             0,
             &settings,
-            1.0,
+            OutputTransform::clamp(1.0),
         );
         assert_eq!((flat, flat_rays), (Vec3::ONE, 0));
     }
