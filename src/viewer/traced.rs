@@ -225,7 +225,7 @@ fn trace(
     let tracer = Tracer::new(scene, settings);
     let mut progressive = Progressive::new(&tracer, START_BLOCK);
     while let Some(block) = pool.install(|| progressive.refine()) {
-        if cancelled() || !send(progressive.image().to_rgba8(OutputTransform::of(&settings)), block) {
+        if cancelled() || !send(progressive.image().to_rgba8(OutputTransform::of(settings)), block) {
             return None;
         }
         if block <= LAST_BLOCK {
@@ -234,7 +234,7 @@ fn trace(
     }
     let control = RenderControl { cancel: Some(cancel), progress: false };
     let (radiance, _) = pool.install(|| tracer.render(&control)).ok()?;
-    let image = radiance.to_rgba8(OutputTransform::of(&settings));
+    let image = radiance.to_rgba8(OutputTransform::of(settings));
     send(image.clone(), 1).then_some(image)
 }
 
