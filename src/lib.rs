@@ -6,6 +6,7 @@
 //! - [`gpu`]: the thin wgpu layer.
 //! - [`raster`]: the z-buffer renderer, one pass per technique.
 //! - [`output`]: the output transform both renderers share.
+//! - [`linear_output`]: the radiance before that transform, as OpenEXR.
 //! - [`compare`]: image metrics for golden images and raster-vs-trace comparisons.
 //! - [`viewer`]: the interactive window (winit + egui) over both renderers.
 
@@ -15,6 +16,7 @@
 
 pub mod compare;
 pub mod gpu;
+pub mod linear_output;
 pub mod output;
 pub mod raster;
 pub mod scene;

@@ -11,10 +11,11 @@ use clap::{Parser, Subcommand};
 use mirador::compare::sheet::{Panel, flip_legend, sheet, with_footer};
 use mirador::gpu::texture::GpuTexture;
 use mirador::gpu::{Gpu, Stopwatch, readback};
+use mirador::linear_output::LinearImage;
 use mirador::raster::{FrameReport, OUTPUT_FORMAT, Renderer, drawn_size};
 use mirador::settings::AntiAliasing;
 use mirador::trace::accel::AccelKind;
-use mirador::trace::{RenderControl, Tracer};
+use mirador::trace::{RadianceImage, RenderControl, Tracer};
 use mirador::{RenderSettings, Scene, output};
 
 #[derive(Parser)]
@@ -40,6 +41,10 @@ enum Command {
         /// Output PNG, written atomically.
         #[arg(short, long)]
         output: PathBuf,
+        /// Also write the linear radiance, before exposure, clamp and sRGB encoding, as an
+        /// OpenEXR file (32-bit float RGB; the rasterizer's half-float HDR target), atomically.
+        #[arg(long, value_name = "FILE.exr")]
+        exr: Option<PathBuf>,
     },
     /// Render a scene with the Whitted ray tracer into a PNG.
     Trace {
@@ -50,6 +55,10 @@ enum Command {
         /// Output PNG, written atomically.
         #[arg(short, long)]
         output: PathBuf,
+        /// Also write the linear radiance the tracer computed, before exposure, clamp and sRGB
+        /// encoding, as an OpenEXR file (32-bit float RGB), atomically.
+        #[arg(long, value_name = "FILE.exr")]
+        exr: Option<PathBuf>,
     },
     /// Render a scene with both renderers and write a sheet: raster | ray traced | FLIP error.
     Compare {
@@ -69,6 +78,10 @@ enum Command {
         /// Also write the FLIP error map here.
         #[arg(long)]
         error_out: Option<PathBuf>,
+        /// Also write both renderers' linear radiance (before exposure, clamp and sRGB encoding)
+        /// side by side, raster on the left, as one OpenEXR file (32-bit float RGB), atomically.
+        #[arg(long, value_name = "FILE.exr")]
+        exr: Option<PathBuf>,
     },
 }
 
@@ -156,10 +169,10 @@ fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = Cli::parse();
     let result = match cli.command {
-        Some(Command::Render { scene, output }) => render(scene, &output),
-        Some(Command::Trace { scene, trace: options, output }) => trace(scene, options, &output),
-        Some(Command::Compare { scene, trace, output, raster_out, trace_out, error_out }) => {
-            compare(scene, trace, &output, [raster_out, trace_out, error_out])
+        Some(Command::Render { scene, output, exr }) => render(scene, &output, exr.as_deref()),
+        Some(Command::Trace { scene, trace: options, output, exr }) => trace(scene, options, &output, exr.as_deref()),
+        Some(Command::Compare { scene, trace, output, raster_out, trace_out, error_out, exr }) => {
+            compare(scene, trace, &output, [raster_out, trace_out, error_out], exr.as_deref())
         }
         Some(Command::View(args)) => view(args),
         None => view(ViewArgs::default()),
@@ -196,17 +209,30 @@ fn view(args: ViewArgs) -> anyhow::Result<()> {
     })
 }
 
-/// Every output must be a PNG; checked before any work is done.
+/// Every image output must be a PNG; checked before any work is done.
 fn check_png(path: &Path) -> anyhow::Result<()> {
+    check_extension(path, "png")
+}
+
+/// `--exr` outputs must be `.exr` files; checked before any work is done.
+fn check_exr(path: Option<&Path>) -> anyhow::Result<()> {
+    path.map_or(Ok(()), |path| check_extension(path, "exr"))
+}
+
+fn check_extension(path: &Path, wanted: &str) -> anyhow::Result<()> {
     let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
-    if extension.as_deref() != Some("png") {
-        bail!("{}: the output must be a .png file", path.display());
+    if extension.as_deref() != Some(wanted) {
+        bail!("{}: the output must be a .{wanted} file", path.display());
     }
     Ok(())
 }
 
 fn write_png(image: &image::RgbaImage, path: &Path) -> anyhow::Result<()> {
     output::write_png_atomically(image, path).with_context(|| format!("{}: cannot write the image", path.display()))
+}
+
+fn write_exr(image: &LinearImage, path: &Path) -> anyhow::Result<()> {
+    image.write_exr_atomically(path).with_context(|| format!("{}: cannot write the image", path.display()))
 }
 
 /// Loads the scene (or the built-in showcase), applies `--set` and the size options.
@@ -253,12 +279,16 @@ fn apply_trace_args(settings: &mut RenderSettings, args: &TraceArgs) -> anyhow::
     Ok(())
 }
 
-fn render(args: SceneArgs, output_path: &Path) -> anyhow::Result<()> {
+fn render(args: SceneArgs, output_path: &Path, exr_path: Option<&Path>) -> anyhow::Result<()> {
     check_png(output_path)?;
+    check_exr(exr_path)?;
     let mut clock = Stopwatch::default();
     let scene = prepare(&args, &mut clock)?;
-    let (image, adapter) = rasterize(&scene, &mut clock, args.stats)?;
+    let (image, linear, adapter) = rasterize(&scene, &mut clock, args.stats, exr_path.is_some())?;
     clock.time("encode + write", || write_png(&image, output_path))?;
+    if let (Some(linear), Some(path)) = (linear, exr_path) {
+        clock.time("EXR encode + write", || write_exr(&linear, path))?;
+    }
     if args.stats {
         println!("adapter: {adapter}");
         print_scene(&scene);
@@ -267,16 +297,22 @@ fn render(args: SceneArgs, output_path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The rasterizer's image of `scene` with its settings; returns it and the adapter's name. With
-/// `timed_frames`, also a second frame (what an interactive frame costs, with everything the
-/// first one cached) and a third with each pass submitted and timed on its own. The size is
-/// checked against the device's limits before anything is created, and every GPU error after
-/// that (validation, out of memory) comes back as an error, not a panic.
-fn rasterize(scene: &Scene, clock: &mut Stopwatch, timed_frames: bool) -> anyhow::Result<(image::RgbaImage, String)> {
+/// The rasterizer's image of `scene` with its settings; returns it, with `linear` its HDR target
+/// (the radiance before the output transform), and the adapter's name. With `timed_frames`,
+/// also a second frame (what an interactive frame costs, with everything the first one cached)
+/// and a third with each pass submitted and timed on its own. The size is checked against the
+/// device's limits before anything is created, and every GPU error after that (validation, out
+/// of memory) comes back as an error, not a panic.
+fn rasterize(
+    scene: &Scene,
+    clock: &mut Stopwatch,
+    timed_frames: bool,
+    linear: bool,
+) -> anyhow::Result<(image::RgbaImage, Option<LinearImage>, String)> {
     let gpu = clock.time("device", Gpu::headless)?;
     let size = (scene.camera.width, scene.camera.height);
     gpu.check_image_size(size)?;
-    let pixels = gpu.checked(|| {
+    let (pixels, radiance) = gpu.checked(|| {
         let mut renderer = clock.time("pipelines", || Renderer::new(&gpu.device, OUTPUT_FORMAT));
         let (mut scene_gpu, mut targets, output) = clock.time("upload", || {
             let scene_gpu = renderer.upload(&gpu, scene);
@@ -300,10 +336,34 @@ fn rasterize(scene: &Scene, clock: &mut Stopwatch, timed_frames: bool) -> anyhow
             let profiled = frame(&mut renderer);
             print_frame_stats(&first, &second, &profiled, scene_gpu.geometry.mesh_count(), renderer.shader_variants());
         }
-        clock.time("readback", || readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture))
+        clock.time("readback", || {
+            let pixels = readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture)?;
+            let hdr = &targets.hdr.texture;
+            let radiance = if linear {
+                Some((readback::read_rgb16f(&gpu.device, &gpu.queue, hdr)?, (hdr.width(), hdr.height())))
+            } else {
+                None
+            };
+            Ok::<_, readback::ReadbackError>((pixels, radiance))
+        })
     })??;
     let image = image::RgbaImage::from_raw(size.0, size.1, pixels).expect("readback returns one RGBA8 texel per pixel");
-    Ok((image, gpu.describe()))
+    let linear = match radiance {
+        Some((pixels, (width, height))) => {
+            if (width, height) != size {
+                log::warn!(
+                    "raster.render_scale = {}: the EXR holds the image as drawn, {width}×{height}, before the \
+                     present pass upscales it to {}×{}",
+                    scene.settings.raster.render_scale,
+                    size.0,
+                    size.1
+                );
+            }
+            Some(LinearImage::new(width, height, pixels)?)
+        }
+        None => None,
+    };
+    Ok((image, linear, gpu.describe()))
 }
 
 /// `--stats` for the rasterizer: what the frames drew and where a frame's time goes.
@@ -341,13 +401,13 @@ fn print_frame_stats(
     }
 }
 
-/// The tracer's image of `scene` with its settings.
+/// The tracer's radiance image of `scene` with its settings.
 fn ray_trace(
     scene: &Scene,
     threads: Option<usize>,
     clock: &mut Stopwatch,
     stats: bool,
-) -> anyhow::Result<image::RgbaImage> {
+) -> anyhow::Result<RadianceImage> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("--threads")?;
     let tracer = clock.time("build", || Tracer::new(scene, &scene.settings));
     let control = RenderControl { cancel: None, progress: true };
@@ -357,19 +417,29 @@ fn ray_trace(
         println!("{}", tracer.accelerator_stats());
         println!("{trace_stats}");
     }
-    Ok(radiance.to_rgba8(mirador::output::OutputTransform::of(&scene.settings)))
+    Ok(radiance)
 }
 
-fn trace(args: SceneArgs, trace_args: TraceArgs, output_path: &Path) -> anyhow::Result<()> {
+/// The tracer's radiance for `--exr`.
+fn linear_of(radiance: RadianceImage) -> anyhow::Result<LinearImage> {
+    Ok(LinearImage::new(radiance.width, radiance.height, radiance.pixels)?)
+}
+
+fn trace(args: SceneArgs, trace_args: TraceArgs, output_path: &Path, exr_path: Option<&Path>) -> anyhow::Result<()> {
     check_png(output_path)?;
+    check_exr(exr_path)?;
     let mut clock = Stopwatch::default();
     let mut scene = prepare(&args, &mut clock)?;
     apply_trace_args(&mut scene.settings, &trace_args)?;
     if args.stats {
         print_scene(&scene);
     }
-    let image = ray_trace(&scene, trace_args.threads, &mut clock, args.stats)?;
-    clock.time("encode + write", || write_png(&image, output_path))?;
+    let radiance = ray_trace(&scene, trace_args.threads, &mut clock, args.stats)?;
+    clock.time("encode + write", || write_png(&radiance.to_rgba8(mirador::output::OutputTransform::of(&scene.settings)), output_path))?;
+    if let Some(path) = exr_path {
+        let linear = linear_of(radiance)?;
+        clock.time("EXR encode + write", || write_exr(&linear, path))?;
+    }
     if args.stats {
         println!("{}", clock.report());
     }
@@ -381,16 +451,19 @@ fn compare(
     trace_args: TraceArgs,
     sheet_path: &Path,
     extra: [Option<PathBuf>; 3],
+    exr_path: Option<&Path>,
 ) -> anyhow::Result<()> {
     check_png(sheet_path)?;
     for path in extra.iter().flatten() {
         check_png(path)?;
     }
+    check_exr(exr_path)?;
     let mut clock = Stopwatch::default();
     let mut scene = prepare(&args, &mut clock)?;
     apply_trace_args(&mut scene.settings, &trace_args)?;
-    let (raster, adapter) = rasterize(&scene, &mut clock, false)?;
-    let traced = ray_trace(&scene, trace_args.threads, &mut clock, args.stats)?;
+    let (raster, raster_linear, adapter) = rasterize(&scene, &mut clock, false, exr_path.is_some())?;
+    let traced_radiance = ray_trace(&scene, trace_args.threads, &mut clock, args.stats)?;
+    let traced = traced_radiance.to_rgba8(mirador::output::OutputTransform::of(&scene.settings));
     let difference = mirador::compare::difference(&traced, &raster).expect("both images have the camera's size");
     println!("adapter: {adapter}");
     println!("FLIP mean: {:.5}", difference.flip_mean);
@@ -408,6 +481,10 @@ fn compare(
         }
     }
     clock.time("encode + write", || write_png(&sheet_image, sheet_path))?;
+    if let (Some(raster_linear), Some(path)) = (raster_linear, exr_path) {
+        let both = LinearImage::side_by_side(&raster_linear, &linear_of(traced_radiance)?);
+        clock.time("EXR encode + write", || write_exr(&both, path))?;
+    }
     if args.stats {
         println!("{}", clock.report());
     }

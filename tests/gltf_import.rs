@@ -1,11 +1,13 @@
-//! glTF import: a valid two-node file read number by number, a GLB, and broken files that must
-//! give an error naming the file and the problem instead of a panic.
+//! glTF import: a valid two-node file read number by number, a GLB, broken files that must give
+//! an error naming the file and the problem instead of a panic, and the extensions real files
+//! use (texture transforms, quantized attributes, material extensions, required ones Mirador
+//! lacks).
 
 use std::path::{Path, PathBuf};
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use mirador::scene::gltf::{GltfImport, GltfProjection, import};
-use mirador::scene::{Attenuation, ColorSpace, LightKind, SceneError, TextureId};
+use mirador::scene::{Attenuation, ColorSpace, LightKind, Material, SceneError, TextureId};
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/gltf/")).join(name)
@@ -219,4 +221,206 @@ fn missing_or_empty_path_is_an_error_naming_it() {
         Err(e @ SceneError::Gltf { .. }) => assert!(e.to_string().contains("empty"), "{e}"),
         other => panic!("expected a glTF error, got {other:?}"),
     }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Extensions real files use. The fixtures are written by hand (the buffers as `data:` URIs); each
+// says what it holds in `asset.extras.about`.
+
+fn material<'a>(import: &'a GltfImport, name: &str) -> &'a Material {
+    import.materials.iter().find(|m| m.name == name).unwrap_or_else(|| panic!("no material `{name}`"))
+}
+
+fn assert_close2(actual: &[Vec2], expected: &[Vec2], what: &str) {
+    assert_eq!(actual.len(), expected.len(), "{what}");
+    for (a, e) in actual.iter().zip(expected) {
+        assert!(a.abs_diff_eq(*e, 1e-5), "{what}: {actual:?} ≠ {expected:?}");
+    }
+}
+
+#[test]
+fn texture_transform_is_baked_into_the_texture_coordinates() {
+    let import = load("texture_transform.gltf");
+    let mesh = |i: usize| &import.meshes[import.objects[i].mesh];
+
+    // `rotated`: TEXCOORD_1 (the transform's texCoord overrides the texture's 0) through
+    // offset (0.5, 0.25), rotation π/2, scale (2, 3): u' = 3v + 0.5, v' = −2u + 0.25.
+    let uv1 = [Vec2::new(0.0, 0.0), Vec2::new(0.5, 0.0), Vec2::new(0.5, 0.5), Vec2::new(0.0, 0.5)];
+    let expected: Vec<Vec2> = uv1.iter().map(|uv| Vec2::new(3.0 * uv.y + 0.5, -2.0 * uv.x + 0.25)).collect();
+    assert_close2(&mesh(0).uvs, &expected, "rotated");
+    assert_close2(
+        &expected,
+        &[Vec2::new(0.5, 0.25), Vec2::new(0.5, -0.75), Vec2::new(2.0, -0.75), Vec2::new(2.0, 0.25)],
+        "by hand",
+    );
+    // u' grows with v, and v = y/2 on this quad: the new tangent ∂p/∂u' is +y, same handedness.
+    for t in &mesh(0).tangents {
+        assert!(t.abs_diff_eq(Vec4::new(0.0, 1.0, 0.0, 1.0), 1e-6), "rotated tangent {t}");
+    }
+
+    // `mismatched`: the base colour's scale 2 wins over the normal texture's scale 4.
+    let uv0 = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(0.0, 1.0)];
+    assert_close2(&mesh(1).uvs, &uv0.map(|uv| uv * 2.0), "mismatched");
+    assert_eq!(mesh(1).tangents, vec![Vec4::new(1.0, 0.0, 0.0, 1.0); 4], "a uniform scale keeps the tangents");
+
+    // `normal-only-mirrored`: u' = 1 − u mirrors the texture: the tangent turns to −x and its
+    // handedness flips, so the bitangent w·(n × t) stays +y.
+    assert_close2(&mesh(2).uvs, &uv0.map(|uv| Vec2::new(1.0 - uv.x, uv.y)), "mirrored");
+    assert_eq!(mesh(2).tangents, vec![Vec4::new(-1.0, 0.0, 0.0, -1.0); 4]);
+
+    // One warning, for the material whose textures disagree, naming both transforms.
+    assert_eq!(import.warnings.len(), 1, "{:?}", import.warnings);
+    let warning = &import.warnings[0];
+    for word in ["mismatched", "scale (4, 4)", "scale (2, 2)", "base colour"] {
+        assert!(warning.contains(word), "the warning should mention `{word}`: {warning}");
+    }
+    assert!(material(&import, "rotated").texture.is_some() && material(&import, "rotated").normal_map.is_some());
+}
+
+#[test]
+fn quantized_attributes_are_read_as_khr_mesh_quantization_defines_them() {
+    // The file *requires* KHR_mesh_quantization, which the `gltf` crate's own validation refuses.
+    let import = load("quantized.gltf");
+    assert!(import.warnings.is_empty(), "{:?}", import.warnings);
+    let shorts = &import.meshes[import.objects[0].mesh];
+    // SHORT positions convert by value; the node's scale 0.01 is the dequantization.
+    assert_eq!(
+        shorts.positions,
+        [Vec3::ZERO, Vec3::new(100.0, 0.0, 0.0), Vec3::new(100.0, 100.0, 0.0), Vec3::new(0.0, 100.0, 0.0)]
+    );
+    let corner = import.objects[0].world_from_local.transform_point3(shorts.positions[2]);
+    assert_close3(corner, Vec3::new(1.0, 1.0, 0.0), "dequantized corner");
+    // Normalized BYTE normals (0, 0, 127) and normalized UNSIGNED_SHORT uvs: 127/127, 65535/65535.
+    assert_eq!(shorts.normals, vec![Vec3::Z; 4]);
+    assert_eq!(shorts.uvs, [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y]);
+
+    let bytes = &import.meshes[import.objects[1].mesh];
+    // Normalized BYTE positions: −128 clamps to −1, 127 is 1.
+    assert_eq!(bytes.positions, [Vec3::NEG_X, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y]);
+    assert_eq!(bytes.normals, vec![Vec3::Z; 4], "normalized SHORT normals");
+    // UNSIGNED_BYTE uvs 0..255, scaled by the material's KHR_texture_transform (1/255).
+    assert_close2(&bytes.uvs, &[Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y], "dequantized uvs");
+}
+
+#[test]
+fn material_extensions_map_by_the_documented_rules() {
+    let import = load("material_extensions.gltf");
+
+    // Clear glass: transmission 1 takes the whole diffuse lobe (kd = (1 − m)(1 − kt) = 0); its
+    // reflectance is F0 = ((ior − 1)/(ior + 1))² with KHR_materials_ior's 1.45.
+    let glass = material(&import, "glass");
+    assert_eq!((glass.kd, glass.transmission, glass.ior), (0.0, 1.0, 1.45));
+    assert_close(glass.ks, (0.45f32 / 2.45).powi(2), "glass ks = F0(1.45)");
+    assert_close(glass.ks, 0.033_736, "glass ks by hand");
+    assert_eq!((glass.mirror, glass.transmission_color), (0.0, Vec3::ONE));
+    assert!(glass.is_transparent());
+
+    // KHR_materials_specular with ior 2: F0 = 1/9, × colour (1, 0.5, 0.25), × factor 0.5 =
+    // (1/18, 1/36, 1/72): ks = 1/18 · (1 − r) = 1/36, S = its hue.
+    let tinted = material(&import, "tinted-specular");
+    assert_close(tinted.ks, 1.0 / 36.0, "tinted ks");
+    assert_close3(tinted.specular_color, Vec3::new(1.0, 0.5, 0.25), "tinted S");
+    assert_close3(tinted.mirror_color, Vec3::new(1.0, 0.5, 0.25), "tinted MPS");
+    assert_eq!((tinted.kd, tinted.ior, tinted.mirror), (1.0, 2.0, 0.0));
+
+    // KHR_materials_clearcoat 1, roughness 0, over a rough red plastic (ks = 0, e = 1): the coat
+    // reflects F = 0.04 in white; the base keeps 0.96 of its diffuse.
+    let coat = material(&import, "clearcoat");
+    assert_close(coat.kd, 0.96, "coat kd");
+    assert_close(coat.ks, 0.04, "coat ks");
+    assert_close(coat.mirror, 0.04, "coat mirror");
+    assert_eq!((coat.specular_color, coat.mirror_color, coat.shininess), (Vec3::ONE, Vec3::ONE, 2048.0));
+    assert_close3(coat.color, Vec3::new(0.8, 0.1, 0.1), "coat C");
+
+    // emissiveFactor (1, 0.5, 0) × KHR_materials_emissive_strength 5.
+    assert_close3(material(&import, "emissive").emission, Vec3::new(5.0, 2.5, 0.0), "emission");
+
+    let frosted = material(&import, "frosted");
+    assert_eq!((frosted.transmission, frosted.kd, frosted.ior), (0.5, 0.5, 1.2));
+    assert_close3(frosted.transmission_color, Vec3::new(0.9, 0.9, 1.0), "frosted MT");
+
+    // Sheen and volume are used by two materials but named in one warning.
+    assert_eq!(import.warnings.len(), 1, "{:?}", import.warnings);
+    let warning = &import.warnings[0];
+    assert!(
+        warning.contains("KHR_materials_sheen") && warning.contains("KHR_materials_volume"),
+        "the warning names the ignored extensions: {warning}"
+    );
+    assert!(!warning.contains("clearcoat") && !warning.contains("specular"), "{warning}");
+}
+
+/// A minimal document using (and, with `required`, requiring) `extension`, in a scratch file.
+fn file_with_extension(extension: &str, required: bool) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mirador-gltf-ext-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("{extension}-{}.gltf", if required { "required" } else { "used" }));
+    let required = if required { format!(r#", "extensionsRequired": ["{extension}"]"#) } else { String::new() };
+    std::fs::write(&path, format!(r#"{{"asset": {{"version": "2.0"}}, "extensionsUsed": ["{extension}"]{required}}}"#))
+        .unwrap();
+    path
+}
+
+#[test]
+fn a_required_extension_mirador_lacks_is_refused_by_name() {
+    for extension in ["KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_texture_basisu", "ACME_unheard_of"]
+    {
+        let path = file_with_extension(extension, true);
+        let message = match import(&path) {
+            Err(e @ SceneError::Gltf { .. }) => e.to_string(),
+            other => panic!("{extension}: expected a glTF error, got {other:?}"),
+        };
+        assert!(message.contains(extension) && message.contains("requires"), "{message}");
+        assert!(message.contains(path.file_name().unwrap().to_str().unwrap()), "names the file: {message}");
+
+        // Used but not required: the file loads, with one warning naming the extension.
+        let used = import(&file_with_extension(extension, false)).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(used.warnings.len(), 1, "{:?}", used.warnings);
+        assert!(used.warnings[0].contains(extension), "{:?}", used.warnings);
+    }
+}
+
+#[test]
+fn a_glass_sphere_with_transmission_1_is_traced_see_through() {
+    use mirador::trace::Tracer;
+    use mirador::trace::whitted::RayCounts;
+
+    // The exporters' clear glass: white, metallic 0, roughness 0, transmission 1.
+    let text = r#"
+        [camera]
+        eye = [0, 0, 5]
+        center = [0, 0, 0]
+        fovy = 30
+        width = 33
+        height = 33
+        [world]
+        ambient = [0.2, 0.2, 0.2]
+        background = [0.2, 0.4, 0.6]
+        [[lights]]
+        type = "point"
+        position = [-5, 5, 5]
+        [[objects]]
+        type = "gltf"
+        path = "glass_sphere.gltf"
+    "#;
+    let mut scene = mirador::scene::file::parse(text, &fixture("glass.toml")).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(scene.materials.iter().filter(|m| m.name == "glass").count(), 1);
+    let glass = scene.materials.iter().position(|m| m.name == "glass").unwrap();
+    assert_eq!((scene.materials[glass].kd, scene.materials[glass].transmission), (0.0, 1.0));
+
+    let background = Vec3::new(0.2, 0.4, 0.6);
+    // The centre, and points halfway to the rim on the right and below (the highlight of the
+    // light at the upper left is elsewhere). Straight through a sphere of uniform background,
+    // every refracted ray leaves it and sees the background: L = kt·MT·L(t) = background.
+    let pixels = [Vec2::new(16.5, 16.5), Vec2::new(22.5, 16.5), Vec2::new(16.5, 22.5)];
+    let tracer = Tracer::new(&scene, &scene.settings);
+    for p in pixels {
+        let got = tracer.primary(p, &mut RayCounts::default());
+        assert!(got.abs_diff_eq(background, 2e-3), "pixel {p}: {got}, not the background seen through the glass");
+    }
+
+    // The bug the issue describes, kd = 1 − m with the transmitted share kept: a lit white ball.
+    scene.materials[glass].kd = 1.0;
+    let tracer = Tracer::new(&scene, &scene.settings);
+    let white = tracer.primary(pixels[0], &mut RayCounts::default());
+    assert!((white - background).min_element() > 0.15, "kd = 1 would add a white diffuse ball: {white}");
 }

@@ -36,6 +36,20 @@ pub fn read_rgba8(
     read_texels(device, queue, texture, 4)
 }
 
+/// Copies mip level 0 of an `Rgba16Float` texture (the rasterizer's HDR target) and widens its
+/// R, G and B to `f32` (exactly: every half-float is an `f32`), rows from the top; alpha is
+/// dropped.
+pub fn read_rgb16f(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+) -> Result<Vec<glam::Vec3>, ReadbackError> {
+    assert_eq!(texture.format(), wgpu::TextureFormat::Rgba16Float, "read_rgb16f reads half-float RGBA textures");
+    let bytes = read_texels(device, queue, texture, 8)?;
+    let half = |b: &[u8]| half::f16::from_le_bytes([b[0], b[1]]).to_f32();
+    Ok(bytes.chunks_exact(8).map(|t| glam::Vec3::new(half(&t[0..2]), half(&t[2..4]), half(&t[4..6]))).collect())
+}
+
 /// Copies mip level 0 of a 2D texture of `bytes_per_texel` bytes per texel, tightly packed, in
 /// bands as large as the device's `max_buffer_size` allows.
 pub fn read_texels(

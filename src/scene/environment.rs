@@ -360,8 +360,8 @@ pub fn fold_cross(image: &EnvImage) -> Result<Box<[EnvImage; 6]>, String> {
 // Loading images.
 
 /// Decodes an environment image: `.hdr` (and any floating-point format) as linear radiance,
-/// 8- and 16-bit formats (PNG, JPEG) as sRGB, decoded to linear. Size limits are the textures'
-/// ([`super::texture::check_size`]); an image over the largest texture is downscaled with a
+/// 8- and 16-bit formats (PNG, JPEG) as sRGB, decoded to linear. Size and memory limits are the
+/// textures' ([`super::texture::decode`]); an image over the largest texture is downscaled with a
 /// warning. Non-finite and negative texels are repaired to 0 with a warning ([`from_image`]).
 pub fn load_image(path: &Path) -> Result<EnvImage, SceneError> {
     let error = |message: String| SceneError::Texture { path: path.to_path_buf(), message };
@@ -369,28 +369,27 @@ pub fn load_image(path: &Path) -> Result<EnvImage, SceneError> {
         .map_err(|e| error(format!("cannot open: {e}")))?
         .with_guessed_format()
         .map_err(|e| error(format!("cannot read: {e}")))?;
-    let (width, height) = reader.into_dimensions().map_err(|e| error(format!("cannot decode: {e}")))?;
-    super::texture::check_size(width, height).map_err(error)?;
-    let decoded = image::ImageReader::open(path)
-        .and_then(|r| r.with_guessed_format())
-        .map_err(|e| error(format!("cannot read: {e}")))?
-        .decode()
-        .map_err(|e| error(format!("cannot decode: {e}")))?;
-    Ok(from_image(path, decoded))
+    Ok(from_image(path, super::texture::decode(reader).map_err(error)?))
 }
 
 /// Converts a decoded image to linear radiance (see [`load_image`]); `path` names it in warnings.
+/// A large image is downscaled in its own format first, so that the 32-bit float copy is made
+/// of the smaller image.
 pub fn from_image(path: &Path, image: image::DynamicImage) -> EnvImage {
     let linear = matches!(image, image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_));
-    let mut rgb = image.into_rgb32f();
-    let (width, height) = rgb.dimensions();
-    if let Some((w, h)) = super::texture::fitted_size(width, height) {
-        log::warn!(
-            "{}: the environment image is {width}×{height}, larger than the largest texture; downscaled to {w}×{h}",
-            path.display()
-        );
-        rgb = image::imageops::resize(&rgb, w, h, image::imageops::FilterType::Triangle);
-    }
+    let (width, height) = (image.width(), image.height());
+    let image = match super::texture::fitted_size(width, height) {
+        Some((w, h)) => {
+            log::warn!(
+                "{}: the environment image is {width}×{height}, larger than the largest texture; downscaled to \
+                 {w}×{h}",
+                path.display()
+            );
+            super::texture::downscaled(image, w, h)
+        }
+        None => image,
+    };
+    let rgb = image.into_rgb32f();
     let (width, height) = rgb.dimensions();
     let mut texels: Vec<Vec3> = rgb
         .pixels()

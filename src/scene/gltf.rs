@@ -7,8 +7,9 @@
 //! The default scene is walked (scene 0 when none is marked default; every root node when the
 //! file has no scenes at all), composing node transforms (a matrix, or translation · rotation ·
 //! scale) from parent to child. Each triangle primitive of a node's mesh becomes one [`Mesh`] in
-//! its local coordinates (`POSITION`, `NORMAL`, `TEXCOORD_0` and the indices; normals are
-//! computed when the file has none, texture coordinates are zero when it has none) and one
+//! its local coordinates (`POSITION`, `NORMAL`, `TANGENT`, the `TEXCOORD_n` set its material's
+//! textures read (see [Extensions](#extensions)) and the indices; normals are computed when the
+//! file has none, texture coordinates are zero when it has none) and one
 //! [`GltfObject`] named `<node name or "node N">/<primitive index>` carrying the node's world
 //! transform. A primitive used by several nodes is one mesh drawn by several objects. Triangle
 //! strips and fans are unrolled into triangle lists; points and lines are skipped with a warning.
@@ -24,16 +25,25 @@
 //!
 //! # Materials: metallic-roughness onto Mirador's Phong-style model
 //!
-//! With `m` = `metallicFactor`, `r` = `roughnessFactor` (both clamped to [0, 1]) and `kt` the
-//! `KHR_materials_transmission` factor (clamped to [0, 1]):
+//! With `m` = `metallicFactor`, `r` = `roughnessFactor` (both clamped to [0, 1]), `kt` the
+//! `KHR_materials_transmission` factor (clamped to [0, 1]), and the dielectric's reflectance at
+//! normal incidence, a colour,
+//!
+//! ```text
+//! F0 = ((η − 1)/(η + 1))²                                   η = KHR_materials_ior, else 1.5
+//! F0 = min(F0 · specularColorFactor, 1) · specularFactor    with KHR_materials_specular
+//! ```
+//!
+//! split into its strength `f = max(F0.r, F0.g, F0.b)` and its hue `H = F0/f` (white when f = 0;
+//! without the specular extension `F0` is grey, `H` white and `f` 0.04 for η = 1.5):
 //!
 //! | Mirador              | from glTF                                                          |
 //! |----------------------|--------------------------------------------------------------------|
 //! | `color` (C)          | `baseColorFactor.rgb` (linear) × `baseColorTexture` (sRGB texture) |
 //! | `ka`                 | 0                                                                  |
 //! | `kd`                 | (1 − m) · (1 − kt)                                                 |
-//! | `ks`                 | (0.04 · (1 − m) + m) · (1 − r)                                     |
-//! | `specular_color` (S) | white · (1 − m) + `baseColorFactor.rgb` · m                        |
+//! | `ks`                 | (f · (1 − m) + m) · (1 − r)                                        |
+//! | `specular_color` (S) | H · (1 − m) + `baseColorFactor.rgb` · m                            |
 //! | `shininess` (e)      | 2/α² − 2 with α = r², clamped to [1, 2048]                         |
 //! | `mirror` (kps)       | m · (1 − r)²                                                       |
 //! | `mirror_color`       | S                                                                  |
@@ -44,8 +54,9 @@
 //! | `alpha`              | `baseColorFactor.a` (clamped to [0, 1])                            |
 //! | `alpha_mode`         | `alphaMode`: OPAQUE; MASK with `alphaCutoff` (default 0.5); BLEND  |
 //!
-//! Metals have no diffuse term and reflect in their own colour; dielectrics reflect about 4 %
-//! (the Fresnel reflectance at normal incidence of an index of 1.5) in white. The exponent `e` is
+//! and `KHR_materials_clearcoat` then adds its layer (below). Metals have no diffuse term and
+//! reflect in their own colour; dielectrics reflect `f` (about 4 %, the Fresnel reflectance at
+//! normal incidence of an index of 1.5) in `H`. The exponent `e` is
 //! the Blinn-Phong exponent whose lobe matches a GGX lobe of roughness α, and the specular and
 //! mirror weights fade with roughness because a rough surface spreads the same energy over a
 //! wider lobe that a Phong lobe of bounded exponent cannot hold. The specular, mirror and
@@ -53,7 +64,32 @@
 //!
 //! **Transmission** (`KHR_materials_transmission`) takes its light from the diffuse lobe: the
 //! light a transmissive dielectric lets through is light it no longer scatters diffusely, hence
-//! `kd·(1 − kt)`; the specular and mirror terms stay.
+//! `kd·(1 − kt)`; the specular and mirror terms stay. Clear glass as exporters write it (white,
+//! metallic 0, roughness 0, transmission 1) is `kd = 0`, `kt = 1`, `ks = f`: see-through with a
+//! faint highlight, not a white ball (`tests/gltf_import.rs` traces one).
+//!
+//! **Specular** (`KHR_materials_specular`) changes only the dielectric's `F0`, as the extension
+//! does. Mirador's model has no Fresnel term, so what the extension calls F90 (the grazing
+//! reflectance, `specularFactor`) has nothing to act on; and one specular weight with one colour
+//! cannot hold a coloured `F0` whose channels differ in strength except as strength × hue, which
+//! is what `f` and `H` are.
+//!
+//! **Clearcoat** (`KHR_materials_clearcoat`, factor `c` and roughness `rc`, clamped to [0, 1]) is
+//! a white dielectric layer of index 1.5 over the base. It reflects `F = 0.04·c`, and the base
+//! below keeps `1 − F`:
+//!
+//! ```text
+//! kd  ← kd·(1 − F)
+//! ks  ← ks·(1 − F) + F·(1 − rc)          S   ← the two weights' mix of S and white
+//! kps ← kps·(1 − F) + F·(1 − rc)²        MPS ← the two weights' mix of MPS and white
+//! e   ← e(rc) where the layer's specular weight is the larger, else the base's e
+//! ```
+//!
+//! What this loses: the layer's Fresnel rise towards grazing angles (most of a clear coat's look,
+//! the bright rim on car paint; at normal incidence the layer reflects only 4 %); its second,
+//! separate highlight (Mirador has one specular lobe, so a sharp coat over a rough base shows the
+//! coat's highlight only, at the summed weight); `clearcoatNormalTexture` and the clearcoat
+//! textures.
 //!
 //! **Alpha** is coverage (`AlphaMode`): `α = alpha ×` the base colour texture's alpha channel,
 //! which survives decoding (textures are RGBA8) and is linear, as glTF defines it. OPAQUE ignores
@@ -66,14 +102,40 @@
 //! A primitive without a material gets [`Material::default()`] named `gltf-default`, not the glTF
 //! default material: that one is fully metallic and fully rough, which the rule above makes black.
 //!
+//! # Extensions
+//!
+//! Read: `KHR_lights_punctual`, `KHR_materials_emissive_strength`, `KHR_materials_transmission`,
+//! `KHR_materials_ior`, `KHR_materials_specular`, `KHR_materials_clearcoat` (all above),
+//! `KHR_texture_transform` and `KHR_mesh_quantization` (below). A file that *requires* any other
+//! (`KHR_draco_mesh_compression`, `EXT_meshopt_compression`, `KHR_texture_basisu`, or one never
+//! heard of) is refused with an error naming it; one that merely *uses* others loads, with one
+//! warning naming them all, however many materials carry them.
+//!
+//! **Texture coordinates and `KHR_texture_transform`.** A Mirador material samples all its
+//! textures with one set of texture coordinates, so the transform is baked into the mesh: each
+//! primitive's `TEXCOORD_n` is read for the set its material's textures name (the transform's
+//! `texCoord` overriding the texture's), and carried through
+//! `uv' = T(offset) · R(rotation) · S(scale) · uv` with the extension's rotation matrix
+//! `[cos sin; −sin cos]`. Barycentric interpolation commutes with an affine map, so this is exact
+//! for every point of every triangle, and mip levels follow the transformed coordinates as they
+//! should. The file's tangents turn with it (`∂p/∂u'` from `∂p/∂u` and `∂p/∂v`, the handedness
+//! flipping under a mirroring transform). The base colour texture decides; a normal texture with
+//! a different set or transform is read with the base colour's, with a warning naming both (a
+//! texture atlas that places the two maps differently shows the wrong part of the normal map).
+//!
+//! **`KHR_mesh_quantization`**: `POSITION`, `NORMAL`, `TANGENT` and `TEXCOORD_n` may be 8- or
+//! 16-bit integers, signed or not, normalized or not. Normalized ones map to [0, 1] or [−1, 1]
+//! (`max(c/127, −1)`, `c/255`, `max(c/32767, −1)`, `c/65535`), others convert by value; the
+//! dequantizing scale and offset are the node's transform (positions) and the material's
+//! `KHR_texture_transform` (texture coordinates), which Mirador applies as it always does.
+//!
 //! # What is ignored
 //!
-//! The metallic-roughness, occlusion, emissive and transmission textures, `doubleSided` (Mirador
-//! draws every surface two-sided, its normal turned to the viewer), samplers' filters (filtering
-//! is the renderers'; their wrap modes are read), texture coordinate sets other than 0 and
-//! `KHR_texture_transform`, vertex colours, skins (meshes are drawn in their bind pose), morph
-//! targets, animations, and light `range`. Files that *require* an extension other than the
-//! four material and light extensions named above and `KHR_mesh_quantization` are refused.
+//! The metallic-roughness, occlusion, emissive, transmission, specular and clearcoat textures,
+//! `doubleSided` (Mirador draws every surface two-sided, its normal turned to the viewer),
+//! samplers' filters (filtering is the renderers'; their wrap modes are read), vertex colours,
+//! skins (meshes are drawn in their bind pose), morph targets, animations, light `range`, and
+//! extensions other than those above.
 //!
 //! # Errors
 //!
@@ -147,15 +209,22 @@ pub enum GltfProjection {
     },
 }
 
-/// Extensions this importer either implements or can safely read without (quantized attributes
-/// are read by the generic accessor reader below), so a file requiring them is accepted.
+/// Extensions this importer implements (quantized attributes are read by the generic accessor
+/// reader below), so a file requiring them is accepted and one using them gets no warning.
 const HANDLED_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
+    "KHR_materials_clearcoat",
     "KHR_materials_emissive_strength",
-    "KHR_materials_transmission",
     "KHR_materials_ior",
+    "KHR_materials_specular",
+    "KHR_materials_transmission",
     "KHR_mesh_quantization",
+    "KHR_texture_transform",
 ];
+
+/// The reflectance at normal incidence of `KHR_materials_clearcoat`'s layer: a dielectric of
+/// index 1.5, as the extension fixes it.
+const CLEARCOAT_F0: f32 = 0.04;
 
 /// The largest Phong exponent a glTF material maps to: roughness 0 would give an infinite one,
 /// and at 2048 the highlight is already a near-point; the mirror term carries the reflection.
@@ -187,13 +256,19 @@ fn import_bytes(path: &Path, bytes: &[u8]) -> Result<GltfImport, String> {
     check_glb_header(bytes)?;
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(describe_gltf_error)?;
-    let json = document.into_json();
-    check_before_validation(&json)?;
-    let document = gltf::Document::from_json(json).map_err(describe_gltf_error)?;
-    let required: Vec<&str> = document.extensions_required().filter(|e| !HANDLED_EXTENSIONS.contains(e)).collect();
+    let mut json = document.into_json();
+    // Before validation: the `gltf` crate's validation refuses every required extension it does
+    // not parse itself (`KHR_mesh_quantization`, `KHR_materials_clearcoat`, …) with a message
+    // that does not say Mirador reads them, and a file requiring one Mirador lacks (Draco,
+    // meshopt, Basis) is best refused by that extension's name before its odd data is looked at.
+    let required: Vec<&str> =
+        json.extensions_required.iter().map(String::as_str).filter(|e| !HANDLED_EXTENSIONS.contains(e)).collect();
     if !required.is_empty() {
         return Err(format!("the file requires extension(s) {}, which Mirador does not support", required.join(", ")));
     }
+    json.extensions_required.clear();
+    check_before_validation(&json)?;
+    let document = gltf::Document::from_json(json).map_err(describe_gltf_error)?;
     let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
     let buffers = load_buffers(&document, &base, blob)?;
     let nodes: Vec<gltf::Node<'_>> = document.nodes().collect();
@@ -205,6 +280,7 @@ fn import_bytes(path: &Path, bytes: &[u8]) -> Result<GltfImport, String> {
         out: GltfImport::default(),
         meshes: HashMap::new(),
         materials: HashMap::new(),
+        uv_mappings: HashMap::new(),
         textures: HashMap::new(),
     };
     let ignored: Vec<&str> = document.extensions_used().filter(|e| !HANDLED_EXTENSIONS.contains(e)).collect();
@@ -398,6 +474,8 @@ struct Importer<'d> {
     meshes: HashMap<(usize, usize), Option<usize>>,
     /// glTF material (`None`: the default) → index into `out.materials`.
     materials: HashMap<Option<usize>, usize>,
+    /// glTF material → the texture coordinates its textures read.
+    uv_mappings: HashMap<Option<usize>, UvMapping>,
     /// glTF image → index into `out.textures`.
     textures: HashMap<(usize, ColorSpace), TextureId>,
 }
@@ -506,7 +584,8 @@ impl<'d> Importer<'d> {
         if let Some(&known) = self.meshes.get(&key) {
             return Ok(known);
         }
-        let built = self.build_mesh(mesh, primitive)?;
+        let mapping = self.uv_mapping(&primitive.material())?;
+        let built = self.build_mesh(mesh, primitive, mapping)?;
         let index = built.map(|m| {
             self.out.meshes.push(m);
             self.out.meshes.len() - 1
@@ -515,7 +594,14 @@ impl<'d> Importer<'d> {
         Ok(index)
     }
 
-    fn build_mesh(&mut self, mesh: &gltf::Mesh<'d>, primitive: &gltf::Primitive<'d>) -> Result<Option<Mesh>, String> {
+    /// Builds one primitive's mesh, its texture coordinates read from the set its material's
+    /// textures use and carried through their `KHR_texture_transform`.
+    fn build_mesh(
+        &mut self,
+        mesh: &gltf::Mesh<'d>,
+        primitive: &gltf::Primitive<'d>,
+        mapping: UvMapping,
+    ) -> Result<Option<Mesh>, String> {
         let mesh_name = mesh.name().map_or_else(|| format!("mesh {}", mesh.index()), str::to_owned);
         let name = format!("{mesh_name}/{}", primitive.index());
         let mode = primitive.mode();
@@ -541,13 +627,22 @@ impl<'d> Importer<'d> {
             ),
             None => None,
         };
-        let uvs: Vec<Vec2> = match primitive.get(&Semantic::TexCoords(0)) {
+        let set = mapping.set;
+        let uvs: Vec<Vec2> = match primitive.get(&Semantic::TexCoords(set)) {
             Some(accessor) => self
-                .read_vectors::<2>(&accessor, &format!("TEXCOORD_0 of mesh `{name}`"))?
+                .read_vectors::<2>(&accessor, &format!("TEXCOORD_{set} of mesh `{name}`"))?
                 .into_iter()
                 .map(Vec2::from_array)
                 .collect(),
-            None => vec![Vec2::ZERO; vertex_count],
+            None => {
+                if set != 0 {
+                    self.warn(format!(
+                        "mesh `{name}` has no TEXCOORD_{set}, which its material's textures read; its texture \
+                         coordinates are all 0"
+                    ));
+                }
+                vec![Vec2::ZERO; vertex_count]
+            }
         };
         let tangents: Vec<Vec4> = match primitive.get(&Semantic::Tangents) {
             Some(accessor) => self
@@ -592,6 +687,9 @@ impl<'d> Importer<'d> {
         }
         if !has_normals {
             built.compute_normals();
+        }
+        if let Some(transform) = mapping.transform {
+            transform.bake(&mut built)?;
         }
         Ok(Some(built))
     }
@@ -708,7 +806,7 @@ impl<'d> Importer<'d> {
         }
         let converted = match key {
             None => Material { name: "gltf-default".into(), ..Material::default() },
-            Some(index) => self.convert_material(&material, index)?,
+            Some(_) => self.convert_material(&material)?,
         };
         self.out.materials.push(converted);
         let index = self.out.materials.len() - 1;
@@ -716,8 +814,66 @@ impl<'d> Importer<'d> {
         Ok(index)
     }
 
-    fn convert_material(&mut self, material: &gltf::Material<'d>, index: usize) -> Result<Material, String> {
-        let name = material.name().map_or_else(|| format!("material {index}"), str::to_owned);
+    /// The texture coordinates `material`'s textures read (see the module documentation),
+    /// decided once per material, which warns once when its textures disagree.
+    fn uv_mapping(&mut self, material: &gltf::Material<'d>) -> Result<UvMapping, String> {
+        let key = material.index();
+        if let Some(&known) = self.uv_mappings.get(&key) {
+            return Ok(known);
+        }
+        let name = material_name(material);
+        let base = match material.pbr_metallic_roughness().base_color_texture() {
+            Some(info) => Some(match info.texture_transform() {
+                Some(t) => UvMapping {
+                    set: t.tex_coord().unwrap_or(info.tex_coord()),
+                    transform: UvTransform::new(
+                        t.offset(),
+                        t.rotation(),
+                        t.scale(),
+                        &format!("material `{name}`'s base colour texture"),
+                    )?,
+                },
+                None => UvMapping { set: info.tex_coord(), transform: None },
+            }),
+            None => None,
+        };
+        let normal = match material.normal_texture() {
+            Some(info) => {
+                let what = format!("material `{name}`'s normal texture");
+                Some(match info.extension_value("KHR_texture_transform") {
+                    Some(value) => {
+                        let t: gltf::json::extensions::texture::TextureTransform =
+                            gltf::json::deserialize::from_value(value.clone())
+                                .map_err(|e| format!("{what}: KHR_texture_transform is malformed: {e}"))?;
+                        UvMapping {
+                            set: t.tex_coord.unwrap_or(info.tex_coord()),
+                            transform: UvTransform::new(t.offset.0, t.rotation.0, t.scale.0, &what)?,
+                        }
+                    }
+                    None => UvMapping { set: info.tex_coord(), transform: None },
+                })
+            }
+            None => None,
+        };
+        let mapping = match (base, normal) {
+            (Some(base), Some(normal)) => {
+                if base != normal {
+                    self.warn(format!(
+                        "material `{name}`: its normal texture reads {normal} and its base colour texture {base}; \
+                         a Mirador material has one set of texture coordinates, so both read the base colour's"
+                    ));
+                }
+                base
+            }
+            (Some(only), None) | (None, Some(only)) => only,
+            (None, None) => UvMapping::default(),
+        };
+        self.uv_mappings.insert(key, mapping);
+        Ok(mapping)
+    }
+
+    fn convert_material(&mut self, material: &gltf::Material<'d>) -> Result<Material, String> {
+        let name = material_name(material);
         let pbr = material.pbr_metallic_roughness();
         let [r, g, b, alpha] = pbr.base_color_factor();
         let base = Vec3::new(r, g, b);
@@ -725,23 +881,21 @@ impl<'d> Importer<'d> {
         let transmission = material.transmission().map_or(0.0, |t| t.transmission_factor());
         let (metallic, roughness) = (pbr.metallic_factor(), pbr.roughness_factor());
         let cutoff = material.alpha_cutoff().unwrap_or(AlphaMode::DEFAULT_CUTOFF);
+        let specular = material.specular().map(|s| (s.specular_factor(), Vec3::from_array(s.specular_color_factor())));
+        let clearcoat = match material.extension_value("KHR_materials_clearcoat") {
+            Some(value) => Some(clearcoat_of(value, &name)?),
+            None => None,
+        };
         let numbers = [r, g, b, alpha, cutoff, metallic, roughness, transmission];
         if numbers.iter().any(|x| !x.is_finite())
             || !emission.is_finite()
             || material.ior().is_some_and(|x| !x.is_finite())
+            || specular.is_some_and(|(factor, color)| !factor.is_finite() || !color.is_finite())
         {
             return Err(format!("material `{name}` has a factor that is not a finite number"));
         }
         let texture = match pbr.base_color_texture() {
-            Some(info) => {
-                if info.tex_coord() != 0 {
-                    self.warn(format!(
-                        "material `{name}`: its base colour texture uses TEXCOORD_{}, read with TEXCOORD_0",
-                        info.tex_coord()
-                    ));
-                }
-                Some(self.texture(info.texture().source(), ColorSpace::Srgb)?)
-            }
+            Some(info) => Some(self.texture(info.texture().source(), ColorSpace::Srgb)?),
             None => None,
         };
         // One wrap for the whole material: the base colour texture's sampler, else the normal
@@ -755,7 +909,14 @@ impl<'d> Importer<'d> {
             Some(info) => Some((self.texture(info.texture().source(), ColorSpace::Linear)?, info.scale())),
             None => None,
         };
-        let phong = phong_from_metallic_roughness(base, metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0));
+        // glTF's index of refraction, 1.5 unless `KHR_materials_ior` says otherwise; it sets the
+        // dielectric reflectance whether or not the material transmits.
+        let gltf_ior = material.ior().filter(|&ior| ior >= 1.0);
+        let f0 = dielectric_f0(gltf_ior.unwrap_or(1.5), specular);
+        let mut phong = phong_from_metallic_roughness(base, metallic.clamp(0.0, 1.0), roughness.clamp(0.0, 1.0), f0);
+        if let Some((factor, coat_roughness)) = clearcoat {
+            phong = with_clearcoat(phong, factor, coat_roughness);
+        }
         let transmission = transmission.clamp(0.0, 1.0);
         let default_ior = if transmission > 0.0 { 1.5 } else { 1.0 };
         let alpha_mode = match material.alpha_mode() {
@@ -781,10 +942,10 @@ impl<'d> Importer<'d> {
             shininess: phong.shininess,
             emission,
             mirror: phong.mirror,
-            mirror_color: phong.specular_color,
+            mirror_color: phong.mirror_color,
             transmission,
             transmission_color: base,
-            ior: material.ior().filter(|&ior| ior >= 1.0).unwrap_or(default_ior),
+            ior: gltf_ior.unwrap_or(default_ior),
             height_map: None,
             height_field: None,
             bump_scale: 1.0,
@@ -844,10 +1005,8 @@ impl<'d> Importer<'d> {
             .ok()
             .or(declared)
             .ok_or_else(|| format!("{described}: not a recognised image format (PNG or JPEG expected)"))?;
-        let reader = || image::ImageReader::with_format(Cursor::new(&bytes[..]), format);
-        let (width, height) = reader().into_dimensions().map_err(|e| format!("{described}: cannot decode: {e}"))?;
-        texture::check_size(width, height).map_err(|e| format!("{described}: {e}"))?;
-        let decoded = reader().decode().map_err(|e| format!("{described}: cannot decode: {e}"))?;
+        let reader = image::ImageReader::with_format(Cursor::new(&bytes[..]), format);
+        let decoded = texture::decode(reader).map_err(|e| format!("{described}: {e}"))?;
         self.out.textures.push(texture::from_image(&texture_path, decoded, space));
         let id = TextureId(self.out.textures.len() - 1);
         self.textures.insert((index, space), id);
@@ -924,6 +1083,90 @@ impl<'d> Importer<'d> {
     }
 }
 
+/// The texture coordinates a material's textures read: one `TEXCOORD_n` set, and the
+/// `KHR_texture_transform` baked into it (`None`: none, or the identity).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct UvMapping {
+    set: u32,
+    transform: Option<UvTransform>,
+}
+
+impl std::fmt::Display for UvMapping {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "TEXCOORD_{}", self.set)?;
+        match self.transform {
+            Some(t) => write!(
+                f,
+                " with offset ({}, {}), rotation {} rad, scale ({}, {})",
+                t.offset.x, t.offset.y, t.rotation, t.scale.x, t.scale.y
+            ),
+            None => write!(f, " untransformed"),
+        }
+    }
+}
+
+/// `KHR_texture_transform`: `uv' = T(offset) · R(rotation) · S(scale) · uv`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct UvTransform {
+    offset: Vec2,
+    /// Radians; the extension's matrix turns uv by `−rotation` (the image appears turned by
+    /// `rotation` counter-clockwise, as the extension words it).
+    rotation: f32,
+    scale: Vec2,
+}
+
+impl UvTransform {
+    /// The extension's fields, `None` for the identity; `what` names them in the error for a
+    /// value that is not finite.
+    fn new(offset: [f32; 2], rotation: f32, scale: [f32; 2], what: &str) -> Result<Option<UvTransform>, String> {
+        if !offset.iter().chain(&scale).all(|x| x.is_finite()) || !rotation.is_finite() {
+            return Err(format!("{what}: KHR_texture_transform has a value that is not a finite number"));
+        }
+        let transform = UvTransform { offset: Vec2::from_array(offset), rotation, scale: Vec2::from_array(scale) };
+        Ok((transform != UvTransform { offset: Vec2::ZERO, rotation: 0.0, scale: Vec2::ONE }).then_some(transform))
+    }
+
+    /// The extension's matrix, translation · rotation · scale, with its rotation
+    /// `[cos sin; −sin cos]` (rows).
+    fn matrix(&self) -> glam::Affine2 {
+        let (sin, cos) = self.rotation.sin_cos();
+        glam::Affine2::from_cols(Vec2::new(cos, -sin) * self.scale.x, Vec2::new(sin, cos) * self.scale.y, self.offset)
+    }
+
+    /// Carries `mesh`'s texture coordinates through the transform, and its tangents (the file's,
+    /// if it has them) with them. A tangent is `∂p/∂u`; with `uv' = A·uv + offset`,
+    /// `∂p/∂u' = ∂p/∂u · (A⁻¹)₀₀ + ∂p/∂v · (A⁻¹)₁₀`, where `∂p/∂v` is glTF's bitangent
+    /// `w·(n × t)`; a mirroring transform (det A < 0) flips the handedness `w`. The lengths of
+    /// `∂p/∂u` and `∂p/∂v` are not in the file (its vectors are unit), so a non-uniform scale
+    /// turns the tangent as if they were equal.
+    fn bake(&self, mesh: &mut Mesh) -> Result<(), String> {
+        let matrix = self.matrix();
+        for uv in &mut mesh.uvs {
+            *uv = matrix.transform_point2(*uv);
+        }
+        if let Some(vertex) = mesh.uvs.iter().position(|uv| !uv.is_finite()) {
+            return Err(format!(
+                "mesh `{}`: vertex {vertex}'s texture coordinates overflow under KHR_texture_transform",
+                mesh.name
+            ));
+        }
+        let a = matrix.matrix2;
+        let determinant = a.determinant();
+        if determinant == 0.0 || !determinant.is_finite() {
+            return Err(format!("mesh `{}`: its KHR_texture_transform collapses the texture (scale 0)", mesh.name));
+        }
+        let inverse = a.inverse();
+        for (tangent, &normal) in mesh.tangents.iter_mut().zip(&mesh.normals) {
+            let (t, w) = (tangent.truncate(), tangent.w);
+            let bitangent = normal.cross(t) * w;
+            let turned = t * inverse.x_axis.x + bitangent * inverse.x_axis.y;
+            let handedness = if determinant < 0.0 { -w } else { w };
+            *tangent = turned.try_normalize().unwrap_or(t).extend(handedness);
+        }
+        Ok(())
+    }
+}
+
 fn node_label(node: &gltf::Node<'_>) -> String {
     node.name().map_or_else(|| format!("node {}", node.index()), str::to_owned)
 }
@@ -973,6 +1216,26 @@ fn fan_to_list(vertices: &[u32]) -> Vec<u32> {
     (0..vertices.len().saturating_sub(2)).flat_map(|i| [vertices[i + 1], vertices[i + 2], vertices[0]]).collect()
 }
 
+/// A material's name for messages: its own, or `material N`.
+fn material_name(material: &gltf::Material<'_>) -> String {
+    material.name().map_or_else(|| format!("material {}", material.index().unwrap_or(0)), str::to_owned)
+}
+
+/// `KHR_materials_clearcoat`'s `clearcoatFactor` and `clearcoatRoughnessFactor` (both 0 when
+/// absent), clamped to [0, 1]. The `gltf` crate does not parse this extension; its JSON is read
+/// here.
+fn clearcoat_of(value: &gltf::json::Value, name: &str) -> Result<(f32, f32), String> {
+    let number = |key: &str| match value.get(key) {
+        None => Ok(0.0),
+        Some(v) => {
+            v.as_f64().map(|x| x as f32).filter(|x| x.is_finite()).map(|x| x.clamp(0.0, 1.0)).ok_or_else(|| {
+                format!("material `{name}`: KHR_materials_clearcoat's `{key}` is {v}, not a finite number")
+            })
+        }
+    };
+    Ok((number("clearcoatFactor")?, number("clearcoatRoughnessFactor")?))
+}
+
 /// The Phong-style terms of the module documentation's material rule.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct PhongTerms {
@@ -981,19 +1244,65 @@ struct PhongTerms {
     specular_color: Vec3,
     shininess: f32,
     mirror: f32,
+    mirror_color: Vec3,
 }
 
-/// `metallic` and `roughness` in [0, 1]; `base` is `baseColorFactor.rgb`.
-fn phong_from_metallic_roughness(base: Vec3, metallic: f32, roughness: f32) -> PhongTerms {
+/// glTF's reflectance of a dielectric at normal incidence: `((ior − 1)/(ior + 1))²` (0.04 for
+/// the default 1.5), and with `KHR_materials_specular`'s (factor, colour)
+/// `min(F0 · specularColorFactor, 1) · specularFactor`, per channel.
+fn dielectric_f0(ior: f32, specular: Option<(f32, Vec3)>) -> Vec3 {
+    let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2);
+    match specular {
+        Some((factor, color)) => (Vec3::splat(f0) * color.max(Vec3::ZERO)).min(Vec3::ONE) * factor.clamp(0.0, 1.0),
+        None => Vec3::splat(f0),
+    }
+}
+
+/// The Phong exponent whose lobe matches a GGX lobe of `roughness` (α = roughness²).
+fn shininess_of(roughness: f32) -> f32 {
     let alpha = roughness * roughness;
     // Roughness 0 divides by zero; the infinite exponent clamps to the sharpest lobe.
-    let shininess = (2.0 / (alpha * alpha) - 2.0).clamp(1.0, MAX_SHININESS);
+    (2.0 / (alpha * alpha) - 2.0).clamp(1.0, MAX_SHININESS)
+}
+
+/// `metallic` and `roughness` in [0, 1]; `base` is `baseColorFactor.rgb`; `f0` the dielectric
+/// reflectance ([`dielectric_f0`]), whose largest channel is the dielectric's specular weight
+/// and whose hue is its specular colour.
+fn phong_from_metallic_roughness(base: Vec3, metallic: f32, roughness: f32, f0: Vec3) -> PhongTerms {
+    let strength = f0.max_element();
+    let hue = if strength > 0.0 { f0 / strength } else { Vec3::ONE };
+    let specular_color = hue.lerp(base, metallic);
     PhongTerms {
         kd: 1.0 - metallic,
-        ks: (0.04 * (1.0 - metallic) + metallic) * (1.0 - roughness),
-        specular_color: Vec3::ONE.lerp(base, metallic),
-        shininess,
+        ks: (strength * (1.0 - metallic) + metallic) * (1.0 - roughness),
+        specular_color,
+        shininess: shininess_of(roughness),
         mirror: metallic * (1.0 - roughness) * (1.0 - roughness),
+        mirror_color: specular_color,
+    }
+}
+
+/// `KHR_materials_clearcoat` (factor `c`, roughness `rc`) as a white dielectric layer of
+/// reflectance `F = 0.04·c` over the base: the base's diffuse, specular and mirror weights keep
+/// `1 − F`, the layer adds `F·(1 − rc)` to the specular weight and `F·(1 − rc)²` to the mirror
+/// weight, the colours become the weights' mix of the base's and white, and the one specular lobe
+/// takes the exponent of whichever of the two weighs more.
+fn with_clearcoat(base: PhongTerms, factor: f32, roughness: f32) -> PhongTerms {
+    let reflectance = CLEARCOAT_F0 * factor;
+    let below = 1.0 - reflectance;
+    let (coat_ks, coat_mirror) = (reflectance * (1.0 - roughness), reflectance * (1.0 - roughness).powi(2));
+    let (base_ks, base_mirror) = (base.ks * below, base.mirror * below);
+    let mix = |base_weight: f32, base_color: Vec3, coat_weight: f32| {
+        let sum = base_weight + coat_weight;
+        if sum > 0.0 { (base_color * base_weight + Vec3::ONE * coat_weight) / sum } else { base_color }
+    };
+    PhongTerms {
+        kd: base.kd * below,
+        ks: base_ks + coat_ks,
+        specular_color: mix(base_ks, base.specular_color, coat_ks),
+        shininess: if coat_ks > base_ks { shininess_of(roughness) } else { base.shininess },
+        mirror: base_mirror + coat_mirror,
+        mirror_color: mix(base_mirror, base.mirror_color, coat_mirror),
     }
 }
 
@@ -1013,20 +1322,22 @@ mod tests {
     #[test]
     fn material_rule_at_its_extremes() {
         let gold = Vec3::new(1.0, 0.8, 0.3);
-        let smooth_metal = phong_from_metallic_roughness(gold, 1.0, 0.0);
+        let f0 = dielectric_f0(1.5, None);
+        assert!((f0 - Vec3::splat(0.04)).abs().max_element() < 1e-7, "ior 1.5 reflects 4 %: {f0}");
+        let smooth_metal = phong_from_metallic_roughness(gold, 1.0, 0.0, f0);
         assert_eq!(smooth_metal.kd, 0.0);
         assert_eq!(smooth_metal.ks, 1.0);
         assert_eq!(smooth_metal.specular_color, gold);
         assert_eq!(smooth_metal.shininess, MAX_SHININESS);
         assert_eq!(smooth_metal.mirror, 1.0);
-        let rough_plastic = phong_from_metallic_roughness(gold, 0.0, 1.0);
+        let rough_plastic = phong_from_metallic_roughness(gold, 0.0, 1.0, f0);
         assert_eq!(rough_plastic.kd, 1.0);
         assert_eq!(rough_plastic.ks, 0.0);
         assert_eq!(rough_plastic.specular_color, Vec3::ONE);
         assert_eq!(rough_plastic.shininess, 1.0);
         assert_eq!(rough_plastic.mirror, 0.0);
         // α = 0.25, e = 2/0.0625 − 2.
-        assert!((phong_from_metallic_roughness(gold, 0.0, 0.5).shininess - 30.0).abs() < 1e-4);
+        assert!((phong_from_metallic_roughness(gold, 0.0, 0.5, f0).shininess - 30.0).abs() < 1e-4);
     }
 
     #[test]
