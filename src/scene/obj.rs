@@ -153,7 +153,7 @@ fn import_text(path: &Path, text: &str) -> Result<ModelImport, String> {
         reader.out.objects.push(GltfObject { name, mesh, material, world_from_local: Mat4::IDENTITY });
     }
     if reader.out.objects.is_empty() {
-        return Err("the file has no faces to draw (no `f` statements with three or more vertices)".into());
+        return Err("the file has no faces to draw (no `f` statement with three or more vertices and an area)".into());
     }
     Ok(reader.out)
 }
