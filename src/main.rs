@@ -87,7 +87,7 @@ enum Command {
 
 #[derive(clap::Args)]
 struct SceneArgs {
-    /// Scene file (TOML, or a .gltf/.glb model). Default: the built-in showcase.
+    /// Scene file (TOML, or a .gltf/.glb/.obj/.ply model). Default: the built-in showcase.
     scene: Option<PathBuf>,
     /// Image width in pixels (default: the scene camera's).
     #[arg(long)]
@@ -105,7 +105,7 @@ struct SceneArgs {
 
 #[derive(clap::Args, Default)]
 struct ViewArgs {
-    /// Scene file (TOML, or a .gltf/.glb model). Default: the built-in showcase.
+    /// Scene file (TOML, or a .gltf/.glb/.obj/.ply model). Default: the built-in showcase.
     scene: Option<PathBuf>,
     /// Change a render setting, as a dotted key and a TOML value: `--set shadows.enabled=false`.
     #[arg(long = "set", value_name = "KEY=VALUE")]

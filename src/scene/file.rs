@@ -17,20 +17,20 @@ use toml::Spanned;
 
 use super::camera::{Camera, Projection};
 use super::environment::{self, Environment, EnvironmentSource, Sky};
-use super::gltf::{GltfCamera, GltfImport, GltfProjection};
+use super::gltf::{GltfCamera, GltfProjection};
 use super::light::{Attenuation, Light, LightKind};
 use super::material::{AlphaMode, ColorSpace, Material, MaterialId, ProceduralHeight, TextureId, Wrap};
-use super::{Object, Scene, SceneError, Shape, texture};
+use super::{ModelImport, Object, Scene, SceneError, Shape, texture};
 use crate::settings::RenderSettings;
 
-/// Reads a scene file: TOML, or a bare glTF model.
+/// Reads a scene file: TOML, or a bare model (glTF, OBJ or PLY, told by the file's extension).
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    let is_gltf = matches!(
-        path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
-        Some("gltf" | "glb")
-    );
-    if is_gltf {
-        return load_bare_gltf(path);
+    let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    match extension.as_deref() {
+        Some("gltf" | "glb") => return load_bare_model(path, super::gltf::import(path)?),
+        Some("obj") => return load_bare_model(path, super::obj::import(path)?),
+        Some("ply") => return load_bare_model(path, super::ply::import(path)?),
+        _ => {}
     }
     let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
     parse(&text, path)
@@ -374,6 +374,8 @@ enum ObjectType {
     Torus,
     RoundedBox,
     Gltf,
+    Obj,
+    Ply,
 }
 
 impl ObjectType {
@@ -386,6 +388,8 @@ impl ObjectType {
             ObjectType::Torus => "torus",
             ObjectType::RoundedBox => "rounded_box",
             ObjectType::Gltf => "gltf",
+            ObjectType::Obj => "obj",
+            ObjectType::Ply => "ply",
         }
     }
 }
@@ -796,6 +800,7 @@ impl<'a> Builder<'a> {
             ObjectType::Torus => &["major_radius", "minor_radius", "material"],
             ObjectType::RoundedBox => &["half_extents", "radius", "material"],
             ObjectType::Gltf => &["path", "lights", "camera"],
+            ObjectType::Obj | ObjectType::Ply => &["path", "material"],
         };
         if let Some((field, _)) = fields.iter().find(|(f, present)| *present && !allowed.contains(f)) {
             return Err(fail(format!("`{field}` does not apply to a {kind_name}")));
@@ -839,28 +844,43 @@ impl<'a> Builder<'a> {
                 let relative = d.path.ok_or_else(|| fail("a gltf object needs a `path`".into()))?;
                 let import = super::gltf::import(&self.dir.join(relative)).map_err(|e| fail(e.to_string()))?;
                 let camera = d.camera.unwrap_or(false).then(|| import.cameras.first().cloned()).flatten();
-                self.add_gltf(import, world_from_local, d.lights.unwrap_or(true), &name);
+                add_model(&mut self.scene, import, world_from_local, d.lights.unwrap_or(true), &name, None);
                 return Ok(
                     camera.map(|c| GltfCamera { world_from_camera: world_from_local * c.world_from_camera, ..c })
                 );
             }
+            ObjectType::Obj | ObjectType::Ply => {
+                let article = if d.kind == ObjectType::Obj { "an" } else { "a" };
+                let relative = d.path.ok_or_else(|| fail(format!("{article} {kind_name} object needs a `path`")))?;
+                let file = self.dir.join(relative);
+                let import = match d.kind {
+                    ObjectType::Obj => super::obj::import(&file),
+                    _ => super::ply::import(&file),
+                };
+                let import = import.map_err(|e| fail(e.to_string()))?;
+                let material = d.material.map(|m| self.named_material(m)).transpose()?;
+                add_model(&mut self.scene, import, world_from_local, false, &name, material);
+                return Ok(None);
+            }
         };
         let material = match d.material {
-            // `default` names the implicit default material, defined or not.
-            Some(m) if m.get_ref() == "default" && !self.material_ids.contains_key("default") => {
-                self.default_material()
-            }
-            Some(m) => {
-                let span = m.span();
-                *self.material_ids.get(m.get_ref()).ok_or_else(|| {
-                    let known: Vec<&str> = self.material_ids.keys().map(String::as_str).collect();
-                    self.error(format!("no material named `{}` (known: {})", m.get_ref(), known.join(", ")), span)
-                })?
-            }
+            Some(m) => self.named_material(m)?,
             None => self.default_material(),
         };
         self.scene.objects.push(Object { name, shape, material, world_from_local });
         Ok(None)
+    }
+
+    /// The material an object's `material` field names.
+    fn named_material(&mut self, name: Spanned<String>) -> Result<MaterialId, SceneError> {
+        // `default` names the implicit default material, defined or not.
+        if name.get_ref() == "default" && !self.material_ids.contains_key("default") {
+            return Ok(self.default_material());
+        }
+        self.material_ids.get(name.get_ref()).copied().ok_or_else(|| {
+            let known: Vec<&str> = self.material_ids.keys().map(String::as_str).collect();
+            self.error(format!("no material named `{}` (known: {})", name.get_ref(), known.join(", ")), name.span())
+        })
     }
 
     fn default_material(&mut self) -> MaterialId {
@@ -869,28 +889,34 @@ impl<'a> Builder<'a> {
             MaterialId(self.scene.materials.len() - 1)
         })
     }
-
-    /// Appends an imported model, placed by `world_from_root`, re-indexing its meshes,
-    /// materials and textures.
-    fn add_gltf(&mut self, import: GltfImport, world_from_root: Mat4, with_lights: bool, name: &str) {
-        add_gltf(&mut self.scene, import, world_from_root, with_lights, name);
-    }
 }
 
-fn add_gltf(scene: &mut Scene, import: GltfImport, world_from_root: Mat4, with_lights: bool, name: &str) {
+/// Appends an imported model, placed by `world_from_root`, re-indexing its meshes, materials and
+/// textures. With `material`, every object of the model is drawn in that scene material instead,
+/// and the model's own materials and textures are left out.
+fn add_model(
+    scene: &mut Scene,
+    import: ModelImport,
+    world_from_root: Mat4,
+    with_lights: bool,
+    name: &str,
+    material: Option<MaterialId>,
+) {
     let (mesh_base, material_base, texture_base) = (scene.meshes.len(), scene.materials.len(), scene.textures.len());
     scene.meshes.extend(import.meshes);
-    scene.textures.extend(import.textures);
-    scene.materials.extend(import.materials.into_iter().map(|mut m| {
-        m.texture = m.texture.map(|TextureId(i)| TextureId(i + texture_base));
-        m.height_map = m.height_map.map(|TextureId(i)| TextureId(i + texture_base));
-        m.normal_map = m.normal_map.map(|TextureId(i)| TextureId(i + texture_base));
-        m
-    }));
+    if material.is_none() {
+        scene.textures.extend(import.textures);
+        scene.materials.extend(import.materials.into_iter().map(|mut m| {
+            m.texture = m.texture.map(|TextureId(i)| TextureId(i + texture_base));
+            m.height_map = m.height_map.map(|TextureId(i)| TextureId(i + texture_base));
+            m.normal_map = m.normal_map.map(|TextureId(i)| TextureId(i + texture_base));
+            m
+        }));
+    }
     scene.objects.extend(import.objects.into_iter().map(|o| Object {
         name: format!("{name}/{}", o.name),
         shape: Shape::Mesh(mesh_base + o.mesh),
-        material: MaterialId(material_base + o.material),
+        material: material.unwrap_or(MaterialId(material_base + o.material)),
         world_from_local: world_from_root * o.world_from_local,
     }));
     if with_lights {
@@ -1016,9 +1042,8 @@ pub const PHYSICAL_WORLD: f32 = 0.0509;
 
 /// A bare model: its own camera if it has one, else one framing it; its own lights if it has
 /// any (then in [`PHYSICAL_WORLD`]), else a white directional light from over the viewer's
-/// shoulder.
-fn load_bare_gltf(path: &Path) -> Result<Scene, SceneError> {
-    let import = super::gltf::import(path)?;
+/// shoulder. OBJ and PLY files have neither, so they always get the framing camera and the light.
+fn load_bare_model(path: &Path, import: ModelImport) -> Result<Scene, SceneError> {
     let mut scene = empty_scene(path);
     if !import.lights.is_empty() {
         scene.ambient = Vec3::splat(PHYSICAL_WORLD);
@@ -1026,7 +1051,7 @@ fn load_bare_gltf(path: &Path) -> Result<Scene, SceneError> {
     }
     let camera = import.cameras.first().cloned();
     let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("model").to_string();
-    add_gltf(&mut scene, import, Mat4::IDENTITY, true, &name);
+    add_model(&mut scene, import, Mat4::IDENTITY, true, &name, None);
     scene.camera = match camera {
         Some(c) => camera_from_gltf(&c, 1280, 720, scene.bounds()),
         None => frame_scene(&scene),

@@ -149,7 +149,6 @@
 use std::collections::HashMap;
 use std::ffi::OsString;
 use std::io::Cursor;
-use std::panic::{self, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
@@ -237,19 +236,7 @@ pub fn import(path: &Path) -> Result<GltfImport, SceneError> {
         return Err(gltf_error("no file given (the path is empty)".into()));
     }
     let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
-    // The explicit checks below come first; this only keeps a malformed file the `gltf` crate
-    // trips over from taking the whole program down.
-    match panic::catch_unwind(AssertUnwindSafe(|| import_bytes(path, &bytes))) {
-        Ok(result) => result.map_err(gltf_error),
-        Err(payload) => {
-            let what = payload
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "no details".into());
-            Err(gltf_error(format!("malformed file (the reader stopped on an internal check: {what})")))
-        }
-    }
+    super::without_panics(|| import_bytes(path, &bytes)).map_err(gltf_error)
 }
 
 fn import_bytes(path: &Path, bytes: &[u8]) -> Result<GltfImport, String> {

@@ -3,7 +3,8 @@
 //! A [`Scene`] holds a camera, lights, materials, textures, meshes and objects. Objects are
 //! analytic shapes (sphere, axis-aligned box, plane) or triangle meshes, each placed by a
 //! `world_from_local` transform; glTF models are imported into meshes, materials, lights and
-//! cameras. Scenes are written in TOML ([`file`], documented in `docs/scene-format.md`).
+//! cameras, Wavefront OBJ models (with their MTL materials) and PLY meshes into meshes and
+//! materials. Scenes are written in TOML ([`file`], documented in `docs/scene-format.md`).
 
 pub mod camera;
 pub mod environment;
@@ -12,6 +13,8 @@ pub mod gltf;
 pub mod light;
 pub mod material;
 pub mod mesh;
+pub mod obj;
+pub mod ply;
 pub mod shading;
 pub mod sphereflake;
 pub mod texture;
@@ -25,6 +28,10 @@ pub use environment::{EnvImage, Environment, EnvironmentSource, Sky};
 pub use light::{Attenuation, Light, LightKind};
 pub use material::{AlphaMode, ColorSpace, Material, MaterialId, ProceduralHeight, Texture, TextureId, Wrap};
 pub use mesh::Mesh;
+
+/// What one model file (glTF, OBJ or PLY) contributes to a scene. glTF's container is the fullest,
+/// so it serves all three; OBJ and PLY files leave its lights and cameras empty.
+pub type ModelImport = gltf::GltfImport;
 
 use crate::settings::RenderSettings;
 
@@ -126,6 +133,10 @@ pub enum SceneError {
     Invalid { path: PathBuf, message: String },
     #[error("{path}: glTF: {message}")]
     Gltf { path: PathBuf, message: String },
+    #[error("{path}: OBJ: {message}")]
+    Obj { path: PathBuf, message: String },
+    #[error("{path}: PLY: {message}")]
+    Ply { path: PathBuf, message: String },
     #[error("{path}: texture: {message}")]
     Texture { path: PathBuf, message: String },
 }
@@ -137,14 +148,16 @@ impl SceneError {
             | SceneError::Syntax { path, .. }
             | SceneError::Invalid { path, .. }
             | SceneError::Gltf { path, .. }
+            | SceneError::Obj { path, .. }
+            | SceneError::Ply { path, .. }
             | SceneError::Texture { path, .. } => path,
         }
     }
 }
 
 impl Scene {
-    /// Loads a TOML scene file (or a bare `.gltf` / `.glb` model, framed by a default camera and
-    /// light).
+    /// Loads a TOML scene file (or a bare `.gltf` / `.glb` / `.obj` / `.ply` model, framed by a
+    /// default camera and light).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         file::load(path)
     }
@@ -204,6 +217,23 @@ impl Scene {
             }
         }
         bounds
+    }
+}
+
+/// Runs a model reader, turning a panic inside a third-party parser into an error message. The
+/// readers check what they can before handing bytes to a parser; this is only the last net that
+/// keeps a malformed file the parser trips over from taking the whole program down.
+fn without_panics<T>(read: impl FnOnce() -> Result<T, String>) -> Result<T, String> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(read)) {
+        Ok(result) => result,
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "no details".into());
+            Err(format!("malformed file (the reader stopped on an internal check: {what})"))
+        }
     }
 }
 

@@ -18,7 +18,7 @@ pub const KEYS: &[(&str, &str)] = &[
     ("O", "show or hide the frame times"),
     ("F12", "screenshot of the window (PNG in the current directory)"),
     ("F1 or H", "this help"),
-    ("drop a file", "open a scene (.toml) or a glTF model (.gltf, .glb)"),
+    ("drop a file", "open a scene (.toml) or a model (.gltf, .glb, .obj, .ply)"),
 ];
 
 pub fn help_window(ctx: &egui::Context, open: &mut bool) {

@@ -188,7 +188,7 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     ui.separator();
     let source = model.scene.scene.source.as_ref().map_or("(built in)".to_string(), |p| p.display().to_string());
     ui.label(format!("scene: {source}")).on_hover_text(
-        "Drop a .toml scene or a .gltf/.glb model on the window to open it; the file is reloaded when it changes.",
+        "Drop a .toml scene or a .gltf/.glb/.obj/.ply model on the window to open it; the file is reloaded when it changes.",
     );
     for notice in model.notices.iter().rev().take(3) {
         ui.small(notice);

@@ -1,0 +1,301 @@
+//! PLY import: Greg Turk's polygon file format, in which the Stanford 3D Scanning Repository
+//! publishes its scans (the bunny, the dragon, Lucy), read in all three encodings (ASCII, binary
+//! little-endian and binary big-endian) into one mesh in the default material. It fills the same
+//! [`ModelImport`] as a glTF file, with one object and no lights or cameras; the scene loader
+//! places it.
+//!
+//! Parsing is the `ply-rs-bw` crate's, the maintained continuation of `ply-rs`. It reads a header
+//! that lies without trusting it: it never reserves more than 65 536 elements up front, so a header
+//! declaring a billion vertices costs nothing until they are actually read, and a file that ends
+//! before its declared counts is an error, not a panic.
+//!
+//! # What is read
+//!
+//! - Element `vertex`: `x`, `y`, `z` (any scalar type, converted to 32-bit floats); `nx`, `ny`,
+//!   `nz` when all three are there (normals are computed, area-weighted as for glTF, when they are
+//!   not, or when one is zero); texture coordinates from `u`, `v` (or `s`, `t`, `texture_u`,
+//!   `texture_v`, `texture_s`, `texture_t`), turned to `(u, 1 − v)`: PLY files written with
+//!   texture coordinates follow OBJ's convention of `v = 0` at the bottom of the image.
+//! - Element `face`: the list `vertex_indices` (or `vertex_index`, which some scanners write) of
+//!   any integer type. Polygons are triangulated as fans (`v0, vi, vi+1`); faces with fewer than
+//!   three vertices are skipped with a warning; zero-area triangles are removed with a warning.
+//! - The mesh is one object named `mesh` in [`Material::default()`], named `ply-default` (PLY has
+//!   no materials). In a scene file, an object's `material` field replaces it.
+//!
+//! Ignored, with a warning: vertex colours (`red`, `green`, `blue`, `alpha`) and every other
+//! vertex or face property; other elements (`edge`, `material`, range-grid data) are read past.
+//!
+//! # Errors
+//!
+//! Bad input gives [`SceneError::Ply`] naming the file and the problem ([`SceneError::Io`] when the
+//! file cannot be read); it never panics: an empty file, a header the parser rejects, a file that
+//! ends before the counts its header declares, a file without `vertex` or `face` elements (a point
+//! cloud, which Mirador cannot draw), `x`, `y` or `z` missing, face indices that are not integers,
+//! a coordinate that is not finite (with its vertex number), and a face index below 0 or past the
+//! last vertex (with its face number).
+
+use std::io::Cursor;
+use std::path::Path;
+
+use glam::{Mat4, Vec2, Vec3};
+use ply_rs_bw::parser::{Parser, Reader};
+use ply_rs_bw::ply::{ElementDef, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType};
+
+use super::gltf::GltfObject;
+use super::{Material, Mesh, ModelImport, SceneError};
+
+/// The name of the material a PLY mesh is drawn in.
+pub const DEFAULT_MATERIAL: &str = "ply-default";
+
+/// The property pairs read as texture coordinates, in order of preference.
+const UV_NAMES: [(&str, &str); 4] = [("u", "v"), ("s", "t"), ("texture_u", "texture_v"), ("texture_s", "texture_t")];
+
+/// The names of a face's vertex index list.
+const INDEX_NAMES: [&str; 2] = ["vertex_indices", "vertex_index"];
+
+/// Loads a `.ply` file; see the module documentation.
+pub fn import(path: &Path) -> Result<ModelImport, SceneError> {
+    let error = |message: String| SceneError::Ply { path: path.to_path_buf(), message };
+    if path.as_os_str().is_empty() {
+        return Err(error("no file given (the path is empty)".into()));
+    }
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    if bytes.is_empty() {
+        return Err(error("the file is empty".into()));
+    }
+    super::without_panics(|| import_bytes(path, &bytes)).map_err(error)
+}
+
+/// One vertex as the file gives it; what the file lacks stays zero.
+#[derive(Clone, Copy, Debug, Default)]
+struct Vertex {
+    position: [f32; 3],
+    normal: [f32; 3],
+    uv: [f32; 2],
+}
+
+impl PropertyAccess for Vertex {
+    fn new() -> Self {
+        Vertex::default()
+    }
+
+    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
+        let Some(x) = property.to_f32_lossy() else { return PropertyAccessResult::Ignored };
+        let slot = match name {
+            "x" => &mut self.position[0],
+            "y" => &mut self.position[1],
+            "z" => &mut self.position[2],
+            "nx" => &mut self.normal[0],
+            "ny" => &mut self.normal[1],
+            "nz" => &mut self.normal[2],
+            "u" | "s" | "texture_u" | "texture_s" => &mut self.uv[0],
+            "v" | "t" | "texture_v" | "texture_t" => &mut self.uv[1],
+            _ => return PropertyAccessResult::Ignored,
+        };
+        *slot = x;
+        PropertyAccessResult::Set
+    }
+}
+
+/// One face's vertex indices, widened so that negative and 32-bit unsigned values both fit.
+#[derive(Clone, Debug, Default)]
+struct Face {
+    indices: Vec<i64>,
+}
+
+impl PropertyAccess for Face {
+    fn new() -> Self {
+        Face::default()
+    }
+
+    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
+        if !INDEX_NAMES.contains(&name) {
+            return PropertyAccessResult::Ignored;
+        }
+        self.indices = match property {
+            Property::ListChar(list) => list.into_iter().map(i64::from).collect(),
+            Property::ListUChar(list) => list.into_iter().map(i64::from).collect(),
+            Property::ListShort(list) => list.into_iter().map(i64::from).collect(),
+            Property::ListUShort(list) => list.into_iter().map(i64::from).collect(),
+            Property::ListInt(list) => list.into_iter().map(i64::from).collect(),
+            Property::ListUInt(list) => list.into_iter().map(i64::from).collect(),
+            _ => return PropertyAccessResult::UnsupportedType,
+        };
+        PropertyAccessResult::Set
+    }
+}
+
+/// An element that is read past and dropped.
+#[derive(Clone, Copy, Debug)]
+struct Skipped;
+
+impl PropertyAccess for Skipped {
+    fn new() -> Self {
+        Skipped
+    }
+}
+
+fn import_bytes(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
+    let mut reader = Reader::new(Cursor::new(bytes));
+    let header = Parser::<Skipped>::new().read_header(&mut reader).map_err(|e| format!("header: {e}"))?;
+    let layout = Layout::of(&header)?;
+    let mut out = ModelImport::default();
+    let mut warn = |message: String| {
+        let message = format!("{}: PLY: {message}", path.display());
+        log::warn!("{message}");
+        out.warnings.push(message);
+    };
+    if !layout.ignored.is_empty() {
+        warn(format!("ignoring propert(ies) {}", layout.ignored.join(", ")));
+    }
+    if layout.partial_normals {
+        warn("the vertices have some but not all of nx, ny, nz; normals are computed".into());
+    }
+
+    let (mut vertices, mut faces) = (Vec::new(), Vec::new());
+    for (name, element) in &header.elements {
+        let failed = |e: ply_rs_bw::parser::ParseError| describe_payload_error(element, e);
+        match name.as_str() {
+            "vertex" => vertices = read_element::<Vertex>(&mut reader, element, &header).map_err(failed)?,
+            "face" => faces = read_element::<Face>(&mut reader, element, &header).map_err(failed)?,
+            _ => {
+                read_element::<Skipped>(&mut reader, element, &header).map_err(failed)?;
+            }
+        }
+    }
+
+    let count = u32::try_from(vertices.len())
+        .map_err(|_| format!("{} vertices are more than 32-bit indices reach", vertices.len()))?;
+    if let Some((i, v)) = vertices.iter().enumerate().find(|(_, v)| !Vec3::from_array(v.position).is_finite()) {
+        return Err(format!(
+            "vertex {i} has a coordinate that is not finite ({:?}; NaN, infinity, or a double beyond ±3.4e38, which \
+             overflows 32-bit floats)",
+            v.position
+        ));
+    }
+    let mut indices = Vec::with_capacity(3 * faces.len());
+    let mut short_faces = 0;
+    for (f, face) in faces.iter().enumerate() {
+        if let Some(&bad) = face.indices.iter().find(|&&i| i < 0 || i >= i64::from(count)) {
+            return Err(format!(
+                "face {f} refers to vertex {bad}, and the file has {count} vertices (numbered 0 to {})",
+                i64::from(count) - 1
+            ));
+        }
+        if face.indices.len() < 3 {
+            short_faces += 1;
+            continue;
+        }
+        let v0 = face.indices[0] as u32;
+        for pair in face.indices[1..].windows(2) {
+            indices.extend_from_slice(&[v0, pair[0] as u32, pair[1] as u32]);
+        }
+    }
+    if short_faces > 0 {
+        warn(format!("skipped {short_faces} face(s) with fewer than three vertices"));
+    }
+
+    let name = path.file_stem().map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned());
+    let mut mesh = Mesh {
+        name,
+        positions: vertices.iter().map(|v| Vec3::from_array(v.position)).collect(),
+        // A placeholder until the indices are known to be in range, which computing normals
+        // relies on.
+        normals: vec![Vec3::Y; vertices.len()],
+        uvs: if layout.uvs {
+            vertices.iter().map(|v| Vec2::new(v.uv[0], 1.0 - v.uv[1])).collect()
+        } else {
+            vec![Vec2::ZERO; vertices.len()]
+        },
+        tangents: Vec::new(),
+        indices,
+    };
+    let removed = mesh.validate_and_repair().map_err(|e| e.to_string())?;
+    if removed > 0 {
+        warn(format!("removed {removed} zero-area (degenerate) triangle(s)"));
+    }
+    if mesh.indices.is_empty() {
+        return Err(format!("no triangles to draw ({} faces, none with three vertices and an area)", faces.len()));
+    }
+    let given: Option<Vec<Vec3>> =
+        layout.normals.then(|| vertices.iter().map(|v| Vec3::from_array(v.normal).try_normalize()).collect()).flatten();
+    match given {
+        Some(normals) => mesh.normals = normals,
+        None => {
+            if layout.normals {
+                warn("a vertex normal is zero or not finite; normals are computed for all vertices".into());
+            }
+            mesh.compute_normals();
+        }
+    }
+    out.meshes.push(mesh);
+    out.materials.push(Material { name: DEFAULT_MATERIAL.into(), ..Material::default() });
+    out.objects.push(GltfObject { name: "mesh".into(), mesh: 0, material: 0, world_from_local: Mat4::IDENTITY });
+    Ok(out)
+}
+
+fn read_element<E: PropertyAccess>(
+    reader: &mut Reader<Cursor<&[u8]>>,
+    element: &ElementDef,
+    header: &Header,
+) -> Result<Vec<E>, ply_rs_bw::parser::ParseError> {
+    Parser::<E>::new().read_payload_for_element(reader, element, header)
+}
+
+fn describe_payload_error(element: &ElementDef, error: ply_rs_bw::parser::ParseError) -> String {
+    let ends_early = error.kind() == std::io::ErrorKind::UnexpectedEof;
+    let why = if ends_early { "the file ends before the header's count; truncated, or the header lies: " } else { "" };
+    format!("element `{}` ({} declared): {why}{error}", element.name, element.count)
+}
+
+/// What the header says the vertices and faces carry, checked before any payload is read.
+struct Layout {
+    normals: bool,
+    partial_normals: bool,
+    uvs: bool,
+    /// Properties that are not read, as `element.property`.
+    ignored: Vec<String>,
+}
+
+impl Layout {
+    fn of(header: &Header) -> Result<Layout, String> {
+        let vertex = header.elements.get("vertex").ok_or("the header declares no `vertex` element")?;
+        let face = header
+            .elements
+            .get("face")
+            .ok_or("the header declares no `face` element (a point cloud, which Mirador cannot draw)")?;
+        let scalar = |name: &str| matches!(vertex.properties.get(name), Some(p) if matches!(p.data_type, PropertyType::Scalar(_)));
+        if let Some(missing) = ["x", "y", "z"].into_iter().find(|&c| !scalar(c)) {
+            return Err(format!("the `vertex` element has no scalar property `{missing}`"));
+        }
+        let normal_count = ["nx", "ny", "nz"].into_iter().filter(|&c| scalar(c)).count();
+        let uv = UV_NAMES.into_iter().find(|(u, v)| scalar(u) && scalar(v));
+        let index_list = INDEX_NAMES
+            .into_iter()
+            .find_map(|name| face.properties.get(name))
+            .ok_or_else(|| format!("the `face` element has no `{}` (or `{}`) list", INDEX_NAMES[0], INDEX_NAMES[1]))?;
+        match index_list.data_type {
+            PropertyType::List(_, ScalarType::Float | ScalarType::Double) => {
+                return Err(format!("the face list `{}` holds floating-point numbers, not indices", index_list.name));
+            }
+            PropertyType::Scalar(_) => return Err(format!("the face property `{}` is not a list", index_list.name)),
+            PropertyType::List(..) => {}
+        }
+        let mut read: Vec<&str> = vec!["x", "y", "z"];
+        if normal_count == 3 {
+            read.extend(["nx", "ny", "nz"]);
+        }
+        if let Some((u, v)) = uv {
+            read.extend([u, v]);
+        }
+        let mut ignored: Vec<String> =
+            vertex.properties.keys().filter(|p| !read.contains(&p.as_str())).map(|p| format!("vertex.{p}")).collect();
+        ignored.extend(face.properties.keys().filter(|&p| *p != index_list.name).map(|p| format!("face.{p}")));
+        Ok(Layout {
+            normals: normal_count == 3,
+            partial_normals: matches!(normal_count, 1 | 2),
+            uvs: uv.is_some(),
+            ignored,
+        })
+    }
+}
