@@ -435,7 +435,9 @@ fn trace(args: SceneArgs, trace_args: TraceArgs, output_path: &Path, exr_path: O
         print_scene(&scene);
     }
     let radiance = ray_trace(&scene, trace_args.threads, &mut clock, args.stats)?;
-    clock.time("encode + write", || write_png(&radiance.to_rgba8(mirador::output::OutputTransform::of(&scene.settings)), output_path))?;
+    clock.time("encode + write", || {
+        write_png(&radiance.to_rgba8(mirador::output::OutputTransform::of(&scene.settings)), output_path)
+    })?;
     if let Some(path) = exr_path {
         let linear = linear_of(radiance)?;
         clock.time("EXR encode + write", || write_exr(&linear, path))?;

@@ -156,7 +156,7 @@ fn gpu_structs_match_their_wgsl_twins_field_by_field() {
     );
     check_struct(&scene, "Shadows", size_of::<GpuShadows>(), &fields!(GpuShadows { layers, map_size, normal_offset }));
     let present = structs(&parse(&shaders::compose(shaders::PRESENT)));
-    check_struct(&present, "Present", size_of::<GpuPresent>(), &fields!(GpuPresent { exposure, scale }));
+    check_struct(&present, "Present", size_of::<GpuPresent>(), &fields!(GpuPresent { exposure, tone_map, scale }));
 }
 
 #[test]
@@ -231,6 +231,17 @@ fn codes_shared_by_rust_and_wgsl_agree() {
     }
     for (name, filter) in SHADOW_FILTER_NAMES {
         assert_eq!(constant(&module, name), f64::from(shadow_filter_code(filter)), "{name}: WGSL vs Rust");
+    }
+    use mirador::settings::ToneMap;
+    let present = parse(&shaders::compose(shaders::PRESENT));
+    for (name, curve) in [
+        ("TONE_MAP_CLAMP", ToneMap::Clamp),
+        ("TONE_MAP_REINHARD", ToneMap::Reinhard),
+        ("TONE_MAP_ACES", ToneMap::Aces),
+        ("TONE_MAP_PBR_NEUTRAL", ToneMap::PbrNeutral),
+    ] {
+        let code = mirador::raster::present::tone_map_code(curve);
+        assert_eq!(constant(&present, name), f64::from(code), "{name}: WGSL vs Rust");
     }
 }
 

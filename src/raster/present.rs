@@ -82,12 +82,7 @@ impl PresentPass {
     ) {
         let out = output.texture().size();
         let scale = [input.size.0 as f32 / out.width as f32, input.size.1 as f32 / out.height as f32];
-        let tone_map = match transform.tone_map {
-            ToneMap::Clamp => 0,
-            ToneMap::Reinhard => 1,
-            ToneMap::Aces => 2,
-            ToneMap::PbrNeutral => 3,
-        };
+        let tone_map = tone_map_code(transform.tone_map);
         self.uniform.write(queue, &GpuPresent { exposure: transform.exposure, tone_map, scale });
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("present::pass"),
@@ -102,5 +97,15 @@ impl PresentPass {
         pass.set_bind_group(0, &input.group, &[]);
         pass.draw(0..3, 0..1);
         pass.pop_debug_group();
+    }
+}
+
+/// `TONE_MAP_*` of `shaders/present.wgsl`: the curve the shader runs.
+pub fn tone_map_code(curve: ToneMap) -> u32 {
+    match curve {
+        ToneMap::Clamp => 0,
+        ToneMap::Reinhard => 1,
+        ToneMap::Aces => 2,
+        ToneMap::PbrNeutral => 3,
     }
 }
