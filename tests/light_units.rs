@@ -16,8 +16,9 @@ use mirador::Scene;
 use mirador::trace::{RenderControl, Tracer};
 
 /// A 4 m × 4 m plane at y = 0 (white Lambertian: base colour `ALBEDO`, rough, not metallic) and
-/// one `light` (a `KHR_lights_punctual` light object, JSON) on a node at `light_node` (JSON).
-fn plane_gltf(light: &str, light_node: &str) -> String {
+/// one `light` (a `KHR_lights_punctual` light object, JSON) on a node at `light_node` (JSON):
+/// the glTF file's text and its buffer, `plane.bin`.
+fn plane_gltf(light: &str, light_node: &str) -> (String, Vec<u8>) {
     let positions: [f32; 12] = [-2.0, 0.0, -2.0, 2.0, 0.0, -2.0, 2.0, 0.0, 2.0, -2.0, 0.0, 2.0];
     let normals: [f32; 12] = [0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0];
     let indices: [u16; 6] = [0, 2, 1, 0, 3, 2];
@@ -25,8 +26,7 @@ fn plane_gltf(light: &str, light_node: &str) -> String {
     bytes.extend(positions.iter().flat_map(|v| v.to_le_bytes()));
     bytes.extend(normals.iter().flat_map(|v| v.to_le_bytes()));
     bytes.extend(indices.iter().flat_map(|v| v.to_le_bytes()));
-    let data = base64(&bytes);
-    format!(
+    let gltf = format!(
         r#"{{
   "asset": {{"version": "2.0"}},
   "extensionsUsed": ["KHR_lights_punctual"],
@@ -36,7 +36,7 @@ fn plane_gltf(light: &str, light_node: &str) -> String {
   "nodes": [{{"mesh": 0}}, {light_node}],
   "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0, "NORMAL": 1}}, "indices": 2, "material": 0}}]}}],
   "materials": [{{"pbrMetallicRoughness": {{"baseColorFactor": [{ALBEDO}, {ALBEDO}, {ALBEDO}, 1], "metallicFactor": 0, "roughnessFactor": 1}}}}],
-  "buffers": [{{"byteLength": {len}, "uri": "data:application/octet-stream;base64,{data}"}}],
+  "buffers": [{{"byteLength": {len}, "uri": "plane.bin"}}],
   "bufferViews": [
     {{"buffer": 0, "byteOffset": 0, "byteLength": 48}},
     {{"buffer": 0, "byteOffset": 48, "byteLength": 48}},
@@ -49,27 +49,11 @@ fn plane_gltf(light: &str, light_node: &str) -> String {
   ]
 }}"#,
         len = bytes.len()
-    )
+    );
+    (gltf, bytes)
 }
 
 const ALBEDO: f32 = 0.8;
-
-fn base64(bytes: &[u8]) -> String {
-    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::new();
-    for chunk in bytes.chunks(3) {
-        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
-        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
-        for k in 0..4 {
-            if k <= chunk.len() {
-                out.push(ALPHABET[(n >> (18 - 6 * k)) as usize & 63] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
-}
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mirador-light-units-{name}-{}", std::process::id()));
@@ -80,8 +64,9 @@ fn scratch(name: &str) -> PathBuf {
 
 /// The plane seen straight down by an orthographic camera over a 0.2 m window, no ambient light,
 /// as a scene file that places the glTF file.
-fn plane_scene(dir: &Path, gltf: &str) -> Scene {
+fn plane_scene(dir: &Path, (gltf, buffer): (String, Vec<u8>)) -> Scene {
     std::fs::write(dir.join("plane.gltf"), gltf).unwrap();
+    std::fs::write(dir.join("plane.bin"), buffer).unwrap();
     let toml = r#"
 [camera]
 eye = [0, 5, 0]
@@ -143,7 +128,7 @@ fn a_point_light_of_known_candela_over_a_white_plane() {
         r#"{"type": "point", "intensity": 1000}"#,
         r#"{"translation": [0, 2, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}}"#,
     );
-    let scene = plane_scene(&dir, &gltf);
+    let scene = plane_scene(&dir, gltf);
     let expected = ALBEDO * 1000.0 / 4.0 / std::f32::consts::PI / 683.0;
     assert!((expected - 0.093_21).abs() < 1e-5);
     check(&scene, expected, "point light");
@@ -162,7 +147,7 @@ fn a_sun_of_known_lux_at_an_angle() {
         q.x, q.y, q.z, q.w
     );
     let gltf = plane_gltf(r#"{"type": "directional", "intensity": 683}"#, &node);
-    let scene = plane_scene(&dir, &gltf);
+    let scene = plane_scene(&dir, gltf);
     let mirador::scene::LightKind::Directional { direction } = scene.lights[0].kind else { panic!("a sun") };
     let angle = direction.dot(Vec3::NEG_Y).acos().to_degrees();
     assert!((angle - 60.0).abs() < 1e-3, "the sun shines 60° from the plane's normal: {angle}°");

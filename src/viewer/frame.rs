@@ -306,11 +306,7 @@ impl Viewer {
     /// Picks at `pixel` of the full-resolution image.
     fn pick(&mut self, pixel: Vec2) {
         let Some((_, _, width, height)) = self.view_pixels else { return };
-        let mut camera = self.scene.scene.camera.clone();
-        (camera.width, camera.height) = (width, height);
-        let rendered = std::mem::replace(&mut self.scene.scene.camera, camera);
-        let picked = self.scene.pick(pixel);
-        self.scene.scene.camera = rendered;
+        let picked = self.scene.pick(pixel, (width, height));
         match picked.and_then(|p| self.scene.scene.objects.get(p.object)) {
             Some(object) => {
                 let message = format!("picked `{}`", object.name);

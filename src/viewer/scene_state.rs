@@ -118,11 +118,9 @@ impl SceneState {
         self.revision += 1;
     }
 
-    /// Picks the object under `pixel` of the current camera's image, building the picker once
-    /// per scene.
-    pub fn pick(&mut self, pixel: glam::Vec2) -> Option<Picked> {
-        let picker = self.picker.get_or_insert_with(|| Picker::new(&self.scene));
-        let picked = picker.pick(&self.scene, pixel);
+    /// Picks the object under `pixel` of an image of `size` pixels taken by the current camera.
+    pub fn pick(&mut self, pixel: glam::Vec2, size: (u32, u32)) -> Option<Picked> {
+        let picked = self.with_picker(size, |picker, scene| picker.pick(scene, pixel));
         self.picked = picked;
         picked
     }
@@ -130,13 +128,18 @@ impl SceneState {
     /// The direction the environment is seen in at `pixel` of an image of `size` pixels taken
     /// by the current camera.
     pub fn seen_direction(&mut self, pixel: glam::Vec2, size: (u32, u32)) -> SeenDirection {
-        let mut scene_camera = self.scene.camera.clone();
-        (scene_camera.width, scene_camera.height) = size;
-        let rendered = std::mem::replace(&mut self.scene.camera, scene_camera);
+        self.with_picker(size, |picker, scene| picker.seen_direction(scene, pixel))
+    }
+
+    /// Runs `f` with the picker (built once per scene) and the scene, its camera taking images
+    /// of `size` pixels (the view's, not the render size the camera was loaded with).
+    fn with_picker<T>(&mut self, size: (u32, u32), f: impl FnOnce(&Picker, &Scene) -> T) -> T {
         let picker = self.picker.get_or_insert_with(|| Picker::new(&self.scene));
-        let seen = picker.seen_direction(&self.scene, pixel);
-        self.scene.camera = rendered;
-        seen
+        let (width, height) = (self.scene.camera.width, self.scene.camera.height);
+        (self.scene.camera.width, self.scene.camera.height) = size;
+        let result = f(picker, &self.scene);
+        (self.scene.camera.width, self.scene.camera.height) = (width, height);
+        result
     }
 
     /// The diagonal of the scene's bounds (1 for an empty scene): the scale of fly speeds.
