@@ -9,6 +9,7 @@
 //! - [`linear_output`]: the radiance before that transform, as OpenEXR.
 //! - [`compare`]: image metrics for golden images and raster-vs-trace comparisons.
 //! - [`viewer`]: the interactive window (winit + egui) over both renderers.
+//! - [`volume`]: scalar fields on voxel grids, classified and ray-cast by both renderers.
 
 // Checks like `!(x > 0.0)` are written that way on purpose: unlike `x <= 0.0` they also reject
 // NaN, which user input can carry.
@@ -26,6 +27,7 @@ pub mod shaders;
 pub mod texture;
 pub mod trace;
 pub mod viewer;
+pub mod volume;
 
 pub use scene::Scene;
 pub use settings::RenderSettings;

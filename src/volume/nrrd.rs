@@ -1,0 +1,1 @@
+//! NRRD and raw volume files (written by a helper).
