@@ -32,6 +32,8 @@ pub struct RenderSettings {
     /// Environment maps for curved mirrors, and the world drawn as the background (TECHNIQUES.md
     /// §6).
     pub environment: EnvironmentSettings,
+    /// Direct volume rendering of voxel grids: compositing and isosurfaces (TECHNIQUES.md §8).
+    pub volume: VolumeSettings,
     /// How the rasterizer spends its time: prepass, tessellation, render scale.
     pub raster: RasterSettings,
     /// The ray tracer's own settings.
@@ -205,6 +207,102 @@ impl Default for EnvironmentSettings {
         }
     }
 }
+
+/// How volumes are shown.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum VolumeMode {
+    /// Each volume as its scene file says (`mode`).
+    Scene,
+    /// Every volume composited: classified samples, front to back.
+    Composite,
+    /// Every volume as its isosurface `f = iso`, shaded like a surface.
+    Isosurface,
+}
+
+/// How the field is read between grid points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum VolumeReconstruction {
+    /// The nearest grid point's value: the voxels show as blocks.
+    Nearest,
+    /// Trilinear interpolation of the eight surrounding grid points.
+    Trilinear,
+}
+
+/// How samples are shaded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum VolumeGradient {
+    /// No shading: each sample shows its classified colour.
+    Off,
+    /// Gradient normals by forward differences (first order).
+    Forward,
+    /// Gradient normals by central differences (second order, the seed's).
+    Central,
+}
+
+/// What the volume technique shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum VolumeView {
+    /// The scene.
+    Off,
+    /// Samples taken per pixel, as a heat map (black none, white `VOLUME_SAMPLES_WHITE`): where
+    /// early termination saves work.
+    Samples,
+}
+
+/// Direct volume rendering in both renderers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VolumeSettings {
+    /// Draw volumes; off, they are left out.
+    pub enabled: bool,
+    pub mode: VolumeMode,
+    /// Distance between samples along a ray, in voxels (of the grid's smallest spacing).
+    pub step: f32,
+    pub reconstruction: VolumeReconstruction,
+    pub gradient: VolumeGradient,
+    /// Correct each sample's opacity for its length (`1 − (1 − α)^ℓ`), so the image does not
+    /// change with the step; off, the transfer function's opacity is used per sample as it is.
+    pub opacity_correction: bool,
+    /// Stop a ray once its accumulated opacity reaches `threshold`.
+    pub early_termination: bool,
+    pub threshold: f32,
+    /// Shadows of opaque surfaces on the volume's samples (shadow rays per sample and light in
+    /// the tracer, shadow-map lookups in the rasterizer). Isosurfaces are shadowed like any
+    /// surface whenever shadows are on.
+    pub shadows: bool,
+    /// Draw the grid's cells as a wireframe (every cell up to 32 a side, coarser beyond).
+    pub wireframe: bool,
+    /// Teaching views.
+    pub view: VolumeView,
+}
+
+impl Default for VolumeSettings {
+    fn default() -> Self {
+        VolumeSettings {
+            enabled: true,
+            mode: VolumeMode::Scene,
+            step: 0.5,
+            reconstruction: VolumeReconstruction::Trilinear,
+            gradient: VolumeGradient::Central,
+            opacity_correction: true,
+            early_termination: true,
+            threshold: 0.99,
+            shadows: false,
+            wireframe: false,
+            view: VolumeView::Off,
+        }
+    }
+}
+
+/// The range of `volume.step`, in voxels.
+pub const VOLUME_STEPS: std::ops::RangeInclusive<f32> = 0.05..=8.0;
+
+/// The sample count the samples view shows as white.
+pub const VOLUME_SAMPLES_WHITE: u32 = 512;
 
 /// The range of `environment.cube_size`.
 pub const CUBE_SIZES: std::ops::RangeInclusive<u32> = 16..=2048;
@@ -555,6 +653,7 @@ impl Default for RenderSettings {
             transparency: TransparencySettings::default(),
             mirrors: MirrorSettings::default(),
             environment: EnvironmentSettings::default(),
+            volume: VolumeSettings::default(),
             raster: RasterSettings::default(),
             trace: TraceSettings::default(),
         }
@@ -655,6 +754,18 @@ impl RenderSettings {
                 CUBE_SIZES.start(),
                 CUBE_SIZES.end()
             )));
+        }
+        let volume = &self.volume;
+        if !VOLUME_STEPS.contains(&volume.step) {
+            return Err(SettingsError::Invalid(format!(
+                "volume.step must lie in {}..={} voxels, got {}",
+                VOLUME_STEPS.start(),
+                VOLUME_STEPS.end(),
+                volume.step
+            )));
+        }
+        if !(volume.threshold > 0.0 && volume.threshold <= 1.0) {
+            return Err(SettingsError::Invalid(format!("volume.threshold must lie in (0, 1], got {}", volume.threshold)));
         }
         let scale = self.raster.render_scale;
         if !(scale.is_finite() && (0.1..=1.0).contains(&scale)) {

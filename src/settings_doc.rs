@@ -17,7 +17,8 @@ use serde::Serialize;
 
 use crate::settings::{
     AccelKind, AntiAliasing, BumpView, EnvironmentMap, EnvironmentView, MirrorView, Prepass, ShadowFilter, ShadowFit,
-    ShadowMethod, ShadowView, SphereView, TangentSource, TextureFilter, ToneMap, TracerLod, TransparencySort,
+    ShadowMethod, ShadowView, SphereView, TangentSource, TextureFilter, ToneMap, TracerLod, TransparencySort, VolumeGradient, VolumeMode,
+    VolumeReconstruction, VolumeView,
 };
 
 /// One value an enum setting can take.
@@ -243,6 +244,38 @@ pub fn describe(key: &str) -> Option<FieldDoc> {
         ),
         "environment.inset" => doc(
             "Draw the teaching view in the frame's lower-right corner with the scene around it (in the viewer the latitude–longitude view then marks the reflected direction under the cursor); off: over the whole frame.",
+        ),
+        "volume" => doc(
+            "Direct volume rendering (TECHNIQUES.md §8): rays march the voxel grid, classify each sample by the transfer function, shade it C = C_amb + C_luz·k_dif·(n·L) and composite front to back; or find the isosurface f = iso.",
+        ),
+        "volume.enabled" => doc("Off: volumes are left out of both renderers."),
+        "volume.mode" => choice::<VolumeMode>(
+            "Composite every volume, show every volume as its isosurface f = iso, or each as its scene file says.",
+        ),
+        "volume.step" => number(
+            "Distance between samples along a ray, in voxels: smaller is slower and finer. With opacity correction the image keeps its brightness.",
+            0.05,
+            8.0,
+        ),
+        "volume.reconstruction" => choice::<VolumeReconstruction>(
+            "How the field is read between grid points: the nearest point (blocks) or trilinear interpolation of the eight around.",
+        ),
+        "volume.gradient" => choice::<VolumeGradient>(
+            "Shading normals n = ∇f/|∇f| by forward (first-order) or central (second-order) differences; off: samples show their classified colour unshaded.",
+        ),
+        "volume.opacity_correction" => doc(
+            "Correct each sample's opacity for its length, α' = 1 − (1 − α)^ℓ, so the image does not change with the step.",
+        ),
+        "volume.early_termination" => doc(
+            "Stop a ray once its accumulated opacity reaches the threshold: what lies behind would add at most 1 − threshold.",
+        ),
+        "volume.threshold" => number("The accumulated opacity at which early termination stops a ray.", 0.5, 1.0),
+        "volume.shadows" => doc(
+            "Shadows of opaque surfaces on composited samples (a shadow ray per sample and light in the tracer, a shadow-map lookup in the rasterizer).",
+        ),
+        "volume.wireframe" => doc("Draw the grid's cells as lines (every cell up to 32 a side, every k-th line beyond)."),
+        "volume.view" => choice::<VolumeView>(
+            "Teaching views: the samples taken per pixel as a heat map (black none, white 512), showing what early termination saves.",
         ),
         "raster" => doc(
             "How the rasterizer spends its time. None of these changes what a technique computes; each trades time for a measured difference.",

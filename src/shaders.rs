@@ -11,11 +11,14 @@ pub const COMMON: &[(&str, &str)] = &[
 ];
 
 /// The scene pass and the transparent surfaces' entry points: one module, so that every variant
-/// computes exactly the same vertex positions (depth peeling tests `Equal` against them).
+/// computes exactly the same vertex positions (depth peeling tests `Equal` against them). The
+/// volumes' ray marching joins them to share the illumination model and the shadow lookups.
 pub const SCENE: &str = concat!(
     include_str!("../shaders/scene.wgsl"),
     "\n// ---- transparency.wgsl\n",
-    include_str!("../shaders/transparency.wgsl")
+    include_str!("../shaders/transparency.wgsl"),
+    "\n// ---- volume.wgsl\n",
+    include_str!("../shaders/volume.wgsl")
 );
 pub const PRESENT: &str = include_str!("../shaders/present.wgsl");
 pub const MIPMAP: &str = include_str!("../shaders/mipmap.wgsl");

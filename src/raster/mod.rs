@@ -26,6 +26,7 @@ pub mod shadow;
 pub mod transparency;
 pub mod uniforms;
 pub mod view;
+pub mod volume;
 
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
@@ -62,6 +63,7 @@ pub struct Renderer {
     projected: ProjectedPass,
     scene: ScenePass,
     transparency: TransparencyPass,
+    volumes: volume::VolumePass,
     overlays: Overlays,
     present: PresentPass,
     environment: EnvironmentPass,
@@ -168,6 +170,7 @@ impl Renderer {
             projected: ProjectedPass::new(device, &layouts),
             scene: ScenePass::new(device, &layouts),
             transparency: TransparencyPass::new(device, &layouts),
+            volumes: volume::VolumePass::new(device, &layouts),
             overlays: Overlays::new(device, &layouts),
             present: PresentPass::new(device, output_format),
             environment: EnvironmentPass::new(device),
@@ -428,6 +431,21 @@ impl Renderer {
             &mirror_images(scene_gpu, &self.mirror_targets, images_of.get(&None)),
         );
         frame.end("opaque");
+        if settings.volume.enabled && !scene.volumes.is_empty() {
+            self.volumes.record(
+                device,
+                queue,
+                &mut frame.encoder,
+                &self.scene,
+                scene,
+                scene_gpu,
+                lighting,
+                frame_key,
+                targets,
+                &settings.volume,
+            );
+            frame.end("volumes");
+        }
         let mut transparency = TransparencyReport::default();
         if sorted_transparency {
             transparency = self.transparency.record(

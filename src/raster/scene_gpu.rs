@@ -4,6 +4,7 @@
 //! pass's outputs. Built once per scene; a frame rewrites the uniforms and, when tessellations
 //! change, the draw list.
 
+use super::volume::VolumeGpu;
 use super::geometry::SceneGeometry;
 use super::mirror::{Mirror, find_mirrors};
 use super::scene_pass::MaterialKey;
@@ -95,6 +96,8 @@ pub struct SceneGpu {
     /// The environment maps, made by the renderer at the first frame (their size is a setting).
     pub environment: Option<super::environment::EnvironmentMaps>,
     pub geometry: SceneGeometry,
+    /// Each volume's field, transfer table and uniform (`super::volume`).
+    pub volumes: Vec<VolumeGpu>,
 }
 
 /// The filter and its anisotropy: what tells sets of material groups apart.
@@ -193,6 +196,7 @@ impl SceneGpu {
             mirrors,
             env_objects,
             environment: None,
+            volumes: scene.volumes.iter().map(|v| VolumeGpu::upload(device, &gpu.queue, v)).collect(),
         }
     }
 

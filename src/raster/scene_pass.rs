@@ -122,7 +122,7 @@ pub const SHADOW_FILTER_NAMES: [(&str, ShadowFilter); 5] = [
 ];
 
 /// What a material brings to the shader: which textures and which height field.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct MaterialKey {
     pub color_texture: bool,
     /// `HEIGHT_*` of `shaders/scene.wgsl`: 0 none, 1 a height map, 2 a sine field, 3 value noise.

@@ -118,6 +118,8 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     pub meshes: Vec<Mesh>,
     pub objects: Vec<Object>,
+    /// Voxel grids, drawn by ray casting (`crate::volume`).
+    pub volumes: Vec<crate::volume::Volume>,
     /// The scene file's defaults for the toggles; the CLI and the viewer start from these.
     pub settings: RenderSettings,
 }
@@ -202,6 +204,11 @@ impl Scene {
                 Some((a, b)) => (a.min(lo), b.max(hi)),
             });
         };
+        for volume in &self.volumes {
+            for corner in volume.world_corners() {
+                add(corner, corner);
+            }
+        }
         for object in &self.objects {
             let m = object.world_from_local;
             if let Shape::Sphere { center, radius } = object.shape {

@@ -22,6 +22,7 @@ pub mod geometry;
 pub mod render;
 pub mod sampling;
 pub mod texture;
+pub mod volume;
 pub mod whitted;
 
 use glam::{Vec2, Vec3};
@@ -71,6 +72,7 @@ impl<'s> Tracer<'s> {
                 textures: SceneTextures::new(scene),
                 texture_settings: settings.textures,
                 bump: settings.bump,
+                volumes: volume::TracedVolumes::new(scene, &settings.volume),
             },
             primary_cone: primary_cone(&scene.camera),
         }

@@ -57,7 +57,18 @@ impl std::fmt::Display for TraceStats {
             r.total(),
             self.elapsed.as_secs_f64(),
             self.mrays_per_second()
-        )
+        )?;
+        if r.volume_samples > 0 {
+            let planned = r.volume_samples + r.volume_samples_saved;
+            write!(
+                f,
+                "; volume samples: {} taken, {} saved by early termination ({:.1} %)",
+                r.volume_samples,
+                r.volume_samples_saved,
+                100.0 * r.volume_samples_saved as f64 / planned as f64
+            )?;
+        }
+        Ok(())
     }
 }
 

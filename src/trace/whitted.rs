@@ -58,6 +58,7 @@ use glam::Vec3;
 use super::accel::Accelerator;
 use super::geometry::{Primitive, SurfaceHit};
 use super::texture::SceneTextures;
+use super::volume::TracedVolumes;
 use crate::scene::shading::{SurfaceSample, Terms, direct, emitted_and_ambient, facing_viewer};
 use crate::scene::{AlphaMode, Material, Ray, Scene};
 use crate::settings::{BumpSettings, BumpView, TextureSettings};
@@ -71,6 +72,9 @@ pub struct RayCounts {
     pub reflected: u64,
     /// Rays through a surface: refracted (kt > 0) and continued past a blended surface.
     pub refracted: u64,
+    /// Volume samples taken, and those early ray termination saved (not rays: not in `total`).
+    pub volume_samples: u64,
+    pub volume_samples_saved: u64,
 }
 
 impl RayCounts {
@@ -85,6 +89,8 @@ impl std::ops::AddAssign for RayCounts {
         self.shadow += o.shadow;
         self.reflected += o.reflected;
         self.refracted += o.refracted;
+        self.volume_samples += o.volume_samples;
+        self.volume_samples_saved += o.volume_samples_saved;
     }
 }
 
@@ -102,6 +108,8 @@ pub struct Whitted<'s> {
     pub textures: SceneTextures,
     pub texture_settings: TextureSettings,
     pub bump: BumpSettings,
+    /// The scene's volumes, marched by every ray (`super::volume`).
+    pub volumes: TracedVolumes<'s>,
 }
 
 /// The most surfaces one ray passes (masked-out hits, shadow rays through transparent
@@ -118,6 +126,9 @@ impl Whitted<'_> {
     /// The radiance arriving at `ray.origin` from `ray.direction` (`RayTracing(o, u, n)`); `cone`
     /// is the ray's footprint, for texture filtering.
     pub fn radiance(&self, ray: &Ray, cone: RayCone, depth: u32, counts: &mut RayCounts) -> Vec3 {
+        if !self.volumes.is_empty() {
+            return self.radiance_through_volumes(ray, cone, depth, counts);
+        }
         match self.nearest_surface(ray, cone) {
             Some((surface, ray, cone)) => self.shade(&ray, cone, &surface, depth, counts),
             None => self.scene.environment_radiance(ray.direction),
@@ -137,7 +148,7 @@ impl Whitted<'_> {
     /// (`α < cutoff`) is passed, the ray going on from just beyond it, its cone continued. Returns
     /// the hit with the ray and the cone that found it (`hit.t` counts from that ray's origin), or
     /// `None` if the ray leaves the scene or passes [`MAX_LAYERS`] masked hits.
-    fn nearest_surface(&self, ray: &Ray, cone: RayCone) -> Option<(SurfaceHit, Ray, RayCone)> {
+    pub(super) fn nearest_surface(&self, ray: &Ray, cone: RayCone) -> Option<(SurfaceHit, Ray, RayCone)> {
         let (mut ray, mut cone) = (*ray, cone);
         for _ in 0..MAX_LAYERS {
             let hit = self.accelerator.closest(&self.primitives, &ray, 0.0, f32::INFINITY)?;
@@ -163,7 +174,7 @@ impl Whitted<'_> {
     /// The radiance leaving the hit towards the viewer. A blended surface (`AlphaMode::Blend`)
     /// covers a fraction `α` of the ray: `α·(the surface's own radiance) + (1 − α)·L(the ray
     /// continued straight through)`, the continuation one level deeper like a refracted ray.
-    fn shade(&self, ray: &Ray, cone: RayCone, hit: &SurfaceHit, depth: u32, counts: &mut RayCounts) -> Vec3 {
+    pub(super) fn shade(&self, ray: &Ray, cone: RayCone, hit: &SurfaceHit, depth: u32, counts: &mut RayCounts) -> Vec3 {
         let material = &self.scene.materials[hit.material.0];
         let v = -ray.direction;
         // The teaching views show the nearest surface itself, blended or not.

@@ -5,6 +5,8 @@
 //! together (a sphere needs a radius, eye ≠ center) are reported at the table they belong to.
 //! Unknown fields are rejected. Paths are relative to the scene file.
 
+mod volume;
+
 use std::collections::HashMap;
 use std::fmt;
 use std::ops::Range;
@@ -199,6 +201,8 @@ struct SceneFile {
     lights: Vec<Spanned<LightDesc>>,
     #[serde(default)]
     objects: Vec<Spanned<ObjectDesc>>,
+    #[serde(default)]
+    volumes: Vec<Spanned<volume::VolumeDesc>>,
 }
 
 #[derive(Deserialize)]
@@ -507,6 +511,10 @@ impl<'a> Builder<'a> {
             if let Some(camera) = self.object(object.into_inner(), span.clone())? {
                 gltf_camera.get_or_insert((camera, span));
             }
+        }
+        for volume in file.volumes {
+            let span = volume.span();
+            self.volume(volume.into_inner(), span)?;
         }
         let table_camera = match file.camera {
             Some(desc) => {
@@ -1030,6 +1038,7 @@ fn empty_scene(path: &Path) -> Scene {
         textures: Vec::new(),
         meshes: Vec::new(),
         objects: Vec::new(),
+        volumes: Vec::new(),
         settings: RenderSettings::default(),
     }
 }

@@ -1,0 +1,217 @@
+//! Volumes in the ray tracer (TECHNIQUES.md §8): every ray, primary or secondary, marches the
+//! volumes it crosses in front of the nearest surface.
+//!
+//! - **Composite**: each volume's box is clipped to `[0, t_surface]` and composited front to back
+//!   (`crate::volume::march`); volumes are taken in the order the ray enters their boxes (overlapping
+//!   boxes are not interleaved sample by sample), and the radiance behind is added as
+//!   `C + (1 − α)·L_behind`. Each volume ends its own march at the termination threshold, and
+//!   when the accumulated opacity is past it the ray goes no further: the surface behind is not
+//!   shaded (what the rasterizer's blend still adds, at most `1 − threshold` of it).
+//! - **Samples are shaded** with the seed's voxel illumination `C = C_amb + C_luz·k_dif·(n·L)`:
+//!   the illumination model of `scene/shading.rs` for a material with `kd = 1`, `ka = ks = 0` and
+//!   the classified colour as `C`, so `C_amb = A ⊗ C` and `C_luz·k_dif = S_i ⊗ C`. The normal is
+//!   the gradient carried to world space by the inverse transpose, normalized and turned to the
+//!   viewer; where the gradient vanishes a sample gets the ambient term alone. With
+//!   `volume.shadows` each sample casts a shadow ray per light (volumes cast none).
+//! - **Isosurface**: the first crossing of `f = iso` in front of the nearest surface becomes a hit
+//!   like any other, shaded by [`Whitted::shade`] with the volume's material: lights, shadows,
+//!   reflections and refraction. Its outward normal is `−∇f` (values rise inwards; distance
+//!   fields are read as positive inside). Textures and bumps do not apply to it.
+
+use glam::{Mat3, Mat4, Vec2, Vec3};
+
+use super::geometry::SurfaceHit;
+use super::whitted::{RayCounts, Whitted};
+use crate::scene::shading::{SurfaceSample, direct, emitted_and_ambient, facing_viewer};
+use crate::scene::{Ray, Scene};
+use crate::settings::{VolumeSettings, VolumeView};
+use crate::texture::RayCone;
+use crate::volume::march::{self, LocalRay};
+use crate::volume::{March, Rendering, Volume};
+
+/// The scene's volumes, prepared for tracing.
+pub struct TracedVolumes<'s> {
+    volumes: Vec<Prepared<'s>>,
+    pub march: March,
+    pub shadows: bool,
+    pub view: VolumeView,
+}
+
+struct Prepared<'s> {
+    volume: &'s Volume,
+    local_from_world: Mat4,
+    normal_from_local: Mat3,
+    rendering: Rendering,
+}
+
+impl<'s> TracedVolumes<'s> {
+    pub fn new(scene: &'s Scene, settings: &VolumeSettings) -> TracedVolumes<'s> {
+        let volumes = if settings.enabled { &scene.volumes[..] } else { &[] };
+        TracedVolumes {
+            volumes: volumes
+                .iter()
+                .map(|volume| Prepared {
+                    volume,
+                    local_from_world: volume.local_from_world(),
+                    normal_from_local: volume.normal_from_local(),
+                    rendering: volume.rendering(settings),
+                })
+                .collect(),
+            march: March::of(settings),
+            shadows: settings.shadows,
+            view: settings.view,
+        }
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.volumes.is_empty()
+    }
+}
+
+impl Prepared<'_> {
+    fn local_ray(&self, ray: &Ray) -> LocalRay {
+        LocalRay {
+            origin: self.local_from_world.transform_point3(ray.origin),
+            direction: self.local_from_world.transform_vector3(ray.direction),
+        }
+    }
+
+    /// The part of `[0, t_max]` where `ray` is inside the box.
+    fn segment(&self, ray: &LocalRay, t_max: f32) -> Option<(f32, f32)> {
+        let (near, far) = ray.box_interval(self.volume.grid.half_extent())?;
+        let (t0, t1) = (near.max(0.0), far.min(t_max));
+        (t0 < t1).then_some((t0, t1))
+    }
+
+    /// The world-space unit normal of a local gradient, `None` where it vanishes.
+    fn normal(&self, gradient: Vec3) -> Option<Vec3> {
+        let n = self.normal_from_local * gradient;
+        (n.length_squared() > 1e-20).then(|| n.normalize())
+    }
+}
+
+/// The heat colour of the samples view: black for none, through red and yellow, white at
+/// `VOLUME_SAMPLES_WHITE` (`heat_colour` in `shaders/volume.wgsl`).
+pub fn heat_colour(samples: u32) -> Vec3 {
+    let x = samples as f32 / crate::settings::VOLUME_SAMPLES_WHITE as f32;
+    (Vec3::new(3.0 * x, 3.0 * x - 1.0, 3.0 * x - 2.0)).clamp(Vec3::ZERO, Vec3::ONE)
+}
+
+impl Whitted<'_> {
+    /// `RayTracing(o, u, n)` where the scene has volumes: the nearest surface or isosurface, with
+    /// the composited volumes in front of it.
+    pub(super) fn radiance_through_volumes(
+        &self,
+        ray: &Ray,
+        cone: RayCone,
+        depth: u32,
+        counts: &mut RayCounts,
+    ) -> Vec3 {
+        let nearest = self.nearest_surface(ray, cone);
+        let t_surface = nearest.as_ref().map_or(f32::INFINITY, |(hit, moved, _)| {
+            (moved.origin - ray.origin).dot(ray.direction) + hit.t
+        });
+        let isosurface = self.nearest_isosurface(ray, t_surface);
+        let t_end = isosurface.as_ref().map_or(t_surface, |hit| hit.t);
+
+        // The composited volumes in front, in the order the ray enters them.
+        let mut segments: Vec<(&Prepared, LocalRay, (f32, f32))> = Vec::new();
+        for prepared in &self.volumes.volumes {
+            if prepared.rendering != Rendering::Composite {
+                continue;
+            }
+            let local = prepared.local_ray(ray);
+            if let Some(segment) = prepared.segment(&local, t_end) {
+                segments.push((prepared, local, segment));
+            }
+        }
+        segments.sort_by(|a, b| a.2.0.total_cmp(&b.2.0));
+        let march = &self.volumes.march;
+        let (mut colour, mut alpha, mut taken) = (Vec3::ZERO, 0.0, 0);
+        for (prepared, local, segment) in segments {
+            let grid = &prepared.volume.grid;
+            let out = {
+                let mut shade = |t: f32, gradient: Vec3, c: Vec3| self.shade_sample(prepared, ray, t, gradient, c, counts);
+                march::composite(grid, &prepared.volume.table, &local, segment, march, &mut shade, None)
+            };
+            counts.volume_samples += u64::from(out.taken);
+            counts.volume_samples_saved += u64::from(out.planned - out.taken);
+            taken += out.taken;
+            colour += (1.0 - alpha) * out.colour;
+            alpha += (1.0 - alpha) * out.alpha;
+        }
+        if depth == 0 && self.volumes.view == VolumeView::Samples {
+            return heat_colour(taken);
+        }
+        if march.termination.is_some_and(|threshold| alpha >= threshold) {
+            return colour;
+        }
+        let behind = match (isosurface, nearest) {
+            (Some(hit), _) => self.shade(ray, cone, &hit, depth, counts),
+            (None, Some((surface, moved, cone))) => self.shade(&moved, cone, &surface, depth, counts),
+            (None, None) => self.scene.environment_radiance(ray.direction),
+        };
+        colour + (1.0 - alpha) * behind
+    }
+
+    /// The nearest crossing of an isosurface volume before `t_max`, as a surface hit.
+    fn nearest_isosurface(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
+        let mut nearest: Option<SurfaceHit> = None;
+        for prepared in &self.volumes.volumes {
+            let Rendering::Isosurface { iso } = prepared.rendering else { continue };
+            let limit = nearest.as_ref().map_or(t_max, |hit| hit.t);
+            let local = prepared.local_ray(ray);
+            let Some(segment) = prepared.segment(&local, limit) else { continue };
+            let grid = &prepared.volume.grid;
+            let Some(t) = march::isosurface(grid, &local, segment, iso, &self.volumes.march) else { continue };
+            let g = grid.grid_coordinates(local.at(t));
+            let differences = self.volumes.march.gradient.unwrap_or(crate::volume::Differences::Central);
+            let gradient = grid.gradient(g, self.volumes.march.reconstruction, differences);
+            // Outward is where values fall; a vanishing gradient faces the ray.
+            let normal = prepared.normal(-gradient).unwrap_or(-ray.direction);
+            nearest = Some(SurfaceHit {
+                t,
+                point: ray.at(t),
+                geometric_normal: normal,
+                normal,
+                uv: Vec2::ZERO,
+                dpdu: Vec3::ZERO,
+                dpdv: Vec3::ZERO,
+                material: prepared.volume.material,
+                object: usize::MAX,
+            });
+        }
+        nearest
+    }
+
+    /// One composited sample's colour: `C_amb + Σ V·C_luz·k_dif·(n·L)` with the classified colour.
+    fn shade_sample(&self, prepared: &Prepared, ray: &Ray, t: f32, gradient: Vec3, colour: Vec3, counts: &mut RayCounts) -> Vec3 {
+        let sample = SurfaceSample {
+            color: colour,
+            ka: 0.0,
+            kd: 1.0,
+            ks: 0.0,
+            specular_color: Vec3::ZERO,
+            shininess: 1.0,
+            emission: Vec3::ZERO,
+        };
+        let mut rad = emitted_and_ambient(&sample, self.scene.ambient, self.terms);
+        let Some(n) = prepared.normal(gradient) else { return rad };
+        let v = -ray.direction;
+        let n = facing_viewer(n, v);
+        let p = ray.at(t);
+        for light in &self.scene.lights {
+            let Some(incidence) = light.incidence(p) else { continue };
+            if incidence.l.dot(n) <= 0.0 {
+                continue;
+            }
+            let visibility = if self.volumes.shadows {
+                self.visibility(p, incidence.l, incidence.distance, counts)
+            } else {
+                Vec3::ONE
+            };
+            rad += visibility * direct(&sample, n, v, &incidence, self.terms);
+        }
+        rad
+    }
+}
