@@ -213,9 +213,6 @@ fn heat_colour(samples: u32) -> vec3f {
 fn fs_volume_composite(in: VolumeVertex) -> @location(0) vec4f {
     let ray = volume_ray(in.clip.xy);
     if ray.t0 >= ray.t1 {
-        if volume.view == VOLUME_VIEW_SAMPLES {
-            return vec4f(0.0, 0.0, 0.0, 1.0);
-        }
         discard;
     }
     let s = volume_samples(ray);

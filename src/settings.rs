@@ -248,8 +248,8 @@ pub enum VolumeGradient {
 pub enum VolumeView {
     /// The scene.
     Off,
-    /// Samples taken per pixel, as a heat map (black none, white `VOLUME_SAMPLES_WHITE`): where
-    /// early termination saves work.
+    /// Where a ray crosses a composited volume, the samples it took, as a heat map (black none,
+    /// white `VOLUME_SAMPLES_WHITE`): where early termination saves work.
     Samples,
 }
 

@@ -60,6 +60,12 @@ fn environment_stage_with_dynamic_cubes() {
 }
 
 #[test]
+fn volume_stage_composited_phantom_and_isosurface_torus() {
+    let scene = common::load("scenes/volume.toml");
+    common::assert_golden("volume", &common::raster(&scene, &scene.settings), TOLERANCE);
+}
+
+#[test]
 fn shadow_stage_with_shadow_maps() {
     let scene = common::load("scenes/shadows.toml");
     common::assert_golden("shadows-map", &common::raster(&scene, &scene.settings), TOLERANCE);

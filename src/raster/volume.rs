@@ -295,8 +295,7 @@ impl VolumePass {
             .volumes
             .iter()
             .map(|volume| {
-                let isosurface = matches!(volume.rendering(settings), Rendering::Isosurface { .. })
-                    && settings.view != VolumeView::Samples;
+                let isosurface = matches!(volume.rendering(settings), Rendering::Isosurface { .. });
                 (frame, gradient, settings.shadows, isosurface)
             })
             .collect();

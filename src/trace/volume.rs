@@ -128,6 +128,7 @@ impl Whitted<'_> {
         segments.sort_by(|a, b| a.2.0.total_cmp(&b.2.0));
         let march = &self.volumes.march;
         let (mut colour, mut alpha, mut taken) = (Vec3::ZERO, 0.0, 0);
+        let crossed = !segments.is_empty();
         for (prepared, local, segment) in segments {
             let grid = &prepared.volume.grid;
             let out = {
@@ -140,7 +141,7 @@ impl Whitted<'_> {
             colour += (1.0 - alpha) * out.colour;
             alpha += (1.0 - alpha) * out.alpha;
         }
-        if depth == 0 && self.volumes.view == VolumeView::Samples {
+        if depth == 0 && crossed && self.volumes.view == VolumeView::Samples {
             return heat_colour(taken);
         }
         if march.termination.is_some_and(|threshold| alpha >= threshold) {

@@ -1,0 +1,258 @@
+//! Direct volume rendering (TECHNIQUES.md §8): the rasterizer's GPU ray marching against the
+//! tracer's, which march the same samples of the same field by construction, so they must agree
+//! up to the GPU's 16-bit field and hardware filtering; opacity correction against the step;
+//! early termination against marching to the end; the reconstruction against the analytic
+//! Marschner–Lobb signal; and scene-file errors. Compositing, interpolation and gradients are
+//! tested by hand in `src/volume/`.
+
+mod common;
+
+use glam::{UVec3, Vec3};
+use mirador::settings::{VolumeMode, VolumeView};
+use mirador::volume::{Grid, Reconstruction, fields};
+use mirador::{RenderSettings, Scene};
+
+fn flip(a: &image::RgbaImage, b: &image::RgbaImage) -> f32 {
+    mirador::compare::difference(a, b).unwrap().flip_mean
+}
+
+fn stage() -> Scene {
+    let mut scene = common::load("scenes/volume.toml");
+    (scene.camera.width, scene.camera.height) = (240, 150);
+    scene
+}
+
+fn traced(scene: &Scene, settings: &RenderSettings) -> image::RgbaImage {
+    mirador::trace::render_image(scene, settings)
+}
+
+/// Raster against traced FLIP.
+fn parity(scene: &Scene, settings: &RenderSettings) -> f32 {
+    flip(&traced(scene, settings), &common::raster(scene, settings))
+}
+
+#[test]
+fn composited_volumes_agree_with_the_tracer() {
+    let scene = stage();
+    let mut settings = scene.settings.clone();
+    settings.volume.mode = VolumeMode::Composite;
+    let error = parity(&scene, &settings);
+    eprintln!("composite raster vs traced: FLIP {error:.5}");
+    assert!(error < 0.01, "composite raster vs traced: FLIP {error}");
+    // The comparison can tell: a raster without gradient shading is far from the shaded tracer.
+    let mut unshaded = settings.clone();
+    unshaded.set("volume.gradient=\"off\"").unwrap();
+    let off = flip(&traced(&scene, &settings), &common::raster(&scene, &unshaded));
+    eprintln!("unshaded raster vs shaded traced: FLIP {off:.5}");
+    assert!(off > 2.0 * error + 0.005, "unshaded raster {off} vs shaded {error}");
+}
+
+#[test]
+fn isosurfaces_agree_with_the_tracer_shadows_included() {
+    let scene = stage();
+    let mut settings = scene.settings.clone();
+    settings.volume.mode = VolumeMode::Isosurface;
+    settings.shadows.enabled = true;
+    let error = parity(&scene, &settings);
+    eprintln!("isosurface raster vs traced: FLIP {error:.5}");
+    assert!(error < 0.02, "isosurface raster vs traced: FLIP {error}");
+}
+
+#[test]
+fn nearest_reconstruction_agrees_with_the_tracer() {
+    let scene = stage();
+    let mut settings = scene.settings.clone();
+    settings.set("volume.reconstruction=\"nearest\"").unwrap();
+    let error = parity(&scene, &settings);
+    eprintln!("nearest raster vs traced: FLIP {error:.5}");
+    assert!(error < 0.02, "nearest raster vs traced: FLIP {error}");
+}
+
+#[test]
+fn both_renderers_take_the_same_samples_per_pixel() {
+    // The samples view: a heat map of the samples each pixel took. Equal counts give equal
+    // colours; a count off by one changes a pixel by 3/512 of the ramp.
+    let scene = stage();
+    let mut settings = scene.settings.clone();
+    settings.volume.view = VolumeView::Samples;
+    let (raster, traced) = (common::raster(&scene, &settings), traced(&scene, &settings));
+    let differing = raster.pixels().zip(traced.pixels()).filter(|(a, b)| {
+        a.0.iter().zip(b.0.iter()).any(|(x, y)| x.abs_diff(*y) > 8)
+    });
+    let fraction = differing.count() as f32 / (raster.width() * raster.height()) as f32;
+    eprintln!("{:.3} % of pixels took different sample counts", 100.0 * fraction);
+    assert!(fraction < 0.01, "{:.2} % of the pixels took different sample counts", 100.0 * fraction);
+}
+
+#[test]
+fn opacity_correction_keeps_the_image_when_the_step_changes() {
+    let scene = stage();
+    let at = |step: f32, correction: bool| {
+        let mut settings = scene.settings.clone();
+        settings.volume.mode = VolumeMode::Composite;
+        settings.volume.step = step;
+        settings.volume.opacity_correction = correction;
+        traced(&scene, &settings)
+    };
+    let corrected = flip(&at(0.25, true), &at(1.0, true));
+    let uncorrected = flip(&at(0.25, false), &at(1.0, false));
+    eprintln!("steps 0.25 vs 1, traced: corrected FLIP {corrected:.5}, uncorrected {uncorrected:.5}");
+    assert!(corrected < 0.02, "corrected steps 0.25 and 1: FLIP {corrected}");
+    assert!(uncorrected > 2.0 * corrected, "uncorrected {uncorrected} vs corrected {corrected}");
+    // The rasterizer corrects the same way.
+    let mut settings = scene.settings.clone();
+    settings.volume.step = 0.25;
+    let fine = common::raster(&scene, &settings);
+    settings.volume.step = 1.0;
+    let coarse = common::raster(&scene, &settings);
+    let raster = flip(&fine, &coarse);
+    eprintln!("steps 0.25 vs 1, raster: corrected FLIP {raster:.5}");
+    assert!(raster < 0.02, "raster corrected steps 0.25 and 1: FLIP {raster}");
+}
+
+#[test]
+fn early_termination_saves_samples_and_little_else() {
+    let scene = stage();
+    let run = |early: bool| {
+        let mut settings = scene.settings.clone();
+        settings.volume.mode = VolumeMode::Composite;
+        settings.volume.early_termination = early;
+        let tracer = mirador::trace::Tracer::new(&scene, &settings);
+        let control = mirador::trace::RenderControl::default();
+        let (radiance, stats) = tracer.render(&control).unwrap();
+        (radiance.to_rgba8(mirador::output::OutputTransform::of(&settings)), stats.rays)
+    };
+    let (with, counts_with) = run(true);
+    let (without, counts_without) = run(false);
+    assert_eq!(counts_without.volume_samples_saved, 0);
+    assert!(counts_with.volume_samples_saved > 0);
+    // Every sample is taken or saved: the planned total is the same.
+    assert_eq!(
+        counts_with.volume_samples + counts_with.volume_samples_saved,
+        counts_without.volume_samples,
+    );
+    let error = flip(&with, &without);
+    eprintln!("early termination: {} samples taken, {} saved; FLIP {error:.5}", counts_with.volume_samples, counts_with.volume_samples_saved);
+    assert!(error < 0.005, "early termination changed the image by FLIP {error}");
+}
+
+/// The RMS error of trilinear reconstruction of the Marschner–Lobb signal sampled on an `n`³ grid
+/// over [−1, 1]³, at fixed pseudo-random points.
+fn marschner_lobb_error(n: u32) -> f32 {
+    let grid = Grid::from_function(UVec3::splat(n), fields::marschner_lobb).unwrap();
+    let mut state = 12345u32;
+    let mut next = || {
+        state = state.wrapping_mul(1664525).wrapping_add(1013904223);
+        (state >> 8) as f32 / (1u32 << 24) as f32 * 1.6 - 0.8
+    };
+    let mut sum = 0.0;
+    let count = 20_000;
+    for _ in 0..count {
+        let p = Vec3::new(next(), next(), next());
+        let error = grid.sample(grid.grid_coordinates(p), Reconstruction::Trilinear) - fields::marschner_lobb(p);
+        sum += error * error;
+    }
+    (sum / count as f32).sqrt()
+}
+
+#[test]
+fn the_marschner_lobb_error_falls_as_the_grid_refines() {
+    let errors: Vec<f32> = [21, 41, 81, 161].into_iter().map(marschner_lobb_error).collect();
+    eprintln!("Marschner–Lobb RMS error at 21, 41, 81, 161 points: {errors:?}");
+    for pair in errors.windows(2) {
+        assert!(pair[1] < 0.6 * pair[0], "errors by resolution 21, 41, 81, 161: {errors:?}");
+    }
+    // Well resolved, trilinear interpolation is second order: halving the spacing quarters it.
+    let ratio = errors[2] / errors[3];
+    assert!(ratio > 3.0, "81 → 161 reduced the error {ratio}×: {errors:?}");
+    let nearest = {
+        let grid = Grid::from_function(UVec3::splat(41), fields::marschner_lobb).unwrap();
+        let p = Vec3::new(0.31, -0.22, 0.17);
+        (grid.sample(grid.grid_coordinates(p), Reconstruction::Nearest) - fields::marschner_lobb(p)).abs()
+    };
+    assert!(nearest > 0.0);
+}
+
+/// A surface inside the volume ends its rays there, in both renderers; a glass pane in front of
+/// the volume is composited over it.
+#[test]
+fn surfaces_inside_and_in_front_of_a_volume_are_composited_in_order() {
+    let text = r#"
+        [camera]
+        eye = [0.0, 0.3, 3.5]
+        center = [0.0, 0.0, 0.0]
+        fovy = 40
+        width = 200
+        height = 150
+        [world]
+        ambient = [0.3, 0.3, 0.3]
+        background = [0.1, 0.1, 0.15]
+        [materials.red]
+        color = [0.9, 0.1, 0.1]
+        [materials.glass]
+        color = [0.2, 0.4, 0.9]
+        transmission = 0.6
+        ior = 1.0
+        [[lights]]
+        type = "directional"
+        direction = [-0.3, -1.0, -0.5]
+        [[objects]]
+        type = "sphere"
+        radius = 0.35
+        material = "red"
+        [[objects]]
+        type = "plane"
+        size = [1.2, 0.6]
+        rotate = [90, 0, 0]
+        translate = [0.3, -0.2, 1.4]
+        material = "glass"
+        [[volumes]]
+        field = { type = "sphere", radius = 0.9, resolution = 40 }
+        transfer = [{ value = 0.0, colour = [0.2, 0.8, 0.3], alpha = 0.0 }, { value = 0.3, colour = [0.2, 0.8, 0.3], alpha = 0.04 }]
+    "#;
+    let scene = mirador::scene::file::parse(text, std::path::Path::new("inline.toml")).unwrap();
+    let mut settings = scene.settings.clone();
+    settings.shadows.enabled = false;
+    let error = parity(&scene, &settings);
+    eprintln!("sphere inside, pane in front: FLIP {error:.5}");
+    assert!(error < 0.02, "raster vs traced with a sphere inside and a pane in front: FLIP {error}");
+    // The red sphere shows through the green haze: the centre pixel is reddish in both.
+    let raster = common::raster(&scene, &settings);
+    let centre = raster.get_pixel(100, 75);
+    assert!(centre[0] > centre[1], "centre pixel {centre:?}");
+}
+
+fn load_error(volume: &str) -> String {
+    let text = format!("[[volumes]]\n{volume}\n");
+    match mirador::scene::file::parse(&text, std::path::Path::new("bad.toml")) {
+        Ok(_) => panic!("accepted: {volume}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn bad_volumes_in_scene_files_are_errors_with_their_line() {
+    let field = "field = { type = \"marschner_lobb\", resolution = 9 }";
+    let cases: [(String, &str); 9] = [
+        (
+            format!("{field}\ntransfer = [\n  {{ value = 0.5, colour = [1, 1, 1], alpha = 0.1 }},\n  {{ value = 0.2, colour = [1, 1, 1], alpha = 0.1 }},\n]"),
+            "bad.toml:5:3: transfer: control point 2: values must not decrease",
+        ),
+        (
+            format!("{field}\ntransfer = [{{ value = 3.0, colour = [1, 1, 1], alpha = 0.1 }}]"),
+            "lies outside the volume's range",
+        ),
+        (format!("{field}\ntransfer = [{{ value = 0.5, colour = [1, 1, 1], alpha = 1.5 }}]"), "must lie in [0, 1]"),
+        (format!("{field}\ntransfer = [{{ value = nan, colour = [1, 1, 1], alpha = 0.5 }}]"), "expected a finite number"),
+        ("field = { type = \"sphere\", resolution = 1 }".into(), "resolution must be at least 2, got 1"),
+        ("field = { type = \"sphere\", resolution = [8, 0, 8] }".into(), "resolution must be at least 2, got 0"),
+        (format!("{field}\npreset = \"bone\""), "no preset `bone`"),
+        (format!("{field}\niso = 7"), "iso 7 lies outside the volume's range"),
+        (format!("{field}\npath = \"x.nrrd\""), "exactly one of `path` (NRRD), `raw` or `field`"),
+    ];
+    for (volume, expected) in cases {
+        let message = load_error(&volume);
+        assert!(message.contains(expected), "{volume}\n→ {message}\n(expected `{expected}`)");
+        assert!(message.starts_with("bad.toml"), "{message}");
+    }
+}
