@@ -183,6 +183,28 @@ fn instance_attributes_match_the_wgsl_locations() {
         [0, 16, 32, 48, 64, 76, 88, 100],
         "the matrix columns, the normal matrix's, then the environment layer"
     );
+    use mirador::raster::volume::GpuVolume;
+    let scene = structs(&parse(&shaders::compose(shaders::SCENE)));
+    check_struct(
+        &scene,
+        "Volume",
+        size_of::<GpuVolume>(),
+        &fields!(GpuVolume {
+            world_from_local,
+            local_from_world,
+            normal_from_local,
+            half_extent,
+            voxel_length,
+            spacing,
+            step,
+            dims,
+            iso,
+            termination,
+            opacity_correction,
+            view,
+            samples_white
+        }),
+    );
     assert_eq!(size_of::<GpuInstance>(), 104);
 }
 
@@ -232,6 +254,19 @@ fn codes_shared_by_rust_and_wgsl_agree() {
     for (name, filter) in SHADOW_FILTER_NAMES {
         assert_eq!(constant(&module, name), f64::from(shadow_filter_code(filter)), "{name}: WGSL vs Rust");
     }
+    for (name, gradient) in mirador::raster::volume::VOLUME_GRADIENT_NAMES {
+        let code = mirador::raster::volume::gradient_code(gradient);
+        assert_eq!(constant(&module, name), f64::from(code), "{name}: WGSL vs Rust");
+    }
+    use mirador::volume::{march, transfer};
+    for (name, rust) in [
+        ("VOLUME_MAX_SAMPLES", march::MAX_SAMPLES as f64),
+        ("VOLUME_BISECTION_STEPS", march::BISECTION_STEPS as f64),
+        ("VOLUME_TABLE_SIZE", transfer::TABLE_SIZE as f64),
+        ("VOLUME_VIEW_SAMPLES", 1.0),
+    ] {
+        assert_eq!(constant(&module, name), rust, "{name}: WGSL vs Rust");
+    }
     use mirador::settings::ToneMap;
     let present = parse(&shaders::compose(shaders::PRESENT));
     for (name, curve) in [
@@ -249,12 +284,13 @@ fn codes_shared_by_rust_and_wgsl_agree() {
 fn every_pipeline_constant_is_an_override_of_the_scene_shader() {
     let module = parse(&shaders::compose(shaders::SCENE));
     let overrides: Vec<String> = module.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect();
-    for name in CONSTANT_NAMES {
+    let volume_names = mirador::raster::volume::VOLUME_CONSTANT_NAMES;
+    for name in CONSTANT_NAMES.iter().chain(&volume_names) {
         assert!(overrides.iter().any(|o| o == name), "{name} is set by scene_pass.rs but is no override of scene.wgsl");
     }
     assert_eq!(
         overrides.len(),
-        CONSTANT_NAMES.len(),
+        CONSTANT_NAMES.len() + volume_names.len(),
         "scene.wgsl has overrides scene_pass.rs never sets: {overrides:?}"
     );
 }

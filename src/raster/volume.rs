@@ -57,6 +57,9 @@ pub struct GpuVolume {
     pub samples_white: f32,
 }
 
+/// The volume pipelines' own `override`s in `shaders/volume.wgsl`, besides the scene's.
+pub const VOLUME_CONSTANT_NAMES: [&str; 2] = ["VOLUME_GRADIENT", "VOLUME_SHADOWS"];
+
 /// `VOLUME_GRADIENT` codes.
 pub const VOLUME_GRADIENT_NAMES: [(&str, VolumeGradient); 3] = [
     ("VOLUME_GRADIENT_OFF", VolumeGradient::Off),
@@ -236,8 +239,7 @@ impl VolumePass {
         self.pipelines.entry(key).or_insert_with(|| {
             let (frame, gradient, shadows, isosurface) = key;
             let mut constants: Vec<(&str, f64)> = constants(&frame, &MaterialKey::default()).to_vec();
-            constants.push(("VOLUME_GRADIENT", f64::from(gradient)));
-            constants.push(("VOLUME_SHADOWS", f64::from(u8::from(shadows))));
+            constants.extend(VOLUME_CONSTANT_NAMES.into_iter().zip([f64::from(gradient), f64::from(u8::from(shadows))]));
             let blend = (!isosurface).then_some(wgpu::BlendState {
                 color: wgpu::BlendComponent {
                     src_factor: wgpu::BlendFactor::One,
