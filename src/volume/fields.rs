@@ -97,7 +97,8 @@ mod tests {
     #[test]
     fn distances_are_zero_on_the_surfaces() {
         assert_eq!(sphere_distance(Vec3::new(0.0, 0.6, 0.0), 0.6), 0.0);
-        assert!(torus_distance(Vec3::new(0.7, 0.2, 0.0), 0.5, 0.2).abs() < 1e-6);
+        assert!(torus_distance(Vec3::new(0.7, 0.0, 0.0), 0.5, 0.2).abs() < 1e-6);
+        assert!((torus_distance(Vec3::new(0.5, 0.3, 0.0), 0.5, 0.2) - 0.1).abs() < 1e-6);
         assert!(torus_distance(Vec3::ZERO, 0.5, 0.2) > 0.0);
     }
 

@@ -198,9 +198,12 @@ mod tests {
 
     #[test]
     fn two_slabs_composite_as_computed_by_hand() {
-        // Value 0: red, α = 0.2 per voxel; value 1: blue, α = 0.5 per voxel. A ray along +x crosses
-        // 1 unit (10 voxels) of each. Without correction by hand: each slab lets (1 − α)^10
-        // through, the first's colour weight is 1 − 0.8^10, the second's 0.8^10·(1 − 0.5^10).
+        // Value 0: red, α = 0.2 per voxel; value 1: blue, α = 0.5 per voxel. Read by nearest
+        // neighbour, the field changes halfway between the grid points x = −0.1 and x = 0, at
+        // x = −0.05: a ray along +x crosses 0.95 units (9.5 voxels) of red, then 10.5 voxels of blue.
+        // By hand: the red slab lets 0.8^9.5 through and keeps 1 − 0.8^9.5 of its colour; the blue
+        // one adds 0.8^9.5·(1 − 0.5^10.5). The samples (every 0.05, at midpoints) fall 19 before
+        // and 21 after the change, so the sum is exact up to rounding.
         let tf = TransferFunction::new(vec![
             ControlPoint { value: 0.0, colour: Vec3::X, alpha: 0.2 },
             ControlPoint { value: 1.0, colour: Vec3::Z, alpha: 0.5 },
@@ -211,10 +214,10 @@ mod tests {
         let (t0, t1) = ray.box_interval(grid.half_extent()).unwrap();
         assert_eq!((t0, t1), (1.0, 3.0));
         let out = composite(&grid, &tf.table(), &ray, (t0, t1), &march(), &mut |_, _, c| c, None);
-        let first = 1.0 - 0.8f32.powi(10);
-        let second = 0.8f32.powi(10) * (1.0 - 0.5f32.powi(10));
-        assert!((out.colour - Vec3::new(first, 0.0, second)).abs().max_element() < 2e-3, "{}", out.colour);
-        assert!((out.alpha - (first + second)).abs() < 2e-3);
+        let first = 1.0 - 0.8f32.powf(9.5);
+        let second = 0.8f32.powf(9.5) * (1.0 - 0.5f32.powf(10.5));
+        assert!((out.colour - Vec3::new(first, 0.0, second)).abs().max_element() < 1e-5, "{}", out.colour);
+        assert!((out.alpha - (first + second)).abs() < 1e-5);
         assert_eq!(out.planned, 40);
         assert_eq!(out.taken, 40);
     }
