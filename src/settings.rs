@@ -765,7 +765,10 @@ impl RenderSettings {
             )));
         }
         if !(volume.threshold > 0.0 && volume.threshold <= 1.0) {
-            return Err(SettingsError::Invalid(format!("volume.threshold must lie in (0, 1], got {}", volume.threshold)));
+            return Err(SettingsError::Invalid(format!(
+                "volume.threshold must lie in (0, 1], got {}",
+                volume.threshold
+            )));
         }
         let scale = self.raster.render_scale;
         if !(scale.is_finite() && (0.1..=1.0).contains(&scale)) {

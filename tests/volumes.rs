@@ -76,9 +76,10 @@ fn both_renderers_take_the_same_samples_per_pixel() {
     let mut settings = scene.settings.clone();
     settings.volume.view = VolumeView::Samples;
     let (raster, traced) = (common::raster(&scene, &settings), traced(&scene, &settings));
-    let differing = raster.pixels().zip(traced.pixels()).filter(|(a, b)| {
-        a.0.iter().zip(b.0.iter()).any(|(x, y)| x.abs_diff(*y) > 8)
-    });
+    let differing = raster
+        .pixels()
+        .zip(traced.pixels())
+        .filter(|(a, b)| a.0.iter().zip(b.0.iter()).any(|(x, y)| x.abs_diff(*y) > 8));
     let fraction = differing.count() as f32 / (raster.width() * raster.height()) as f32;
     eprintln!("{:.3} % of pixels took different sample counts", 100.0 * fraction);
     assert!(fraction < 0.01, "{:.2} % of the pixels took different sample counts", 100.0 * fraction);
@@ -127,12 +128,12 @@ fn early_termination_saves_samples_and_little_else() {
     assert_eq!(counts_without.volume_samples_saved, 0);
     assert!(counts_with.volume_samples_saved > 0);
     // Every sample is taken or saved: the planned total is the same.
-    assert_eq!(
-        counts_with.volume_samples + counts_with.volume_samples_saved,
-        counts_without.volume_samples,
-    );
+    assert_eq!(counts_with.volume_samples + counts_with.volume_samples_saved, counts_without.volume_samples,);
     let error = flip(&with, &without);
-    eprintln!("early termination: {} samples taken, {} saved; FLIP {error:.5}", counts_with.volume_samples, counts_with.volume_samples_saved);
+    eprintln!(
+        "early termination: {} samples taken, {} saved; FLIP {error:.5}",
+        counts_with.volume_samples, counts_with.volume_samples_saved
+    );
     assert!(error < 0.005, "early termination changed the image by FLIP {error}");
 }
 
@@ -235,7 +236,9 @@ fn bad_volumes_in_scene_files_are_errors_with_their_line() {
     let field = "field = { type = \"marschner_lobb\", resolution = 9 }";
     let cases: [(String, &str); 9] = [
         (
-            format!("{field}\ntransfer = [\n  {{ value = 0.5, colour = [1, 1, 1], alpha = 0.1 }},\n  {{ value = 0.2, colour = [1, 1, 1], alpha = 0.1 }},\n]"),
+            format!(
+                "{field}\ntransfer = [\n  {{ value = 0.5, colour = [1, 1, 1], alpha = 0.1 }},\n  {{ value = 0.2, colour = [1, 1, 1], alpha = 0.1 }},\n]"
+            ),
             "bad.toml:5:3: transfer: control point 2: values must not decrease",
         ),
         (
@@ -243,7 +246,10 @@ fn bad_volumes_in_scene_files_are_errors_with_their_line() {
             "lies outside the volume's range",
         ),
         (format!("{field}\ntransfer = [{{ value = 0.5, colour = [1, 1, 1], alpha = 1.5 }}]"), "must lie in [0, 1]"),
-        (format!("{field}\ntransfer = [{{ value = nan, colour = [1, 1, 1], alpha = 0.5 }}]"), "expected a finite number"),
+        (
+            format!("{field}\ntransfer = [{{ value = nan, colour = [1, 1, 1], alpha = 0.5 }}]"),
+            "expected a finite number",
+        ),
         ("field = { type = \"sphere\", resolution = 1 }".into(), "resolution must be at least 2, got 1"),
         ("field = { type = \"sphere\", resolution = [8, 0, 8] }".into(), "resolution must be at least 2, got 0"),
         (format!("{field}\npreset = \"bone\""), "no preset `bone`"),
@@ -255,4 +261,37 @@ fn bad_volumes_in_scene_files_are_errors_with_their_line() {
         assert!(message.contains(expected), "{volume}\n→ {message}\n(expected `{expected}`)");
         assert!(message.starts_with("bad.toml"), "{message}");
     }
+}
+
+#[test]
+fn the_phantom_file_holds_the_procedural_phantom() {
+    // assets/volumes/phantom.nrrd is `fields::phantom` on 96³ points with 2.5-voxel edges,
+    // written as 16-bit integers: every voxel within rounding of the function.
+    let grid = mirador::volume::nrrd::read_nrrd(&common::asset("volumes/phantom.nrrd")).unwrap();
+    assert_eq!(grid.dims, UVec3::splat(96));
+    let blur = 2.5 * 2.0 / 95.0;
+    let procedural = Grid::from_function(grid.dims, |p| fields::phantom(p, blur)).unwrap();
+    let worst = grid.values.iter().zip(&procedural.values).map(|(a, b)| (a - b).abs()).fold(0.0, f32::max);
+    assert!(worst <= 0.5 + 1e-3, "largest difference {worst}");
+    assert!((grid.spacing - Vec3::splat(2.0 / 95.0)).abs().max_element() < 1e-6);
+}
+
+#[test]
+fn a_raw_file_of_the_wrong_size_is_named_with_the_scene_line() {
+    let dir = std::env::temp_dir().join(format!("mirador-volumes-raw-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("short.raw"), vec![0u8; 999]).unwrap();
+    let scene = dir.join("scene.toml");
+    let text = "[[volumes]]\nraw = { path = \"short.raw\", dims = [10, 10, 10], type = \"uint8\" }\n";
+    let error = mirador::scene::file::parse(text, &scene).unwrap_err().to_string();
+    assert!(error.starts_with(&format!("{}:2:", scene.display())), "{error}");
+    assert!(error.contains("short.raw") && error.contains("999") && error.contains("1000"), "{error}");
+    // A good one loads.
+    std::fs::write(dir.join("good.raw"), (0..1000u32).map(|i| (i % 251) as u8).collect::<Vec<_>>()).unwrap();
+    let good =
+        "[[volumes]]\nraw = { path = \"good.raw\", dims = [10, 10, 10], type = \"uint8\", spacing = [1, 1, 2] }\n";
+    let loaded = mirador::scene::file::parse(good, &scene).unwrap();
+    assert_eq!(loaded.volumes[0].grid.dims, UVec3::splat(10));
+    assert_eq!(loaded.volumes[0].grid.half_extent(), Vec3::new(4.5, 4.5, 9.0));
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -4,12 +4,12 @@
 //! pass's outputs. Built once per scene; a frame rewrites the uniforms and, when tessellations
 //! change, the draw list.
 
-use super::volume::VolumeGpu;
 use super::geometry::SceneGeometry;
 use super::mirror::{Mirror, find_mirrors};
 use super::scene_pass::MaterialKey;
 use super::uniforms::{GpuFrame, GpuMaterial};
 use super::view::ViewBuffer;
+use super::volume::VolumeGpu;
 use crate::gpu::mipmap::{MipmapGenerator, sampler_descriptor, upload_with_mipmaps};
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::uniform::UniformBuffer;

@@ -123,7 +123,11 @@ impl VolumeGpu {
         queue.write_texture(
             table.as_image_copy(),
             bytemuck::cast_slice(&volume.table.0),
-            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(16 * TABLE_SIZE as u32), rows_per_image: None },
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(16 * TABLE_SIZE as u32),
+                rows_per_image: None,
+            },
             table.size(),
         );
         let uniform = UniformBuffer::new(device, "volume::uniform", &GpuVolume::zeroed());
@@ -203,7 +207,11 @@ impl VolumePass {
                 layout::uniform(4, wgpu::ShaderStages::VERTEX_FRAGMENT),
                 layout::texture(5, wgpu::TextureSampleType::Float { filterable: true }, wgpu::TextureViewDimension::D3),
                 layout::sampler(6, wgpu::SamplerBindingType::Filtering),
-                layout::texture(7, wgpu::TextureSampleType::Float { filterable: false }, wgpu::TextureViewDimension::D2),
+                layout::texture(
+                    7,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    wgpu::TextureViewDimension::D2,
+                ),
             ],
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -239,7 +247,8 @@ impl VolumePass {
         self.pipelines.entry(key).or_insert_with(|| {
             let (frame, gradient, shadows, isosurface) = key;
             let mut constants: Vec<(&str, f64)> = constants(&frame, &MaterialKey::default()).to_vec();
-            constants.extend(VOLUME_CONSTANT_NAMES.into_iter().zip([f64::from(gradient), f64::from(u8::from(shadows))]));
+            constants
+                .extend(VOLUME_CONSTANT_NAMES.into_iter().zip([f64::from(gradient), f64::from(u8::from(shadows))]));
             let blend = (!isosurface).then_some(wgpu::BlendState {
                 color: wgpu::BlendComponent {
                     src_factor: wgpu::BlendFactor::One,
@@ -254,7 +263,10 @@ impl VolumePass {
                 vertex: wgpu::VertexState {
                     module: scene_pass.module(),
                     entry_point: Some("vs_volume"),
-                    compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
                     buffers: &[],
                 },
                 // Back faces: a camera inside the box still sees them.
@@ -264,7 +276,10 @@ impl VolumePass {
                 fragment: Some(wgpu::FragmentState {
                     module: scene_pass.module(),
                     entry_point: Some(if isosurface { "fs_volume_isosurface" } else { "fs_volume_composite" }),
-                    compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
                     targets: &[Some(wgpu::ColorTargetState {
                         format: HDR_FORMAT,
                         blend,

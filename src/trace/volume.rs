@@ -108,9 +108,9 @@ impl Whitted<'_> {
         counts: &mut RayCounts,
     ) -> Vec3 {
         let nearest = self.nearest_surface(ray, cone);
-        let t_surface = nearest.as_ref().map_or(f32::INFINITY, |(hit, moved, _)| {
-            (moved.origin - ray.origin).dot(ray.direction) + hit.t
-        });
+        let t_surface = nearest
+            .as_ref()
+            .map_or(f32::INFINITY, |(hit, moved, _)| (moved.origin - ray.origin).dot(ray.direction) + hit.t);
         let isosurface = self.nearest_isosurface(ray, t_surface);
         let t_end = isosurface.as_ref().map_or(t_surface, |hit| hit.t);
 
@@ -132,7 +132,8 @@ impl Whitted<'_> {
         for (prepared, local, segment) in segments {
             let grid = &prepared.volume.grid;
             let out = {
-                let mut shade = |t: f32, gradient: Vec3, c: Vec3| self.shade_sample(prepared, ray, t, gradient, c, counts);
+                let mut shade =
+                    |t: f32, gradient: Vec3, c: Vec3| self.shade_sample(prepared, ray, t, gradient, c, counts);
                 march::composite(grid, &prepared.volume.table, &local, segment, march, &mut shade, None)
             };
             counts.volume_samples += u64::from(out.taken);
@@ -186,7 +187,15 @@ impl Whitted<'_> {
     }
 
     /// One composited sample's colour: `C_amb + Σ V·C_luz·k_dif·(n·L)` with the classified colour.
-    fn shade_sample(&self, prepared: &Prepared, ray: &Ray, t: f32, gradient: Vec3, colour: Vec3, counts: &mut RayCounts) -> Vec3 {
+    fn shade_sample(
+        &self,
+        prepared: &Prepared,
+        ray: &Ray,
+        t: f32,
+        gradient: Vec3,
+        colour: Vec3,
+        counts: &mut RayCounts,
+    ) -> Vec3 {
         let sample = SurfaceSample {
             color: colour,
             ka: 0.0,

@@ -228,7 +228,9 @@ mod tests {
     fn sizes_spacing_and_values_are_checked() {
         let ok = |d: UVec3| vec![0.0; voxel_count(d) as usize];
         assert!(Grid::new(UVec3::new(1, 4, 4), Vec3::ONE, ok(UVec3::new(1, 4, 4))).unwrap_err().contains("at least 2"));
-        assert!(Grid::new(UVec3::splat(2), Vec3::new(1.0, 0.0, 1.0), ok(UVec3::splat(2))).unwrap_err().contains("spacing"));
+        assert!(
+            Grid::new(UVec3::splat(2), Vec3::new(1.0, 0.0, 1.0), ok(UVec3::splat(2))).unwrap_err().contains("spacing")
+        );
         assert!(Grid::new(UVec3::splat(2), Vec3::ONE, vec![0.0; 7]).unwrap_err().contains("needs 8 values, got 7"));
         let mut values = ok(UVec3::splat(2));
         values[5] = f32::NAN;

@@ -50,7 +50,8 @@ impl Preset {
     }
 
     pub fn transfer_function(self) -> TransferFunction {
-        let p = |value: f32, r: f32, g: f32, b: f32, alpha: f32| ControlPoint { value, colour: Vec3::new(r, g, b), alpha };
+        let p =
+            |value: f32, r: f32, g: f32, b: f32, alpha: f32| ControlPoint { value, colour: Vec3::new(r, g, b), alpha };
         let points = match self {
             Preset::Grey => vec![p(0.0, 0.0, 0.0, 0.0, 0.0), p(1.0, 1.0, 1.0, 1.0, 0.25)],
             // x = (HU + 1000)/2000 over −1000..1000: skin ≈ 0.52, lesions 0.7, bone 1.
@@ -99,7 +100,11 @@ impl TransferFunction {
                 ));
             }
             if i > 0 && point.value < points[i - 1].value {
-                return Err(format!("control point {n}: values must not decrease ({} after {})", point.value, points[i - 1].value));
+                return Err(format!(
+                    "control point {n}: values must not decrease ({} after {})",
+                    point.value,
+                    points[i - 1].value
+                ));
             }
         }
         Ok(TransferFunction { points })
@@ -162,7 +167,8 @@ mod tests {
 
     #[test]
     fn evaluation_is_piecewise_linear_and_constant_beyond_the_ends() {
-        let tf = TransferFunction::new(vec![point(0.2, 0.0), point(0.6, 0.8), point(0.6, 0.1), point(1.0, 0.5)]).unwrap();
+        let tf =
+            TransferFunction::new(vec![point(0.2, 0.0), point(0.6, 0.8), point(0.6, 0.1), point(1.0, 0.5)]).unwrap();
         assert_eq!(tf.evaluate(0.0).w, 0.0);
         assert!((tf.evaluate(0.4).w - 0.4).abs() < 1e-6);
         assert!((tf.evaluate(0.8).w - 0.3).abs() < 1e-6);

@@ -10,6 +10,7 @@ use toml::Spanned;
 
 use super::{Builder, Finite, Scale, V3, transform};
 use crate::scene::SceneError;
+use crate::volume::nrrd::{Endian, RawDesc, ScalarType, read_nrrd, read_raw};
 use crate::volume::{ControlPoint, Grid, Preset, Rendering, TransferFunction, Volume, fields};
 
 #[derive(Deserialize)]
@@ -99,7 +100,7 @@ impl Builder<'_> {
         if sources.iter().filter(|&&s| s).count() != 1 {
             return Err(fail("a volume needs exactly one of `path` (NRRD), `raw` or `field`".into()));
         }
-        let (grid, default_iso) = self.volume_grid(&d)?;
+        let (grid, default_iso) = self.volume_grid(&d, span.clone())?;
         let (lo, hi) = match d.range {
             Some([Finite(lo), Finite(hi)]) if lo < hi => (lo, hi),
             Some([Finite(lo), Finite(hi)]) => return Err(fail(format!("range needs low < high, got [{lo}, {hi}]"))),
@@ -145,13 +146,36 @@ impl Builder<'_> {
     }
 
     /// The grid in data units, and the iso value its kind suggests (0 for distance fields).
-    fn volume_grid(&self, d: &VolumeDesc) -> Result<(Grid, Option<f32>), SceneError> {
+    fn volume_grid(&self, d: &VolumeDesc, span: Range<usize>) -> Result<(Grid, Option<f32>), SceneError> {
         if let Some(field) = &d.field {
             let span = field.span();
             let fail = |message: String| self.error(message, span.clone());
             return procedural(field.get_ref()).map_err(fail);
         }
-        Err(self.error("volume files are read in the next step".to_string(), 0..0))
+        if let Some(raw) = &d.raw {
+            let span = raw.span();
+            let fail = |message: String| self.error(format!("raw: {message}"), span.clone());
+            let r = raw.get_ref();
+            let dims = UVec3::new(
+                checked_dim(r.dims[0]).map_err(&fail)?,
+                checked_dim(r.dims[1]).map_err(&fail)?,
+                checked_dim(r.dims[2]).map_err(&fail)?,
+            );
+            let desc = RawDesc {
+                dims,
+                scalar: r.scalar.parse::<ScalarType>().map_err(&fail)?,
+                spacing: r.spacing.map_or(Vec3::ONE, |V3(s)| s),
+                endian: r.endian.as_deref().unwrap_or("little").parse::<Endian>().map_err(&fail)?,
+                header_bytes: r.header_bytes.unwrap_or(0),
+            };
+            let file = self.dir.join(&r.path);
+            let grid = read_raw(&file, &desc).map_err(|e| fail(format!("{}: {e}", file.display())))?;
+            return Ok((grid, None));
+        }
+        let relative = d.path.as_ref().expect("one source is present");
+        let file = self.dir.join(relative);
+        let grid = read_nrrd(&file).map_err(|e| self.error(format!("{}: NRRD: {e}", file.display()), span))?;
+        Ok((grid, None))
     }
 
     fn transfer_function(
@@ -163,7 +187,8 @@ impl Builder<'_> {
         let spans: Vec<Range<usize>> = points.iter().map(Spanned::span).collect();
         let mut converted = Vec::with_capacity(points.len());
         for (point, span) in points.into_iter().zip(&spans) {
-            let ControlPointDesc { value: Finite(value), colour: V3(colour), alpha: Finite(alpha) } = point.into_inner();
+            let ControlPointDesc { value: Finite(value), colour: V3(colour), alpha: Finite(alpha) } =
+                point.into_inner();
             if !(lo..=hi).contains(&value) {
                 let message = format!("control point value {value} lies outside the volume's range [{lo}, {hi}]");
                 return Err(self.error(message, span.clone()));
@@ -196,7 +221,11 @@ fn procedural(d: &FieldDesc) -> Result<(Grid, Option<f32>), String> {
         Some(Resolution::Axes([x, y, z])) => UVec3::new(checked_dim(x)?, checked_dim(y)?, checked_dim(z)?),
     };
     let applies = |field: &str, present: bool, allowed: &[FieldType]| {
-        if present && !allowed.contains(&d.kind) { Err(format!("`{field}` does not apply to this field")) } else { Ok(()) }
+        if present && !allowed.contains(&d.kind) {
+            Err(format!("`{field}` does not apply to this field"))
+        } else {
+            Ok(())
+        }
     };
     applies("radius", d.radius.is_some(), &[FieldType::Sphere])?;
     applies("major_radius", d.major_radius.is_some(), &[FieldType::Torus])?;
@@ -231,6 +260,3 @@ fn procedural(d: &FieldDesc) -> Result<(Grid, Option<f32>), String> {
 fn checked_dim(n: i64) -> Result<u32, String> {
     u32::try_from(n).ok().filter(|&n| n >= 2).ok_or_else(|| format!("resolution must be at least 2, got {n}"))
 }
-
-#[allow(dead_code)]
-fn unused(_: Vec3) {}
