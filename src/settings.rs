@@ -274,7 +274,8 @@ pub struct VolumeSettings {
     /// the tracer, shadow-map lookups in the rasterizer). Isosurfaces are shadowed like any
     /// surface whenever shadows are on.
     pub shadows: bool,
-    /// Draw the grid's cells as a wireframe (every cell up to 32 a side, coarser beyond).
+    /// Draw the grid's cells as a wireframe in the rasterizer (every cell up to 32 a side, every
+    /// k-th plane beyond, `k = ⌈cells/32⌉`); the tracer does not draw it.
     pub wireframe: bool,
     /// Teaching views.
     pub view: VolumeView,
@@ -765,7 +766,10 @@ impl RenderSettings {
             )));
         }
         if !(volume.threshold > 0.0 && volume.threshold <= 1.0) {
-            return Err(SettingsError::Invalid(format!("volume.threshold must lie in (0, 1], got {}", volume.threshold)));
+            return Err(SettingsError::Invalid(format!(
+                "volume.threshold must lie in (0, 1], got {}",
+                volume.threshold
+            )));
         }
         let scale = self.raster.render_scale;
         if !(scale.is_finite() && (0.1..=1.0).contains(&scale)) {
