@@ -1,5 +1,5 @@
 // Teaching overlays drawn over the shaded image (src/raster/overlays.rs): one shadow-map layer as
-// grey levels, and the lights' view volumes as lines in the scene.
+// grey levels, and lines in the scene (view volumes, the volumes' grid wireframe).
 
 // ---- One layer of the shadow maps, depth as grey.
 
@@ -37,17 +37,22 @@ fn fs_shadow_map_view(@builtin(position) pixel: vec4f) -> @location(0) vec4f {
     return vec4f(vec3f(distance), 1.0);
 }
 
-// ---- The lights' view volumes as lines in the scene.
+// ---- Lines in the scene, one colour per draw.
 
 // Group 0 of the scene pass, read at the main view's slot.
 @group(0) @binding(0) var<uniform> view: View;
 
+struct LineVertex {
+    @builtin(position) position: vec4f,
+    @location(0) colour: vec3f,
+}
+
 @vertex
-fn vs_frustum(@location(0) position: vec3f) -> @builtin(position) vec4f {
-    return view.clip_from_world * vec4f(position, 1.0);
+fn vs_lines(@location(0) position: vec3f, @location(1) colour: vec3f) -> LineVertex {
+    return LineVertex(view.clip_from_world * vec4f(position, 1.0), colour);
 }
 
 @fragment
-fn fs_frustum() -> @location(0) vec4f {
-    return vec4f(1.0, 0.8, 0.1, 1.0);
+fn fs_lines(line: LineVertex) -> @location(0) vec4f {
+    return vec4f(line.colour, 1.0);
 }

@@ -119,7 +119,7 @@ struct ViewArgs {
     screenshot: Option<PathBuf>,
     /// A scripted step, one per frame, in order: `set KEY=VALUE`, `view raster|traced|split|difference`,
     /// `split X`, `orbit DX DY`, `pan DX DY`, `zoom N`, `frame`, `reset`, `navigate orbit|fly`,
-    /// `walk X Y Z`, `pick X Y`, `cursor X Y`, `material KEY=VALUE`, `load FILE`, `scale S`, `help on|off`,
+    /// `walk X Y Z`, `pick X Y`, `cursor X Y`, `probe`, `material KEY=VALUE`, `load FILE`, `scale S`, `help on|off`,
     /// `panel on|off`, `overlay on|off`, `wait N`, `wait traced`, `screenshot FILE.png`.
     #[arg(long = "step", value_name = "STEP", requires = "frames")]
     steps: Vec<String>,

@@ -274,7 +274,8 @@ pub struct VolumeSettings {
     /// the tracer, shadow-map lookups in the rasterizer). Isosurfaces are shadowed like any
     /// surface whenever shadows are on.
     pub shadows: bool,
-    /// Draw the grid's cells as a wireframe (every cell up to 32 a side, coarser beyond).
+    /// Draw the grid's cells as a wireframe in the rasterizer (every cell up to 32 a side, every
+    /// k-th plane beyond, `k = ⌈cells/32⌉`); the tracer does not draw it.
     pub wireframe: bool,
     /// Teaching views.
     pub view: VolumeView,

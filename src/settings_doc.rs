@@ -273,9 +273,9 @@ pub fn describe(key: &str) -> Option<FieldDoc> {
         "volume.shadows" => doc(
             "Shadows of opaque surfaces on composited samples (a shadow ray per sample and light in the tracer, a shadow-map lookup in the rasterizer).",
         ),
-        "volume.wireframe" => {
-            doc("Draw the grid's cells as lines (every cell up to 32 a side, every k-th line beyond).")
-        }
+        "volume.wireframe" => doc(
+            "Draw each volume's grid cells as lines on its box's faces, over the frame: a line at every grid plane up to 32 cells a side, beyond that at every k-th plane (k = ⌈cells/32⌉), and the box's edges. A rasterizer overlay: the ray tracer does not draw it.",
+        ),
         "volume.view" => choice::<VolumeView>(
             "Teaching views: the samples taken per pixel as a heat map (black none, white 512), showing what early termination saves.",
         ),

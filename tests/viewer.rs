@@ -342,3 +342,92 @@ fn the_latlong_view_marks_the_direction_seen_under_the_cursor() {
         );
     }
 }
+
+/// The `key=value` fields of each of the viewer's `volume probe …` lines.
+fn probe_fields(output: &Output) -> Vec<std::collections::HashMap<String, String>> {
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let fields = |line: &str| {
+        line.split_whitespace().filter_map(|f| f.split_once('=')).map(|(k, v)| (k.into(), v.into())).collect()
+    };
+    stdout.lines().filter_map(|l| l.strip_prefix("volume probe ")).map(fields).collect()
+}
+
+#[test]
+fn the_volume_ray_under_the_cursor_shows_its_samples() {
+    use mirador::volume::{March, march};
+
+    let dir = scratch("volume-probe");
+    let shot = dir.join("probe.png");
+    // Over the phantom's lower half, where the ray reaches the threshold and stops early; then
+    // over the torus's isosurface.
+    let cursors = [glam::Vec2::new(200.5, 350.5), glam::Vec2::new(520.5, 320.5)];
+    let scene_path = common::asset("scenes/volume.toml");
+    let mut args: Vec<String> =
+        [scene_path.to_str().unwrap(), "--size", "1000x600", "--frames", "2"].map(String::from).to_vec();
+    for step in [
+        "overlay off".to_string(),
+        format!("cursor {} {}", cursors[0].x, cursors[0].y),
+        "probe".to_string(),
+        format!("screenshot {}", shot.display()),
+        format!("cursor {} {}", cursors[1].x, cursors[1].y),
+        "probe".to_string(),
+    ] {
+        args.extend(["--step".to_string(), step]);
+    }
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let output = viewer(&args, &dir);
+    succeeded(&output);
+    let probes = probe_fields(&output);
+    assert_eq!(probes.len(), 2, "two probe lines: {probes:?}");
+    let fields = &probes[0];
+    let number = |key: &str| fields[key].parse::<f32>().unwrap_or_else(|e| panic!("{key}: {e}"));
+    let list = |key: &str| fields[key].split(',').map(|v| v.parse::<f32>().unwrap()).collect::<Vec<_>>();
+    assert_eq!((fields["volume"].as_str(), fields["mode"].as_str()), ("phantom", "composite"));
+
+    // The same ray, from the camera and the volume alone: its box cut where the floor (y = 0)
+    // is, sampled as `march::samples` cuts it.
+    let views = views(&output);
+    let view = views[0].1;
+    let mut scene = Scene::load(&scene_path).expect("the volume scene");
+    (scene.camera.width, scene.camera.height) = (view[2], view[3]);
+    let settings = &scene.settings.volume;
+    let in_front_of_the_floor = |name: &str, cursor: glam::Vec2| {
+        let ray = scene.camera.ray_through(cursor.x, cursor.y);
+        let volume = scene.volumes.iter().find(|v| v.name == name).expect("the volume");
+        let local = volume.local_ray(&ray);
+        let (near, far) = local.box_interval(volume.grid.half_extent()).expect("the ray enters the box");
+        let floor = if ray.direction.y < 0.0 { -ray.origin.y / ray.direction.y } else { f32::INFINITY };
+        (volume, local, (near.max(0.0), far.min(floor)))
+    };
+    let (phantom, local, segment) = in_front_of_the_floor("phantom", cursors[0]);
+    let planned = march::samples(&phantom.grid, &local, segment, settings.step).count;
+    assert_eq!(number("planned") as u32, planned, "the samples planned along the ray");
+
+    let alpha_out = list("alpha_out");
+    let taken = number("taken") as u32;
+    assert_eq!(alpha_out.len() as u32, taken, "one accumulated opacity per sample taken");
+    assert_eq!(list("value").len() as u32, taken);
+    assert!(alpha_out.windows(2).all(|w| w[0] <= w[1]), "the accumulated opacity never falls: {alpha_out:?}");
+    let threshold = March::of(settings).termination.expect("early termination is on in the scene");
+    assert!(taken < planned, "the ray stops early here: {taken} of {planned}");
+    assert!(number("alpha") >= threshold && alpha_out[alpha_out.len() - 2] < threshold, "it stops at the threshold");
+
+    // Over the torus: its values along the ray and the crossing `march::isosurface` finds.
+    let torus = &probes[1];
+    assert_eq!((torus["volume"].as_str(), torus["mode"].as_str()), ("torus", "isosurface"));
+    let (volume, local, segment) = in_front_of_the_floor("torus", cursors[1]);
+    let crossing =
+        march::isosurface(&volume.grid, &local, segment, volume.iso, &March::of(settings)).expect("a crossing");
+    let shown: f32 = torus["crossing"].parse().expect("the crossing's t");
+    assert!((shown - crossing).abs() < 1e-4, "the crossing shown at t = {shown}, computed at {crossing}");
+
+    // The plot is drawn in the view's lower-right corner (across from the cursor): its
+    // accumulated-opacity curve's light blue is there.
+    let image = image::open(&shot).expect("the screenshot").into_rgba8();
+    let corner = crop(&image, [view[0] + view[2] / 2, view[1] + view[3] / 2, view[2] / 2, view[3] / 2]);
+    assert!(
+        corner.pixels().filter(|p| p[0] < 90 && p[1] > 170 && p[2] > 220).count() > 50,
+        "the α_out curve is drawn: {}",
+        shot.display()
+    );
+}

@@ -31,15 +31,18 @@ pub mod volume;
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
+use glam::Vec3;
+
 use crate::gpu::mipmap::MipmapGenerator;
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::{Gpu, readback};
 use crate::output::OutputTransform;
 use crate::scene::Scene;
 use crate::settings::{EnvironmentView, MirrorView, Prepass, RenderSettings, ShadowMethod, TransparencySettings};
+use crate::volume::WIREFRAME_CELLS;
 use environment::{EnvironmentMaps, EnvironmentPass, capture_key, capture_range, cube_face_view, object_centre};
 use mirror::pass::{children, plan, volumes};
-use overlays::Overlays;
+use overlays::{FRUSTUM_COLOUR, Overlays, WIREFRAME_COLOUR};
 use present::{PresentInput, PresentPass};
 use scene_gpu::{SceneGpu, SceneLayouts};
 use scene_pass::{FrameKey, MirrorImages, SHADOWS_OFF, ScenePass, SceneTargets};
@@ -445,6 +448,13 @@ impl Renderer {
                 &settings.volume,
             );
             frame.end("volumes");
+            if settings.volume.wireframe {
+                let lines: Vec<[Vec3; 2]> =
+                    scene.volumes.iter().flat_map(|v| v.wireframe_lines(WIREFRAME_CELLS)).collect();
+                let lines = lines.as_flattened();
+                self.overlays.record_lines(device, &mut frame.encoder, scene_gpu, lines, WIREFRAME_COLOUR, targets);
+                frame.end("volume wireframe");
+            }
         }
         let mut transparency = TransparencyReport::default();
         if sorted_transparency {
@@ -466,7 +476,8 @@ impl Renderer {
         }
         self.overlays.record(device, queue, &mut frame.encoder, shadows, scene_gpu, map_layout, &maps, targets);
         if mirrors.view == MirrorView::Camera && !nodes.is_empty() {
-            self.overlays.record_volumes(device, &mut frame.encoder, scene_gpu, &volumes(&nodes), targets);
+            let edges = overlays::box_edges(&volumes(&nodes));
+            self.overlays.record_lines(device, &mut frame.encoder, scene_gpu, &edges, FRUSTUM_COLOUR, targets);
         }
         // The environment's teaching views, over the frame.
         let env_view = settings.environment.view;

@@ -1,7 +1,9 @@
 //! Teaching overlays drawn over the shaded HDR image, before the output transform: a shadow map
-//! layer as grey levels (near black, far white), and the lights' view volumes as lines in the
-//! scene (`shadows.view = "map"`, `shadows.show_frusta`). They read what the passes made and
-//! change nothing the techniques compute.
+//! layer as grey levels (near black, far white), and lines in the scene, depth tested against the
+//! frame: the lights' and mirrored cameras' view volumes (`shadows.view = "map"`,
+//! `shadows.show_frusta`, `mirrors.view = "camera"`) and the volumes' grid cells
+//! (`volume.wireframe`). They read what the passes made and change nothing the techniques
+//! compute.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
@@ -22,14 +24,19 @@ pub struct Overlays {
     /// Made on first use: GL cannot read a depth texture without comparing it, so there this
     /// one view fails (with a clear error) while every other pass runs.
     map_view: std::cell::OnceCell<MapView>,
-    frusta: Frusta,
+    lines: Lines,
 }
+
+/// The colour of view volumes' edges.
+pub const FRUSTUM_COLOUR: Vec3 = Vec3::new(1.0, 0.8, 0.1);
+/// The colour of the volumes' grid wireframe.
+pub const WIREFRAME_COLOUR: Vec3 = Vec3::new(0.2, 0.85, 1.0);
 
 impl Overlays {
     pub fn new(device: &wgpu::Device, scene_layouts: &SceneLayouts) -> Overlays {
         let module = shaders::module(device, "overlays::shader", shaders::OVERLAYS);
-        let frusta = Frusta::new(device, &module, scene_layouts);
-        Overlays { module, map_view: std::cell::OnceCell::new(), frusta }
+        let lines = Lines::new(device, &module, scene_layouts);
+        Overlays { module, map_view: std::cell::OnceCell::new(), lines }
     }
 
     /// Draws the overlays that `settings` asks for over `frame`'s HDR image.
@@ -56,24 +63,33 @@ impl Overlays {
         }
         if settings.show_frusta {
             let volumes: Vec<[Vec3; 8]> = (0..layout.views.len()).map(|layer| layout.corners(layer)).collect();
-            self.frusta.record(device, encoder, scene, &volumes, &frame.hdr.view, &frame.depth.view);
+            self.record_lines(device, encoder, scene, &box_edges(&volumes), FRUSTUM_COLOUR, frame);
         }
     }
-}
 
-impl Overlays {
-    /// Draws the edges of each of `volumes` (eight corners, as `view::frustum_corners` orders
-    /// them) into the scene: the mirrored cameras' view volumes (`mirrors.view = "camera"`).
-    pub fn record_volumes(
+    /// Draws `lines` (world-space segments, two points each) in `colour` into the scene as the
+    /// main view sees it, depth tested against `frame` (not written).
+    pub fn record_lines(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         scene: &SceneGpu,
-        volumes: &[[Vec3; 8]],
+        lines: &[Vec3],
+        colour: Vec3,
         frame: &FrameTargets,
     ) {
-        self.frusta.record(device, encoder, scene, volumes, &frame.hdr.view, &frame.depth.view);
+        if !lines.is_empty() {
+            self.lines.record(device, encoder, scene, lines, colour, &frame.hdr.view, &frame.depth.view);
+        }
     }
+}
+
+/// The twelve edges of each box or frustum of `volumes` (eight corners, as
+/// `view::frustum_corners` orders them), as line segments.
+pub fn box_edges(volumes: &[[Vec3; 8]]) -> Vec<Vec3> {
+    const EDGES: [(usize, usize); 12] =
+        [(0, 1), (2, 3), (0, 2), (1, 3), (4, 5), (6, 7), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)];
+    volumes.iter().flat_map(|corners| EDGES.into_iter().flat_map(move |(a, b)| [corners[a], corners[b]])).collect()
 }
 
 /// One map layer drawn over the image as grey levels.
@@ -161,69 +177,70 @@ impl MapView {
     }
 }
 
-/// The edges of each light view's volume, drawn into the scene from the main view.
-struct Frusta {
+/// Line segments drawn into the scene from the main view, in one colour.
+struct Lines {
     pipeline: wgpu::RenderPipeline,
 }
 
-impl Frusta {
-    fn new(device: &wgpu::Device, module: &wgpu::ShaderModule, scene_layouts: &SceneLayouts) -> Frusta {
+impl Lines {
+    fn new(device: &wgpu::Device, module: &wgpu::ShaderModule, scene_layouts: &SceneLayouts) -> Lines {
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("overlays::frusta_pipeline_layout"),
+            label: Some("overlays::lines_pipeline_layout"),
             bind_group_layouts: &[Some(&scene_layouts.frame)],
             immediate_size: 0,
         });
+        let buffer = |step_mode, attributes| wgpu::VertexBufferLayout { array_stride: 12, step_mode, attributes };
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("overlays::frusta_pipeline"),
+            label: Some("overlays::lines_pipeline"),
             layout: Some(&pipeline_layout),
             vertex: wgpu::VertexState {
                 module,
-                entry_point: Some("vs_frustum"),
+                entry_point: Some("vs_lines"),
                 compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: 12,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3],
-                })],
+                // Positions per vertex; the colour per instance, so one value serves every line.
+                buffers: &[
+                    Some(buffer(wgpu::VertexStepMode::Vertex, &wgpu::vertex_attr_array![0 => Float32x3])),
+                    Some(buffer(wgpu::VertexStepMode::Instance, &wgpu::vertex_attr_array![1 => Float32x3])),
+                ],
             },
             primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::LineList, ..Default::default() },
             depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::LessEqual, false),
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
                 module,
-                entry_point: Some("fs_frustum"),
+                entry_point: Some("fs_lines"),
                 compilation_options: Default::default(),
                 targets: &[Some(HDR_FORMAT.into())],
             }),
             multiview_mask: None,
             cache: None,
         });
-        Frusta { pipeline }
+        Lines { pipeline }
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn record(
         &self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         scene: &SceneGpu,
-        volumes: &[[Vec3; 8]],
+        lines: &[Vec3],
+        colour: Vec3,
         hdr: &wgpu::TextureView,
         depth: &wgpu::TextureView,
     ) {
-        const EDGES: [(usize, usize); 12] =
-            [(0, 1), (2, 3), (0, 2), (1, 3), (4, 5), (6, 7), (4, 6), (5, 7), (0, 4), (1, 5), (2, 6), (3, 7)];
-        let lines: Vec<Vec3> = volumes
-            .iter()
-            .flat_map(|corners| EDGES.into_iter().flat_map(move |(a, b)| [corners[a], corners[b]]))
-            .collect();
-        // A teaching view, drawn only while it is on: a buffer made here costs nothing when off.
-        let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("overlays::frusta_vertices"),
-            contents: bytemuck::cast_slice(&lines),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
+        // A teaching view, drawn only while it is on: buffers made here cost nothing when off.
+        let buffer = |label, contents: &[Vec3]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytemuck::cast_slice(contents),
+                usage: wgpu::BufferUsages::VERTEX,
+            })
+        };
+        let vertices = buffer("overlays::lines_vertices", lines);
+        let colour = buffer("overlays::lines_colour", &[colour]);
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("overlays::frusta_pass"),
+            label: Some("overlays::lines_pass"),
             color_attachments: &[Some(layout::color_attachment(hdr, wgpu::LoadOp::Load))],
             depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Load)),
             timestamp_writes: None,
@@ -233,6 +250,7 @@ impl Frusta {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(ViewSlot::Main)]);
         pass.set_vertex_buffer(0, vertices.slice(..));
+        pass.set_vertex_buffer(1, colour.slice(..));
         pass.draw(0..lines.len() as u32, 0..1);
     }
 }

@@ -22,7 +22,8 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use super::geometry::SurfaceHit;
 use super::whitted::{RayCounts, Whitted};
-use crate::scene::shading::{SurfaceSample, direct, emitted_and_ambient, facing_viewer};
+use crate::scene::light::Incidence;
+use crate::scene::shading::{SurfaceSample, Terms, direct, emitted_and_ambient, facing_viewer};
 use crate::scene::{Ray, Scene};
 use crate::settings::{VolumeSettings, VolumeView};
 use crate::texture::RayCone;
@@ -85,8 +86,7 @@ impl Prepared<'_> {
 
     /// The world-space unit normal of a local gradient, `None` where it vanishes.
     fn normal(&self, gradient: Vec3) -> Option<Vec3> {
-        let n = self.normal_from_local * gradient;
-        (n.length_squared() > 1e-20).then(|| n.normalize())
+        world_normal(self.normal_from_local, gradient)
     }
 }
 
@@ -186,7 +186,8 @@ impl Whitted<'_> {
         nearest
     }
 
-    /// One composited sample's colour: `C_amb + Σ V·C_luz·k_dif·(n·L)` with the classified colour.
+    /// One composited sample's colour (see [`voxel_illumination`]), with shadow rays when
+    /// `volume.shadows` is on.
     fn shade_sample(
         &self,
         prepared: &Prepared,
@@ -196,32 +197,52 @@ impl Whitted<'_> {
         colour: Vec3,
         counts: &mut RayCounts,
     ) -> Vec3 {
-        let sample = SurfaceSample {
-            color: colour,
-            ka: 0.0,
-            kd: 1.0,
-            ks: 0.0,
-            specular_color: Vec3::ZERO,
-            shininess: 1.0,
-            emission: Vec3::ZERO,
-        };
-        let mut rad = emitted_and_ambient(&sample, self.scene.ambient, self.terms);
-        let Some(n) = prepared.normal(gradient) else { return rad };
-        let v = -ray.direction;
-        let n = facing_viewer(n, v);
         let p = ray.at(t);
-        for light in &self.scene.lights {
-            let Some(incidence) = light.incidence(p) else { continue };
-            if incidence.l.dot(n) <= 0.0 {
-                continue;
-            }
-            let visibility = if self.volumes.shadows {
-                self.visibility(p, incidence.l, incidence.distance, counts)
-            } else {
-                Vec3::ONE
-            };
-            rad += visibility * direct(&sample, n, v, &incidence, self.terms);
-        }
-        rad
+        let normal = world_normal(prepared.normal_from_local, gradient);
+        voxel_illumination(self.scene, self.terms, colour, normal, -ray.direction, p, &mut |incidence| {
+            if self.volumes.shadows { self.visibility(p, incidence.l, incidence.distance, counts) } else { Vec3::ONE }
+        })
     }
+}
+
+/// The world-space unit normal of a local gradient (`normal_from_local`: the inverse transpose),
+/// `None` where it vanishes.
+pub fn world_normal(normal_from_local: Mat3, gradient: Vec3) -> Option<Vec3> {
+    let n = normal_from_local * gradient;
+    (n.length_squared() > 1e-20).then(|| n.normalize())
+}
+
+/// One composited sample's colour, the seed's voxel illumination `C_amb + Σ V·C_luz·k_dif·(n·L)`
+/// with the classified colour `colour`, at `p` seen from direction `v` (unit, towards the viewer):
+/// `normal` is turned to the viewer, `None` gives the ambient term alone; `visibility` is each
+/// light's `V`.
+pub fn voxel_illumination(
+    scene: &Scene,
+    terms: Terms,
+    colour: Vec3,
+    normal: Option<Vec3>,
+    v: Vec3,
+    p: Vec3,
+    visibility: &mut dyn FnMut(&Incidence) -> Vec3,
+) -> Vec3 {
+    let sample = SurfaceSample {
+        color: colour,
+        ka: 0.0,
+        kd: 1.0,
+        ks: 0.0,
+        specular_color: Vec3::ZERO,
+        shininess: 1.0,
+        emission: Vec3::ZERO,
+    };
+    let mut rad = emitted_and_ambient(&sample, scene.ambient, terms);
+    let Some(n) = normal else { return rad };
+    let n = facing_viewer(n, v);
+    for light in &scene.lights {
+        let Some(incidence) = light.incidence(p) else { continue };
+        if incidence.l.dot(n) <= 0.0 {
+            continue;
+        }
+        rad += visibility(&incidence) * direct(&sample, n, v, &incidence, terms);
+    }
+    rad
 }

@@ -49,6 +49,8 @@ pub struct Viewer {
     /// The 3D view's size in pixels, and where it sits in the window.
     pub view_pixels: Option<(u32, u32, u32, u32)>,
     screenshot: Option<PathBuf>,
+    /// Print the volume ray under the cursor after this frame's UI (the `probe` step).
+    print_probe: bool,
 }
 
 /// Scripted steps still to run and the wait in progress.
@@ -99,6 +101,7 @@ impl Viewer {
             key: 0,
             view_pixels: None,
             screenshot: None,
+            print_probe: false,
         }
     }
 
@@ -176,6 +179,9 @@ impl Viewer {
             screen.egui.run_ui(raw, |ui| output = ui::draw(ui, &mut model))
         };
         times.ui = ui_start.elapsed();
+        if std::mem::take(&mut self.print_probe) {
+            println!("{}", output.probe.as_ref().map_or("volume probe none".to_string(), |p| p.report()));
+        }
         let repaint = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
         self.apply(&output, input, start);
 
@@ -404,6 +410,7 @@ impl Viewer {
             Step::Panel(on) => self.view.panel_open = on,
             Step::Overlay(on) => self.view.overlay_open = on,
             Step::Cursor(pixel) => self.view.scripted_cursor = Some(pixel),
+            Step::Probe => self.print_probe = true,
             Step::Wait(frames) => self.script.wait_frames = frames,
             Step::WaitTraced => self.script.wait_traced_since = Some(Instant::now()),
             Step::Screenshot(path) => self.screenshot = Some(path),

@@ -14,6 +14,7 @@ pub const KEYS: &[(&str, &str)] = &[
     ("R", "reset to the scene's camera"),
     ("1 2 3 4", "view: raster, ray traced, split, difference"),
     ("click", "pick an object and edit its material"),
+    ("hover a volume", "plot the samples its ray takes (in a lower corner)"),
     ("P", "show or hide the side panel"),
     ("O", "show or hide the frame times"),
     ("F12", "screenshot of the window (PNG in the current directory)"),

@@ -8,7 +8,8 @@
 //!   [`scene_panel`] the camera, light and material editors; [`hud`] frame times and help.
 //! - [`camera_control`]: orbit, pan, zoom, fly and frame as pure functions on the camera.
 //! - [`raster_view`]: the one place the rasterizer is called; [`traced`]: the background tracer.
-//! - [`scene_state`] and [`picking`]: the scene, reloading, the picked object.
+//! - [`scene_state`] and [`picking`]: the scene, reloading, the picked object;
+//!   [`volume_probe`]: the samples of the volume ray under the cursor.
 //! - [`config`]: what is remembered between runs; [`script`]: scripted steps for tests.
 //!
 //! This module holds the winit `ApplicationHandler`: it opens the window when the event loop
@@ -28,6 +29,7 @@ pub mod script;
 pub mod traced;
 pub mod ui;
 pub mod view_mode;
+pub mod volume_probe;
 
 use std::path::PathBuf;
 use std::time::Instant;

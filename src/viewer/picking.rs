@@ -5,7 +5,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::scene::Scene;
+use crate::scene::{Ray, Scene};
 use crate::trace::accel::{self, AccelKind, Accelerator};
 use crate::trace::geometry::{Primitive, scene_primitives};
 
@@ -38,6 +38,11 @@ impl Picker {
         let hit = self.accelerator.closest(&self.primitives, &ray, 0.0, f32::INFINITY)?;
         let primitive = &self.primitives[hit.primitive as usize];
         Some(Picked { object: primitive.object(), material: primitive.material().0 })
+    }
+
+    /// The distance along `ray` to the nearest surface, ∞ where it hits none.
+    pub fn nearest(&self, ray: &Ray) -> f32 {
+        self.accelerator.closest(&self.primitives, ray, 0.0, f32::INFINITY).map_or(f32::INFINITY, |hit| hit.t)
     }
 
     /// The direction the environment is seen in at image point `pixel`: `r = reflect(d, n)` at

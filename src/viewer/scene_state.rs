@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant, SystemTime};
 
 use super::picking::{Picked, Picker, SeenDirection};
+use super::volume_probe::{self, Probe};
 use crate::scene::Camera;
 use crate::{RenderSettings, Scene};
 
@@ -129,6 +130,18 @@ impl SceneState {
     /// by the current camera.
     pub fn seen_direction(&mut self, pixel: glam::Vec2, size: (u32, u32)) -> SeenDirection {
         self.with_picker(size, |picker, scene| picker.seen_direction(scene, pixel))
+    }
+
+    /// What the volume ray through `pixel` of an image of `size` pixels taken by the current
+    /// camera does (`volume_probe`): `None` where it enters no volume in front of the surfaces.
+    pub fn volume_probe(&mut self, pixel: glam::Vec2, size: (u32, u32), settings: &RenderSettings) -> Option<Probe> {
+        if self.scene.volumes.is_empty() {
+            return None;
+        }
+        self.with_picker(size, |picker, scene| {
+            let ray = scene.camera.ray_through(pixel.x, pixel.y);
+            volume_probe::probe(scene, settings, &ray, picker.nearest(&ray))
+        })
     }
 
     /// Runs `f` with the picker (built once per scene) and the scene, its camera taking images

@@ -12,7 +12,9 @@
 //! navigate fly | navigate orbit
 //! walk 0 0 1                    fly by (right, up, forward) scene units
 //! pick 320 200                  click the 3D view at this pixel (selects the object)
-//! cursor 320 200                 hold the mouse over this pixel (the lat–long view's marker)
+//! cursor 320 200                hold the mouse over this pixel (the lat–long view's marker, the
+//!                               volume ray's samples)
+//! probe                         print the volume ray under the cursor (one line on stdout)
 //! material kd=0.2               edit the picked object's material
 //! load FILE                     as if FILE were dropped on the window
 //! scale 0.5                     the render scale while the camera moves
@@ -46,6 +48,7 @@ pub enum Step {
     Walk(Vec3),
     Pick(Vec2),
     Cursor(Vec2),
+    Probe,
     Material(String),
     Load(PathBuf),
     Scale(f32),
@@ -115,6 +118,7 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
         "zoom" => Step::Zoom(numbers::<1>(args).ok_or_else(|| fail("expected wheel steps"))?[0]),
         "walk" => Step::Walk(Vec3::from(numbers::<3>(args).ok_or_else(|| fail("expected right up forward"))?)),
         "frame" => Step::Frame,
+        "probe" => Step::Probe,
         "reset" => Step::Reset,
         "navigate" => Step::Navigate(match args {
             "orbit" => Navigation::Orbit,
@@ -162,6 +166,7 @@ mod tests {
         assert_eq!(parse("  view   split ").unwrap(), Step::View(ViewMode::Split));
         assert_eq!(parse("orbit 40 -10").unwrap(), Step::Orbit(Vec2::new(40.0, -10.0)));
         assert_eq!(parse("wait traced").unwrap(), Step::WaitTraced);
+        assert_eq!(parse("probe").unwrap(), Step::Probe);
         assert_eq!(parse("wait 3").unwrap(), Step::Wait(3));
         assert_eq!(parse("screenshot out.png").unwrap(), Step::Screenshot("out.png".into()));
         for bad in ["view sideways", "orbit 1", "split 2", "set shadows", "screenshot a.jpg", "dance", "pick nan 1"] {

@@ -15,6 +15,7 @@ use super::scene_panel;
 use super::scene_state::SceneState;
 use super::traced::TracedView;
 use super::view_mode::{ViewMode, ViewState};
+use super::volume_probe;
 use crate::RenderSettings;
 
 /// What the frame reads from and edits through the UI.
@@ -61,6 +62,8 @@ pub struct UiOutput {
     pub camera_edited: bool,
     pub lights_edited: bool,
     pub material_edited: bool,
+    /// The volume ray under the cursor, as the view shows it.
+    pub probe: Option<volume_probe::Probe>,
 }
 
 /// Draws the whole window.
@@ -246,12 +249,14 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
             }
         },
     }
-    if model.view.mode == ViewMode::Raster {
-        let cursor = response.hover_pos().map(|p| (p - rect.min) * ppp).map(|p| Vec2::new(p.x, p.y));
-        if let Some(pixel) = model.view.scripted_cursor.or(cursor) {
-            latlong_marker(&painter, model, rect, ppp, pixel);
-        }
+    let cursor = response.hover_pos().map(|p| (p - rect.min) * ppp).map(|p| Vec2::new(p.x, p.y));
+    let cursor = model.view.scripted_cursor.or(cursor);
+    if model.view.mode == ViewMode::Raster
+        && let Some(pixel) = cursor
+    {
+        latlong_marker(&painter, model, rect, ppp, pixel);
     }
+    output.probe = volume_probe::show(ui.ctx(), model.scene, model.settings, (rect, ppp), cursor);
     if model.view.overlay_open {
         overlay(ui, model, rect);
     }

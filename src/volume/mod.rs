@@ -34,6 +34,10 @@ pub use transfer::{ControlPoint, Preset, Table, TransferFunction};
 use crate::scene::{MaterialId, Ray};
 use crate::settings::{VolumeGradient, VolumeMode, VolumeReconstruction, VolumeSettings};
 
+/// Cells a side up to which the rasterizer's wireframe (`volume.wireframe`) draws every grid
+/// plane; a grid with more draws every k-th, `k = ⌈cells / WIREFRAME_CELLS⌉`.
+pub const WIREFRAME_CELLS: u32 = 32;
+
 /// How a volume is shown.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Rendering {
@@ -104,6 +108,39 @@ impl Volume {
             self.world_from_local.transform_point3(sign * h)
         })
     }
+
+    /// The grid's cells drawn on the box's six faces, in world space: on each face a line at every
+    /// grid plane that crosses it, and the box's twelve edges. An axis of more than `max_cells`
+    /// cells gets a line at every k-th plane only, `k = ⌈cells / max_cells⌉`.
+    pub fn wireframe_lines(&self, max_cells: u32) -> Vec<[Vec3; 2]> {
+        let h = self.grid.half_extent();
+        // The inner planes along each axis, as local coordinates.
+        let inner: [Vec<f32>; 3] = std::array::from_fn(|axis| {
+            let cells = self.grid.dims[axis] - 1;
+            let k = cells.div_ceil(max_cells.max(1)).max(1);
+            (k..cells).step_by(k as usize).map(|i| i as f32 * self.grid.spacing[axis] - h[axis]).collect()
+        });
+        let mut lines = Vec::new();
+        for axis in 0..3 {
+            // Lines along `axis`, through (u, v) on the other two axes `a` and `b`.
+            let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+            let mut line = |u: f32, v: f32| {
+                let mut p = Vec3::ZERO;
+                (p[a], p[b], p[axis]) = (u, v, -h[axis]);
+                let mut q = p;
+                q[axis] = h[axis];
+                lines.push([p, q]);
+            };
+            for side in [-1.0, 1.0] {
+                inner[b].iter().for_each(|&v| line(side * h[a], v));
+                inner[a].iter().for_each(|&u| line(u, side * h[b]));
+                line(side * h[a], -h[b]);
+                line(side * h[a], h[b]);
+            }
+        }
+        let world = |p: Vec3| self.world_from_local.transform_point3(p);
+        lines.into_iter().map(|[p, q]| [world(p), world(q)]).collect()
+    }
 }
 
 impl March {
@@ -123,5 +160,75 @@ impl March {
             opacity_correction: settings.opacity_correction,
             termination: settings.early_termination.then_some(settings.threshold),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Quat, UVec3};
+
+    use super::*;
+
+    fn volume(dims: UVec3) -> Volume {
+        let grid = Grid::from_function(dims, |p| p.x).unwrap();
+        let transfer = TransferFunction::new(vec![ControlPoint { value: 0.0, colour: Vec3::ONE, alpha: 0.1 }]).unwrap();
+        Volume {
+            name: "test".into(),
+            grid: Arc::new(grid),
+            range: (0.0, 1.0),
+            world_from_local: Mat4::from_scale_rotation_translation(
+                Vec3::new(0.5, 2.0, 1.5),
+                Quat::from_rotation_y(0.7),
+                Vec3::new(1.0, -2.0, 3.0),
+            ),
+            table: transfer.table(),
+            transfer,
+            rendering: Rendering::Composite,
+            iso: 0.5,
+            material: MaterialId(0),
+        }
+    }
+
+    #[test]
+    fn the_wireframe_draws_every_cell_on_the_faces_and_the_edges() {
+        // 6 × 5 × 4 points: 5 × 4 × 3 cells, so 4 + 3 + 2 inner planes. Each inner plane crosses
+        // four faces; the box adds its 12 edges.
+        let volume = volume(UVec3::new(6, 5, 4));
+        let lines = volume.wireframe_lines(WIREFRAME_CELLS);
+        assert_eq!(lines.len(), 4 * (4 + 3 + 2) + 12);
+        let h = volume.grid.half_extent();
+        let local_from_world = volume.local_from_world();
+        for [p, q] in lines {
+            let (p, q) = (local_from_world.transform_point3(p), local_from_world.transform_point3(q));
+            // Each line runs along one axis from face to face, on a face of the box and inside it.
+            let d = (q - p).abs();
+            let along: Vec<usize> = (0..3).filter(|&i| d[i] > 1e-4).collect();
+            assert_eq!(along.len(), 1, "{p} – {q}");
+            assert!((d[along[0]] - 2.0 * h[along[0]]).abs() < 1e-4, "{p} – {q} spans the box");
+            for point in [p, q] {
+                assert!((point.abs() - h).max_element() < 1e-4, "{point} is in the box");
+                assert!((0..3).any(|i| i != along[0] && (point[i].abs() - h[i]).abs() < 1e-4), "{point} on a face");
+            }
+        }
+    }
+
+    #[test]
+    fn a_fine_grid_gets_every_kth_plane() {
+        // 70 cells along x: k = ⌈70/32⌉ = 3, inner planes 3, 6, …, 69 (23 of them); y has one.
+        let volume = volume(UVec3::new(71, 3, 2));
+        let lines = volume.wireframe_lines(32);
+        assert_eq!(lines.len(), 4 * (23 + 1) + 12);
+        // The planes the lines not along x lie in, in cells from the box's −x face.
+        let local_from_world = volume.local_from_world();
+        let mut planes: Vec<u32> = lines
+            .iter()
+            .map(|&[p, q]| (local_from_world.transform_point3(p), local_from_world.transform_point3(q)))
+            .filter(|(p, q)| (q.x - p.x).abs() < 1e-4)
+            .map(|(p, _)| ((p.x + volume.grid.half_extent().x) / volume.grid.spacing.x).round() as u32)
+            .collect();
+        planes.sort();
+        planes.dedup();
+        let expected: Vec<u32> = (0..70).step_by(3).chain([70]).collect();
+        assert_eq!(planes, expected);
     }
 }
