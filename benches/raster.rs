@@ -16,7 +16,9 @@
 //!    each lookup (world cube, lat–long, sphere map, dynamic cubes kept) as a ratio to the frame
 //!    without lookups; a dynamic capture (six views per object) drawn every frame, and a sphere
 //!    map made every frame for a turning camera, as ratios to one plain frame.
-//! 6. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
+//! 6. Volumes: samples per second of the GPU ray-marching pass and of the tracer on a 256³ grid
+//!    at 1280×720, with and without early termination, and the grid's memory on each side.
+//! 7. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
 //!    about a million triangles: upload, frame, triangles, beside `trace` of the same scene.
 //!
 //! Times are wall-clock from submit to the queue being idle (the median of several frames after
@@ -30,7 +32,8 @@ use mirador::gpu::texture::GpuTexture;
 use mirador::raster::{FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer, drawn_size};
 use mirador::scene::sphereflake::{sphere_count, sphereflake_toml};
 use mirador::scene::{Attenuation, Light, LightKind, Mesh, Object, Shape};
-use mirador::settings::{EnvironmentMap, Prepass, ShadowFit, SphereView, TransparencySort};
+use mirador::settings::{EnvironmentMap, Prepass, ShadowFit, SphereView, TransparencySort, VolumeGradient};
+use mirador::trace::whitted::RayCounts;
 use mirador::trace::{RenderControl, Tracer};
 use mirador::{RenderSettings, Scene};
 
@@ -462,12 +465,143 @@ fn environment_costs(gpu: &Gpu) {
     println!("{:>48} {:>9.1} ms {:>7.2}× a plain frame", "one sphere-map generation", sphere * 1e3, sphere / plain);
 }
 
+/// The phantom on a 256³ grid (the `ct` preset), filling most of a 1280×720 frame.
+const VOLUME_SCENE: &str = r#"
+[camera]
+eye = [1.0, 0.6, 3.0]
+center = [0.0, 0.0, 0.0]
+fovy = 40
+width = 1280
+height = 720
+
+[world]
+ambient = [0.25, 0.25, 0.28]
+
+[[lights]]
+name = "key"
+type = "directional"
+direction = [0.6, -0.8, 0.2]
+intensity = 0.9
+
+[[volumes]]
+name = "phantom"
+field = { type = "phantom", resolution = 256 }
+range = [-1000, 1000]
+preset = "ct"
+"#;
+
+/// Rounds of the volume comparison (three traces each round): a GPU frame of this volume takes
+/// seconds on lavapipe.
+const VOLUME_ROUNDS: usize = 3;
+
+fn traced_counts(scene: &Scene, settings: &RenderSettings) -> (Duration, RayCounts) {
+    let (_, stats) = Tracer::new(scene, settings).render(&RenderControl::default()).expect("nothing cancels it");
+    (stats.elapsed, stats.rays)
+}
+
+fn volume_costs(gpu: &Gpu) {
+    let start = Instant::now();
+    let path = std::path::Path::new("volume-256.toml");
+    let scene = mirador::scene::file::parse(VOLUME_SCENE, path).expect("the volume scene parses");
+    let built = start.elapsed();
+    let grid = &scene.volumes[0].grid;
+    let voxels = grid.values.len() as u64;
+    let termination = |on: bool| {
+        let mut s = scene.settings.clone();
+        s.volume.early_termination = on;
+        s
+    };
+    let cases = [termination(true), termination(false)];
+    // The samples of the full frame. Shading changes no opacity, so one unshaded trace with
+    // termination counts both ways: taken, and taken + saved (what a march to the end takes).
+    let mut unshaded = cases[0].clone();
+    unshaded.volume.gradient = VolumeGradient::Off;
+    let (_, full) = traced_counts(&scene, &unshaded);
+    let full_samples = [full.volume_samples, full.volume_samples + full.volume_samples_saved];
+    // The tracer at a quarter of the size each way: 1280×720 takes tens of seconds on 2 cores.
+    let mut small = scene.clone();
+    (small.camera.width, small.camera.height) = (320, 180);
+    let mut bench = Bench::new(gpu, &scene);
+    bench.renderer.profile = true;
+    let (mut gpu_times, mut trace_times) = (vec![Vec::new(); 2], vec![Vec::new(); 2]);
+    let mut trace_samples = [0; 2];
+    // Interleaved rounds, GPU and tracer alike: the VM's speed drifts over seconds.
+    for _ in 0..VOLUME_ROUNDS {
+        for (k, settings) in cases.iter().enumerate() {
+            let (_, report) = bench.frame(&scene, settings);
+            let pass = report.passes.iter().find(|(name, _)| *name == "volumes").expect("the volume pass ran").1;
+            gpu_times[k].push(pass);
+            // The tracer is quick: three traces a round make its median as steady as the GPU's.
+            for _ in 0..3 {
+                let (time, counts) = traced_counts(&small, settings);
+                trace_times[k].push(time);
+                trace_samples[k] = counts.volume_samples;
+            }
+        }
+    }
+    let gpu_times: Vec<f64> = gpu_times.into_iter().map(|t| median(t).as_secs_f64()).collect();
+    let trace_times: Vec<f64> = trace_times.into_iter().map(|t| median(t).as_secs_f64()).collect();
+    let mib = |bytes: u64| bytes as f64 / (1 << 20) as f64;
+    let m = |n: f64| n / 1e6;
+    let settings = &scene.settings.volume;
+    println!(
+        "\nvolumes: the phantom (ct preset) on a {}³ grid (built in {:.1} s), step {} voxels, {:?} reconstruction, \
+         {:?} gradients, threshold {}; medians of {VOLUME_ROUNDS} interleaved rounds (GPU) and {} traces",
+        grid.dims.x,
+        built.as_secs_f64(),
+        settings.step,
+        settings.reconstruction,
+        settings.gradient,
+        settings.threshold,
+        3 * VOLUME_ROUNDS
+    );
+    println!(
+        "{:>44} {voxels} voxels: {:.1} MiB as f32 on the CPU, {:.1} MiB as R16Float on the GPU",
+        "grid",
+        mib(grid.bytes()),
+        mib(2 * voxels)
+    );
+    println!(
+        "{:>44} {:.1} M with early termination, {:.1} M without (counted by the tracer; the GPU pass marches the \
+         same samples per pixel by construction)",
+        "samples at 1280×720",
+        m(full_samples[0] as f64),
+        m(full_samples[1] as f64)
+    );
+    println!("{:>44} {:>11} {:>11} {:>13}", "", "time", "samples", "samples/s");
+    let mut rates = [[0.0; 2]; 2];
+    for (k, name) in ["on", "off"].iter().enumerate() {
+        let rows = [
+            (format!("GPU pass 1280×720, termination {name}"), gpu_times[k], full_samples[k]),
+            (format!("tracer 320×180, termination {name}"), trace_times[k], trace_samples[k]),
+        ];
+        for (r, (label, time, samples)) in rows.iter().enumerate() {
+            rates[r][k] = *samples as f64 / time;
+            println!("{label:>44} {:>8.0} ms {:>9.1} M {:>9.1} M/s", time * 1e3, m(*samples as f64), m(rates[r][k]));
+        }
+    }
+    println!(
+        "{:>44} GPU {:.2}× the time, tracer {:.2}× the time; {:.2}× the samples",
+        "early termination on / off",
+        gpu_times[0] / gpu_times[1],
+        trace_times[0] / trace_times[1],
+        full_samples[0] as f64 / full_samples[1] as f64
+    );
+    println!(
+        "{:>44} {:.2}× with termination, {:.2}× without",
+        "samples/s, GPU / tracer",
+        rates[0][0] / rates[1][0],
+        rates[0][1] / rates[1][1]
+    );
+    println!("{:>44} {:.0} s (the grid, the count and the rounds)", "this section took", start.elapsed().as_secs_f64());
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let quick = args.iter().any(|a| a == "--quick");
     // Section names on the command line run those sections alone:
     // `cargo bench --bench raster -- transparency`.
-    const SECTIONS: [&str; 6] = ["showcase", "shadows", "transparency", "mirrors", "environment", "growing"];
+    const SECTIONS: [&str; 7] = ["showcase", "shadows", "transparency", "mirrors", "environment", "volume", "growing"];
     let chosen: Vec<&str> = SECTIONS.into_iter().filter(|s| args.iter().any(|a| a == s)).collect();
     let run = |section: &str| chosen.is_empty() || chosen.contains(&section);
     let gpu = Gpu::headless().expect("the benchmark needs a graphics adapter");
@@ -486,6 +620,9 @@ fn main() {
     }
     if run("environment") {
         environment_costs(&gpu);
+    }
+    if run("volume") {
+        volume_costs(&gpu);
     }
     if run("growing") {
         growing_scenes(&gpu, quick);
