@@ -22,6 +22,7 @@
 //! warning: the rasterizer then shows a coarser field than the tracer.
 
 use std::collections::HashMap;
+use std::sync::Mutex;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, UVec3, Vec3};
@@ -82,7 +83,13 @@ pub struct VolumeGpu {
     uniform: UniformBuffer<GpuVolume>,
     /// The grid the texture holds (smaller than the scene's when it was resampled to fit).
     grid_on_gpu: Grid,
+    /// Group 3, kept while the depth copy and the reconstruction it was made for stay.
+    group: Mutex<Option<(GroupKey, wgpu::BindGroup)>>,
 }
+
+/// What a volume's group 3 depends on besides the volume: the depth copy (by its generation) and
+/// the sampler.
+type GroupKey = (u64, VolumeReconstruction);
 
 impl VolumeGpu {
     pub fn upload(device: &wgpu::Device, queue: &wgpu::Queue, volume: &Volume) -> VolumeGpu {
@@ -136,16 +143,16 @@ impl VolumeGpu {
             table: table.create_view(&Default::default()),
             uniform,
             grid_on_gpu: grid,
+            group: Mutex::new(None),
         }
     }
 
     fn uniform_of(&self, volume: &Volume, settings: &VolumeSettings) -> GpuVolume {
         let grid = &self.grid_on_gpu;
-        let normal = glam::Mat3::from_mat4(volume.world_from_local).inverse().transpose();
         GpuVolume {
             world_from_local: volume.world_from_local,
-            local_from_world: volume.world_from_local.inverse(),
-            normal_from_local: Mat4::from_mat3(normal),
+            local_from_world: volume.local_from_world(),
+            normal_from_local: Mat4::from_mat3(volume.normal_from_local()),
             half_extent: grid.half_extent(),
             voxel_length: grid.voxel_length(),
             spacing: grid.spacing,
@@ -194,8 +201,10 @@ pub struct VolumePass {
     pipelines: HashMap<PipelineKey, wgpu::RenderPipeline>,
     nearest: wgpu::Sampler,
     trilinear: wgpu::Sampler,
-    /// A copy of the frame's depth: where each ray meets the opaque surfaces.
+    /// A copy of the frame's depth: where each ray meets the opaque surfaces; and how many have
+    /// been made (the volumes' groups name the one they read).
     depth_copy: Option<GpuTexture>,
+    depth_copies: u64,
 }
 
 impl VolumePass {
@@ -239,6 +248,7 @@ impl VolumePass {
             nearest: sampler("volume::nearest", wgpu::FilterMode::Nearest),
             trilinear: sampler("volume::trilinear", wgpu::FilterMode::Linear),
             depth_copy: None,
+            depth_copies: 0,
         }
     }
 
@@ -312,7 +322,7 @@ impl VolumePass {
             .volumes
             .iter()
             .map(|volume| {
-                let isosurface = matches!(volume.rendering(settings), Rendering::Isosurface { .. });
+                let isosurface = volume.rendering(settings) == Rendering::Isosurface;
                 (frame, gradient, settings.shadows, isosurface)
             })
             .collect();
@@ -322,6 +332,7 @@ impl VolumePass {
         let size = targets.size;
         if self.depth_copy.as_ref().is_none_or(|d| (d.texture.width(), d.texture.height()) != size) {
             self.depth_copy = Some(depth_copy_target(device, size));
+            self.depth_copies += 1;
         }
         let depth_copy = self.depth_copy.as_ref().expect("made above");
         encoder.copy_texture_to_texture(
@@ -333,21 +344,30 @@ impl VolumePass {
             VolumeReconstruction::Nearest => &self.nearest,
             VolumeReconstruction::Trilinear => &self.trilinear,
         };
+        let group_key = (self.depth_copies, settings.reconstruction);
         let mut draws = Vec::new();
         for ((volume, gpu), key) in scene.volumes.iter().zip(&scene_gpu.volumes).zip(keys) {
             gpu.uniform.write(queue, &gpu.uniform_of(volume, settings));
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("volume::group"),
-                layout: &self.group_layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&depth_copy.view) },
-                    wgpu::BindGroupEntry { binding: 4, resource: gpu.uniform.binding() },
-                    wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&gpu.field) },
-                    wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(sampler) },
-                    wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&gpu.table) },
-                ],
-            });
-            draws.push((key, group, volume.material.0));
+            let mut group = gpu.group.lock().expect("no panics while the lock is held");
+            if group.as_ref().is_none_or(|(k, _)| *k != group_key) {
+                let made = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("volume::group"),
+                    layout: &self.group_layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::TextureView(&depth_copy.view),
+                        },
+                        wgpu::BindGroupEntry { binding: 4, resource: gpu.uniform.binding() },
+                        wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&gpu.field) },
+                        wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(sampler) },
+                        wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&gpu.table) },
+                    ],
+                });
+                *group = Some((group_key, made));
+            }
+            let (_, group) = group.as_ref().expect("made above");
+            draws.push((key, group.clone(), volume.material.0));
         }
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("volume::pass"),

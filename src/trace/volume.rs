@@ -76,18 +76,6 @@ impl Prepared<'_> {
             direction: self.local_from_world.transform_vector3(ray.direction),
         }
     }
-
-    /// The part of `[0, t_max]` where `ray` is inside the box.
-    fn segment(&self, ray: &LocalRay, t_max: f32) -> Option<(f32, f32)> {
-        let (near, far) = ray.box_interval(self.volume.grid.half_extent())?;
-        let (t0, t1) = (near.max(0.0), far.min(t_max));
-        (t0 < t1).then_some((t0, t1))
-    }
-
-    /// The world-space unit normal of a local gradient, `None` where it vanishes.
-    fn normal(&self, gradient: Vec3) -> Option<Vec3> {
-        world_normal(self.normal_from_local, gradient)
-    }
 }
 
 /// The heat colour of the samples view: black for none, through red and yellow, white at
@@ -121,7 +109,7 @@ impl Whitted<'_> {
                 continue;
             }
             let local = prepared.local_ray(ray);
-            if let Some(segment) = prepared.segment(&local, t_end) {
+            if let Some(segment) = prepared.volume.segment(&local, t_end) {
                 segments.push((prepared, local, segment));
             }
         }
@@ -160,17 +148,20 @@ impl Whitted<'_> {
     fn nearest_isosurface(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
         let mut nearest: Option<SurfaceHit> = None;
         for prepared in &self.volumes.volumes {
-            let Rendering::Isosurface { iso } = prepared.rendering else { continue };
+            if prepared.rendering != Rendering::Isosurface {
+                continue;
+            }
+            let iso = prepared.volume.iso;
             let limit = nearest.as_ref().map_or(t_max, |hit| hit.t);
             let local = prepared.local_ray(ray);
-            let Some(segment) = prepared.segment(&local, limit) else { continue };
+            let Some(segment) = prepared.volume.segment(&local, limit) else { continue };
             let grid = &prepared.volume.grid;
             let Some(t) = march::isosurface(grid, &local, segment, iso, &self.volumes.march) else { continue };
             let g = grid.grid_coordinates(local.at(t));
             let differences = self.volumes.march.gradient.unwrap_or(crate::volume::Differences::Central);
             let gradient = grid.gradient(g, self.volumes.march.reconstruction, differences);
             // Outward is where values fall; a vanishing gradient faces the ray.
-            let normal = prepared.normal(-gradient).unwrap_or(-ray.direction);
+            let normal = world_normal(prepared.normal_from_local, -gradient).unwrap_or(-ray.direction);
             nearest = Some(SurfaceHit {
                 t,
                 point: ray.at(t),

@@ -56,14 +56,12 @@ pub fn probe(scene: &Scene, settings: &RenderSettings, ray: &Ray, t_surface: f32
         .iter()
         .filter_map(|volume| {
             let local = volume.local_ray(ray);
-            let (near, far) = local.box_interval(volume.grid.half_extent())?;
-            let segment = (near.max(0.0), far.min(t_surface));
-            (segment.0 < segment.1).then_some((volume, local, segment))
+            volume.segment(&local, t_surface).map(|segment| (volume, local, segment))
         })
         .collect();
     let crossing = |(volume, local, segment): &(&Volume, LocalRay, (f32, f32))| {
-        let Rendering::Isosurface { iso } = volume.rendering(volume_settings) else { return None };
-        march::isosurface(&volume.grid, local, *segment, iso, &march)
+        let isosurface = volume.rendering(volume_settings) == Rendering::Isosurface;
+        isosurface.then(|| march::isosurface(&volume.grid, local, *segment, volume.iso, &march)).flatten()
     };
     // The nearest isosurface ends the composited segments, as in the tracer.
     let t_iso = crossed.iter().filter_map(crossing).fold(f32::INFINITY, f32::min);
@@ -71,7 +69,7 @@ pub fn probe(scene: &Scene, settings: &RenderSettings, ray: &Ray, t_surface: f32
         .into_iter()
         .map(|(volume, local, (t0, t1))| match volume.rendering(volume_settings) {
             Rendering::Composite => (volume, local, (t0, t1.min(t_iso))),
-            Rendering::Isosurface { .. } => (volume, local, (t0, t1)),
+            Rendering::Isosurface => (volume, local, (t0, t1)),
         })
         .filter(|(_, _, (t0, t1))| t0 < t1)
         .min_by(|a, b| a.2.0.total_cmp(&b.2.0))?;
@@ -91,8 +89,8 @@ fn march_volume(
     let (isosurface, march) = match volume.rendering(&settings.volume) {
         Rendering::Composite => (None, *march),
         // The values along the whole segment, with the crossing marked.
-        Rendering::Isosurface { iso } => (
-            Some((iso, march::isosurface(&volume.grid, local, segment, iso, march))),
+        Rendering::Isosurface => (
+            Some((volume.iso, march::isosurface(&volume.grid, local, segment, volume.iso, march))),
             March { termination: None, ..*march },
         ),
     };

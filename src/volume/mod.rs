@@ -39,12 +39,12 @@ use crate::settings::{VolumeGradient, VolumeMode, VolumeReconstruction, VolumeSe
 pub const WIREFRAME_CELLS: u32 = 32;
 
 /// How a volume is shown.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Rendering {
     /// Classified samples composited front to back.
     Composite,
-    /// The surface where the normalized field equals `iso`, shaded with the volume's material.
-    Isosurface { iso: f32 },
+    /// The surface where the normalized field equals the volume's `iso`, shaded with its material.
+    Isosurface,
 }
 
 /// A voxel grid in the scene.
@@ -60,8 +60,8 @@ pub struct Volume {
     /// The transfer function as the renderers read it.
     pub table: Table,
     pub rendering: Rendering,
-    /// The isosurface's iso value (normalized) whatever `rendering` says, so the settings can switch
-    /// a composited volume to its isosurface.
+    /// The isosurface's value (normalized), kept whatever `rendering` says, so the settings can
+    /// show a composited volume's isosurface.
     pub iso: f32,
     /// The isosurface's material.
     pub material: MaterialId,
@@ -74,7 +74,7 @@ impl Volume {
         match settings.mode {
             VolumeMode::Scene => self.rendering,
             VolumeMode::Composite => Rendering::Composite,
-            VolumeMode::Isosurface => Rendering::Isosurface { iso: self.iso },
+            VolumeMode::Isosurface => Rendering::Isosurface,
         }
     }
 
@@ -94,6 +94,13 @@ impl Volume {
             origin: local_from_world.transform_point3(ray.origin),
             direction: local_from_world.transform_vector3(ray.direction),
         }
+    }
+
+    /// The part of `[0, t_max]` where the local `ray` is inside the volume's box, if any.
+    pub fn segment(&self, ray: &LocalRay, t_max: f32) -> Option<(f32, f32)> {
+        let (near, far) = ray.box_interval(self.grid.half_extent())?;
+        let (t0, t1) = (near.max(0.0), far.min(t_max));
+        (t0 < t1).then_some((t0, t1))
     }
 
     /// The eight corners of the volume's box in world space.

@@ -136,7 +136,7 @@ impl Builder<'_> {
             transfer,
             table,
             rendering: match d.mode {
-                Some(ModeName::Isosurface) => Rendering::Isosurface { iso },
+                Some(ModeName::Isosurface) => Rendering::Isosurface,
                 Some(ModeName::Composite) | None => Rendering::Composite,
             },
             iso,
