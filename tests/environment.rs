@@ -9,6 +9,7 @@
 
 mod common;
 
+use common::flip;
 use glam::{Vec2, Vec3};
 use mirador::raster::Headless;
 use mirador::scene::environment::cube_direction;
@@ -49,10 +50,6 @@ fn ball(environment: &str, more: &str) -> Scene {
 
 const SKY: &str = "sky = { sun_direction = [0.3, 0.5, 0.8], sun_radius = 4 }";
 const LATLONG: &str = r#"latlong = "../environments/sky.hdr""#;
-
-fn flip(a: &image::RgbaImage, b: &image::RgbaImage) -> f32 {
-    mirador::compare::difference(a, b).unwrap().flip_mean
-}
 
 fn with_map(scene: &Scene, map: EnvironmentMap, dynamic: bool) -> RenderSettings {
     let mut settings = scene.settings.clone();

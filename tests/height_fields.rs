@@ -114,11 +114,11 @@ fn procedural_bumps_agree_between_the_renderers() {
         let scene = stage(field);
         let raster = common::raster(&scene, &scene.settings);
         let traced = mirador::trace::render_image(&scene, &scene.settings);
-        let flip = mirador::compare::difference(&traced, &raster).unwrap().flip_mean;
+        let flip = common::difference(&traced, &raster).flip_mean;
         assert!(flip < 0.01, "{name}: FLIP mean {flip}");
         let mut flat = scene.settings.clone();
         flat.bump.enabled = false;
-        let against_flat = mirador::compare::difference(&traced, &common::raster(&scene, &flat)).unwrap().flip_mean;
+        let against_flat = common::flip(&traced, &common::raster(&scene, &flat));
         assert!(
             against_flat > 3.0 * flip,
             "{name}: the bumps matter ({against_flat} against flat, {flip} against bumped)"
@@ -140,7 +140,7 @@ fn finite_differences_draw_what_the_analytic_gradient_draws() {
                 mirador::trace::render_image(&scene, &analytic),
             ),
         ] {
-            let flip = mirador::compare::difference(&a, &b).unwrap().flip_mean;
+            let flip = common::difference(&a, &b).flip_mean;
             assert!(flip < 0.003, "{name}, {renderer}: finite differences against analytic, FLIP {flip}");
         }
     }

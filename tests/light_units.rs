@@ -196,7 +196,7 @@ fn against_blender(name: &str) -> [(f32, f32); 2] {
     let dir = std::env::temp_dir();
     let measure = |image: &image::RgbaImage, what: &str| {
         let _ = image.save(dir.join(format!("mirador-blender-{name}-{what}.png")));
-        let flip = mirador::compare::difference(&reference, image).expect("same sizes").flip_mean;
+        let flip = common::difference(&reference, image).flip_mean;
         (flip, mean_linear(image) / mean_linear(&reference))
     };
     [measure(&raster, "raster"), measure(&traced, "traced")]

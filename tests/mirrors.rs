@@ -6,6 +6,7 @@
 
 mod common;
 
+use common::flip;
 use mirador::settings::{MirrorView, TransparencySort};
 use mirador::{RenderSettings, Scene};
 
@@ -13,10 +14,6 @@ fn scene() -> Scene {
     let mut scene = common::load("scenes/mirrors.toml");
     (scene.camera.width, scene.camera.height) = (240, 150);
     scene
-}
-
-fn flip(a: &image::RgbaImage, b: &image::RgbaImage) -> f32 {
-    mirador::compare::difference(a, b).unwrap().flip_mean
 }
 
 /// Raster with `mirrors.depth = depth` against the tracer with `max_depth = depth`.

@@ -621,7 +621,7 @@ fn assert_renderers_agree(path: &Path, name: &str, tolerance: common::Tolerance)
     camera.near = 0.25 * camera.eye.distance(camera.center);
     let raster = common::raster(&scene, &scene.settings);
     let traced = mirador::trace::render_image(&scene, &scene.settings);
-    let difference = mirador::compare::difference(&traced, &raster).unwrap();
+    let difference = common::difference(&traced, &raster);
     let dir = temp_dir(name);
     raster.save(dir.join(format!("{name}-raster.png"))).unwrap();
     traced.save(dir.join(format!("{name}-traced.png"))).unwrap();

@@ -21,7 +21,7 @@ fn scene(text: &str) -> Scene {
 fn parity(scene: &Scene, settings: &RenderSettings) -> (image::RgbaImage, image::RgbaImage, f32) {
     let raster = common::raster(scene, settings);
     let traced = mirador::trace::render_image(scene, settings);
-    let flip = mirador::compare::difference(&traced, &raster).unwrap().flip_mean;
+    let flip = common::difference(&traced, &raster).flip_mean;
     (raster, traced, flip)
 }
 

@@ -5,6 +5,7 @@
 
 mod common;
 
+use common::flip;
 use std::path::Path;
 
 use glam::Vec3;
@@ -35,10 +36,6 @@ fn linear(c: u8) -> f32 {
 fn linear_pixel(image: &image::RgbaImage, x: u32, y: u32) -> Vec3 {
     let p = image.get_pixel(x, y);
     Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))
-}
-
-fn flip(a: &image::RgbaImage, b: &image::RgbaImage) -> f32 {
-    mirador::compare::difference(a, b).unwrap().flip_mean
 }
 
 /// A pane facing the camera: emission only (no lights), so `Im = ME` exactly.

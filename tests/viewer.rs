@@ -87,7 +87,7 @@ fn showcase(w: u32, h: u32) -> Scene {
 }
 
 fn flip(reference: &image::RgbaImage, test: &image::RgbaImage, what: &str, dir: &Path) -> f32 {
-    let d = mirador::compare::difference(reference, test).unwrap_or_else(|e| panic!("{what}: {e}"));
+    let d = common::difference(reference, test);
     if d.flip_mean > MAX_FLIP_MEAN {
         let _ = reference.save(dir.join(format!("{what}-expected.png")));
         let _ = test.save(dir.join(format!("{what}-actual.png")));

@@ -7,14 +7,11 @@
 
 mod common;
 
+use common::flip;
 use glam::{UVec3, Vec3};
 use mirador::settings::{VolumeMode, VolumeView};
 use mirador::volume::{Grid, Reconstruction, fields};
 use mirador::{RenderSettings, Scene};
-
-fn flip(a: &image::RgbaImage, b: &image::RgbaImage) -> f32 {
-    mirador::compare::difference(a, b).unwrap().flip_mean
-}
 
 fn stage() -> Scene {
     let mut scene = common::load("scenes/volume.toml");
@@ -31,6 +28,10 @@ fn parity(scene: &Scene, settings: &RenderSettings) -> f32 {
     flip(&traced(scene, settings), &common::raster(scene, settings))
 }
 
+/// The bound of the composited parity test, measured: 0.0039 on the machines the goldens come
+/// from, 0.0041 with another CPU's images (below).
+const COMPOSITE_PARITY: f32 = 0.01;
+
 #[test]
 fn composited_volumes_agree_with_the_tracer() {
     let scene = stage();
@@ -38,13 +39,27 @@ fn composited_volumes_agree_with_the_tracer() {
     settings.volume.mode = VolumeMode::Composite;
     let error = parity(&scene, &settings);
     eprintln!("composite raster vs traced: FLIP {error:.5}");
-    assert!(error < 0.01, "composite raster vs traced: FLIP {error}");
+    assert!(error < COMPOSITE_PARITY, "composite raster vs traced: FLIP {error}");
     // The comparison can tell: a raster without gradient shading is far from the shaded tracer.
     let mut unshaded = settings.clone();
     unshaded.set("volume.gradient=\"off\"").unwrap();
     let off = flip(&traced(&scene, &settings), &common::raster(&scene, &unshaded));
     eprintln!("unshaded raster vs shaded traced: FLIP {off:.5}");
     assert!(off > 2.0 * error + 0.005, "unshaded raster {off} vs shaded {error}");
+}
+
+/// The same comparison holds on images another CPU made (`tests/data/cross-cpu/README.md`): its
+/// raster floor is one level darker in red than its traced one, 38 % of the image, which FLIP
+/// alone counts as 0.0154.
+#[test]
+fn composited_parity_holds_for_another_cpus_images() {
+    let image = |name: &str| common::data_image(&format!("cross-cpu/{name}"));
+    let (raster, traced) = (image("composite-raster-avx512.png"), image("composite-traced-avx512.png"));
+    let plain = mirador::compare::difference(&traced, &raster).unwrap().flip_mean;
+    let error = flip(&traced, &raster);
+    eprintln!("another CPU's composite: FLIP {plain:.5}, beyond {} levels {error:.5}", common::CPU_LEVELS);
+    assert!(plain > COMPOSITE_PARITY, "the images show the rounding this test is about: {plain}");
+    assert!(error < COMPOSITE_PARITY, "another CPU's composite raster vs traced: FLIP {error}");
 }
 
 #[test]

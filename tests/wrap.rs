@@ -67,7 +67,7 @@ fn wrap_modes_agree_between_the_renderers() {
         let scene = parse(&text, Path::new("wrap.toml")).unwrap_or_else(|e| panic!("{e}"));
         let raster = common::raster(&scene, &scene.settings);
         let traced = mirador::trace::render_image(&scene, &scene.settings);
-        let difference = mirador::compare::difference(&traced, &raster).unwrap();
+        let difference = common::difference(&traced, &raster);
         assert!(
             difference.psnr_db > 45.0 && difference.flip_mean < 0.03,
             "wrap {wrap}: PSNR {} dB, FLIP {}",
@@ -79,7 +79,7 @@ fn wrap_modes_agree_between_the_renderers() {
     // Every mode draws a different image.
     for a in 0..images.len() {
         for b in a + 1..images.len() {
-            let flip = mirador::compare::difference(&images[a], &images[b]).unwrap().flip_mean;
+            let flip = common::difference(&images[a], &images[b]).flip_mean;
             assert!(flip > 0.02, "modes {a} and {b} look alike ({flip})");
         }
     }
