@@ -107,7 +107,10 @@ fn the_background_is_what_the_tracers_missed_rays_see() {
 fn largest_difference(scene: &Scene) -> u8 {
     let raster = common::raster(scene, &scene.settings);
     let traced = mirador::trace::render_image(scene, &scene.settings);
-    raster.pixels().zip(traced.pixels()).flat_map(|(a, b)| (0..3).map(move |c| a[c].abs_diff(b[c]))).max().unwrap()
+    let largest =
+        raster.pixels().zip(traced.pixels()).flat_map(|(a, b)| (0..3).map(move |c| a[c].abs_diff(b[c]))).max().unwrap();
+    eprintln!("largest difference raster vs traced: {largest}/255");
+    largest
 }
 
 /// sRGB encoding of linear radiance, clamped, as the present pass writes it at exposure 1.
