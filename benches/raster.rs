@@ -29,7 +29,7 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use mirador::gpu::Gpu;
 use mirador::gpu::texture::GpuTexture;
-use mirador::raster::{FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer, drawn_size};
+use mirador::raster::{Figure, FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer, drawn_size};
 use mirador::scene::sphereflake::{sphere_count, sphereflake_toml};
 use mirador::scene::{Attenuation, Light, LightKind, Mesh, Object, Shape};
 use mirador::settings::{EnvironmentMap, Prepass, ShadowFit, SphereView, TransparencySort, VolumeGradient};
@@ -48,29 +48,26 @@ fn ms(d: Duration) -> f64 {
     d.as_secs_f64() * 1e3
 }
 
-/// A renderer with `scene` uploaded, ready to draw frames.
+/// A renderer with `scene` loaded, ready to draw frames.
 struct Bench<'g> {
     gpu: &'g Gpu,
     renderer: Renderer,
-    scene_gpu: mirador::raster::scene_gpu::SceneGpu,
     targets: FrameTargets,
     output: GpuTexture,
 }
 
 impl<'g> Bench<'g> {
     fn new(gpu: &'g Gpu, scene: &Scene) -> Bench<'g> {
-        let renderer = Renderer::new(&gpu.device, OUTPUT_FORMAT);
-        let scene_gpu = renderer.upload(gpu, scene);
+        let renderer = Renderer::new(gpu, scene, OUTPUT_FORMAT);
         let size = (scene.camera.width, scene.camera.height);
-        let targets = renderer.targets(&gpu.device, drawn_size(size, scene.settings.raster.render_scale));
+        let targets = FrameTargets::new(&gpu.device, drawn_size(size, scene.settings.raster.render_scale));
         let output = GpuTexture::target(&gpu.device, "bench::output", size, OUTPUT_FORMAT);
-        Bench { gpu, renderer, scene_gpu, targets, output }
+        Bench { gpu, renderer, targets, output }
     }
 
     fn frame(&mut self, scene: &Scene, settings: &RenderSettings) -> (Duration, FrameReport) {
         let start = Instant::now();
-        let report =
-            self.renderer.render(self.gpu, scene, &mut self.scene_gpu, settings, &mut self.targets, &self.output.view);
+        let report = self.renderer.render(self.gpu, scene, settings, &mut self.targets, &self.output.view);
         self.gpu.wait();
         (start.elapsed(), report)
     }
@@ -145,7 +142,7 @@ fn showcase_breakdown(gpu: &Gpu) {
             moving.camera.eye = glam::Quat::from_rotation_y(angle) * scene.camera.eye;
             let (t, report) = bench.frame(&moving, &settings);
             times.push(t);
-            redrawn += report.shadow_layers_drawn;
+            redrawn += report.count("shadow maps", "layers drawn");
         }
         let t = median(times);
         row(&format!("all on, camera orbiting, fit {fit:?} ({redrawn} layers redrawn)"), t);
@@ -288,10 +285,10 @@ fn transparency_costs(gpu: &Gpu) {
     let mut bench = Bench::new(gpu, &scene);
     let floor = bench.median_frame(&scene, &opaque);
     bench.frame(&scene, &base);
-    let transparent = bench.scene_gpu.geometry.transparent_triangles();
+    let transparent = bench.renderer.scene_gpu().geometry.transparent_triangles();
     println!(
         "\ntransparency, 1280×720, {transparent} transparent triangles in {} objects, ratios to drawing them opaque",
-        bench.scene_gpu.geometry.transparent.len()
+        bench.renderer.scene_gpu().geometry.transparent.len()
     );
     let row = |name: &str, t: Duration| {
         println!("{name:>44} {:>9.1} ms {:>7.2}×", ms(t), t.as_secs_f64() / floor.as_secs_f64())
@@ -313,9 +310,13 @@ fn transparency_costs(gpu: &Gpu) {
     for step in 0..FRAMES + 2 {
         moving.camera.eye = glam::Quat::from_rotation_y(0.01 * (step + 1) as f32) * scene.camera.eye;
         let (t, report) = bench.frame(&moving, &settings);
-        assert!(report.transparency.sorted, "a moved camera re-sorts");
+        assert!(report.flag("transparency sort", "sorted"), "a moved camera re-sorts");
         times.push(t);
-        sorts.push(report.transparency.sort_time);
+        let sort_time = match report.figure("transparency sort", "sort time") {
+            Some(Figure::Time(time)) => time,
+            _ => Duration::ZERO,
+        };
+        sorts.push(sort_time);
     }
     let sort = median(sorts.split_off(2));
     row("per triangle, moving camera (re-sorted)", median(times.split_off(2)));
@@ -365,7 +366,7 @@ fn mirror_costs(gpu: &Gpu) {
     for round in 0..FRAMES + 2 {
         for (k, (_, scene, settings)) in cases.iter().enumerate() {
             let (t, report) = benches[k].frame(scene, settings);
-            views[k] = report.mirror_views;
+            views[k] = report.count("mirror views", "views");
             if round >= 2 {
                 times[k].push(t);
             }
@@ -377,7 +378,7 @@ fn mirror_costs(gpu: &Gpu) {
     for (k, (name, ..)) in cases.iter().enumerate() {
         let t = medians[k].as_secs_f64();
         let each = if views[k] > 0 {
-            format!("   {} views, {:.2}× a plain frame each", views[k], (t - plain) / plain / f64::from(views[k]))
+            format!("   {} views, {:.2}× a plain frame each", views[k], (t - plain) / plain / views[k] as f64)
         } else {
             String::new()
         };
@@ -423,7 +424,7 @@ fn environment_costs(gpu: &Gpu) {
     // Interleaved rounds, as for the mirrors: the VM's speed drifts over seconds.
     let mut benches: Vec<Bench> = cases.iter().map(|_| Bench::new(gpu, &scene)).collect();
     let mut times = vec![Vec::new(); cases.len()];
-    let mut faces = vec![0; cases.len()];
+    let mut faces = vec![0u64; cases.len()];
     let mut spheres = vec![0; cases.len()];
     for round in 0..FRAMES + 2 {
         let mut turned = scene.clone();
@@ -432,8 +433,8 @@ fn environment_costs(gpu: &Gpu) {
             let (t, report) = benches[k].frame(if case.turning { &turned } else { &scene }, &case.settings);
             if round >= 2 {
                 times[k].push(t);
-                faces[k] += report.environment_faces;
-                spheres[k] += u32::from(report.sphere_map_made);
+                faces[k] += report.count("environment cubes", "faces");
+                spheres[k] += u32::from(report.flag("environment maps", "sphere map made"));
             }
         }
     }
@@ -453,7 +454,7 @@ fn environment_costs(gpu: &Gpu) {
     }
     let name = |n: &str| cases.iter().position(|c| c.name == n).expect("a case of that name");
     let capture = medians[name("dynamic cubes, drawn every frame")] - medians[name("dynamic cubes, kept")];
-    let objects = f64::from(faces[name("dynamic cubes, drawn every frame")]) / FRAMES as f64 / 6.0;
+    let objects = faces[name("dynamic cubes, drawn every frame")] as f64 / FRAMES as f64 / 6.0;
     println!(
         "{:>48} {:>9.1} ms {:>7.2}× a plain frame",
         "one capture (six views of one object)",
@@ -529,7 +530,7 @@ fn volume_costs(gpu: &Gpu) {
     for _ in 0..VOLUME_ROUNDS {
         for (k, settings) in cases.iter().enumerate() {
             let (_, report) = bench.frame(&scene, settings);
-            let pass = report.passes.iter().find(|(name, _)| *name == "volumes").expect("the volume pass ran").1;
+            let pass = report.time("volumes").expect("the volume pass ran, profiled");
             gpu_times[k].push(pass);
             // The tracer is quick: three traces a round make its median as steady as the GPU's.
             for _ in 0..3 {

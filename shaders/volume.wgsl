@@ -15,6 +15,11 @@
 
 override VOLUME_GRADIENT: u32 = 2u;
 override VOLUME_SHADOWS: bool = false;
+// Rays end at the nearer of the opaque surface and `peeled_depth` (a transparent layer peeled
+// before: the volume lies behind it), and start at `near_depth` (the layer being peeled: the
+// volume lies behind it, between the two). src/raster/transparency.rs says when.
+override VOLUME_FAR_LIMIT: bool = false;
+override VOLUME_NEAR_LIMIT: bool = false;
 
 const VOLUME_GRADIENT_OFF: u32 = 0u;
 const VOLUME_GRADIENT_FORWARD: u32 = 1u;
@@ -47,7 +52,9 @@ struct Volume {
     samples_white: f32,
 }
 
-// Group 3 binding 0 is transparency.wgsl's `opaque_depth`: here a copy of the frame's depth.
+// Group 3 bindings 0 and 1 are transparency.wgsl's `opaque_depth` (the view's depth: a copy of
+// it for isosurfaces, which write depth) and `peeled_depth`.
+@group(3) @binding(3) var near_depth: texture_depth_2d;
 @group(3) @binding(4) var<uniform> volume: Volume;
 @group(3) @binding(5) var volume_texture: texture_3d<f32>;
 @group(3) @binding(6) var volume_sampler: sampler;
@@ -84,8 +91,9 @@ struct VolumeRay {
     t1: f32,
 }
 
-// The camera ray through the pixel centre `pixel`, clipped to the box and to the opaque surface.
-// `valid` is false where nothing of the box is in front of the surface.
+// The camera ray through the pixel centre `pixel`, clipped to the box, to the opaque surface, to
+// the transparent layers that bound this part of it, and to the view's clip plane (a mirrored
+// camera sees only what lies beyond its mirror). `t0 >= t1` where nothing of the box is left.
 fn volume_ray(pixel: vec2f) -> VolumeRay {
     let size = vec2f(textureDimensions(opaque_depth));
     let ndc = vec2f(2.0 * pixel.x / size.x - 1.0, 1.0 - 2.0 * pixel.y / size.y);
@@ -99,11 +107,27 @@ fn volume_ray(pixel: vec2f) -> VolumeRay {
         ray.origin = view.eye;
         ray.direction = normalize(far.xyz / far.w - view.eye);
     }
-    var t_surface = 3.4e38;
-    let depth = textureLoad(opaque_depth, vec2i(pixel), 0);
-    if depth < 1.0 {
-        let p = view.world_from_clip * vec4f(ndc, depth, 1.0);
-        t_surface = dot(p.xyz / p.w - ray.origin, ray.direction);
+    var t_end = depth_distance(ray, ndc, textureLoad(opaque_depth, vec2i(pixel), 0));
+    var t_start = 0.0;
+    if VOLUME_FAR_LIMIT {
+        t_end = min(t_end, depth_distance(ray, ndc, textureLoad(peeled_depth, vec2i(pixel), 0)));
+    }
+    if VOLUME_NEAR_LIMIT {
+        // No layer here (the peel is cleared to 0): nothing in front bounds the ray.
+        let depth = textureLoad(near_depth, vec2i(pixel), 0);
+        if depth > 0.0 {
+            t_start = depth_distance(ray, ndc, depth);
+        }
+    }
+    let plane = view.clip_plane;
+    if any(plane != vec4f(0.0)) {
+        let distance = dot(plane.xyz, ray.origin) + plane.w;
+        let rate = dot(plane.xyz, ray.direction);
+        if distance < 0.0 {
+            t_start = max(t_start, select(3.4e38, -distance / rate, rate > 0.0));
+        } else if rate < 0.0 {
+            t_end = min(t_end, -distance / rate);
+        }
     }
     ray.local_origin = (volume.local_from_world * vec4f(ray.origin, 1.0)).xyz;
     ray.local_direction = (volume.local_from_world * vec4f(ray.direction, 0.0)).xyz;
@@ -112,9 +136,19 @@ fn volume_ray(pixel: vec2f) -> VolumeRay {
     let b = (volume.half_extent - ray.local_origin) * inverse;
     let near = max(max(min(a.x, b.x), min(a.y, b.y)), min(a.z, b.z));
     let far_t = min(min(max(a.x, b.x), max(a.y, b.y)), max(a.z, b.z));
-    ray.t0 = max(near, 0.0);
-    ray.t1 = min(far_t, t_surface);
+    ray.t0 = max(near, t_start);
+    ray.t1 = min(far_t, t_end);
     return ray;
+}
+
+// The distance along `ray` to the point of the pixel at `ndc` with depth `depth`; beyond every
+// volume where the depth is the far plane's (nothing was drawn there).
+fn depth_distance(ray: VolumeRay, ndc: vec2f, depth: f32) -> f32 {
+    if depth >= 1.0 {
+        return 3.4e38;
+    }
+    let p = view.world_from_clip * vec4f(ndc, depth, 1.0);
+    return dot(p.xyz / p.w - ray.origin, ray.direction);
 }
 
 // Grid coordinates of a local point, clamped to the grid, as texture coordinates.

@@ -12,7 +12,7 @@ use mirador::compare::sheet::{Panel, flip_legend, sheet, with_footer};
 use mirador::gpu::texture::GpuTexture;
 use mirador::gpu::{Gpu, Stopwatch, readback};
 use mirador::linear_output::LinearImage;
-use mirador::raster::{FrameReport, OUTPUT_FORMAT, Renderer, drawn_size};
+use mirador::raster::{FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer, drawn_size};
 use mirador::settings::AntiAliasing;
 use mirador::trace::accel::AccelKind;
 use mirador::trace::{RadianceImage, RenderControl, Tracer};
@@ -313,18 +313,17 @@ fn rasterize(
     let size = (scene.camera.width, scene.camera.height);
     gpu.check_image_size(size)?;
     let (pixels, radiance) = gpu.checked(|| {
-        let mut renderer = clock.time("pipelines", || Renderer::new(&gpu.device, OUTPUT_FORMAT));
-        let (mut scene_gpu, mut targets, output) = clock.time("upload", || {
-            let scene_gpu = renderer.upload(&gpu, scene);
-            let targets = renderer.targets(&gpu.device, drawn_size(size, scene.settings.raster.render_scale));
+        let (mut renderer, mut targets, output) = clock.time("pipelines and upload", || {
+            let renderer = Renderer::new(&gpu, scene, OUTPUT_FORMAT);
+            let targets = FrameTargets::new(&gpu.device, drawn_size(size, scene.settings.raster.render_scale));
             let output = GpuTexture::target(&gpu.device, "cli::output", size, OUTPUT_FORMAT);
             gpu.wait();
-            (scene_gpu, targets, output)
+            (renderer, targets, output)
         });
         // The first frame also pays for the driver's lazy pipeline compilation and fills the
         // caches (shadow maps, tessellations); the second is what an interactive frame costs.
         let mut frame = |renderer: &mut Renderer| {
-            let report = renderer.render(&gpu, scene, &mut scene_gpu, &scene.settings, &mut targets, &output.view);
+            let report = renderer.render(&gpu, scene, &scene.settings, &mut targets, &output.view);
             gpu.wait();
             report
         };
@@ -334,7 +333,8 @@ fn rasterize(
             renderer.profile = true;
             renderer.invalidate_shadows();
             let profiled = frame(&mut renderer);
-            print_frame_stats(&first, &second, &profiled, scene_gpu.geometry.mesh_count(), renderer.shader_variants());
+            let meshes = renderer.scene_gpu().geometry.mesh_count();
+            print_frame_stats(&first, &second, &profiled, meshes, renderer.shader_variants());
         }
         clock.time("readback", || {
             let pixels = readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture)?;
@@ -378,26 +378,22 @@ fn print_frame_stats(
         "raster: {} triangles per view in {meshes} meshes, {variants} shader variants, drawn at {}×{}",
         first.triangles, first.drawn_size.0, first.drawn_size.1
     );
-    println!(
-        "shadow layers drawn: {} in the first frame, {} in the second (kept across frames)",
-        first.shadow_layers_drawn, second.shadow_layers_drawn
-    );
-    let t = &first.transparency;
-    if t.draws > 0 {
-        println!(
-            "transparency: {} draws{}{}",
-            t.draws,
-            if t.layers > 0 { format!(", {} peeled layers", t.layers) } else { String::new() },
-            if t.sorted {
-                format!(", triangles sorted in {:.3} ms", t.sort_time.as_secs_f64() * 1e3)
-            } else {
-                String::new()
-            },
-        );
+    println!("what each pass did, in the first frame | the second (what it kept):");
+    for pass in first.passes.iter().filter(|p| !p.figures.is_empty()) {
+        let figures: Vec<String> = pass
+            .figures
+            .iter()
+            .map(|(name, value)| match second.figure(pass.name, name) {
+                Some(again) => format!("{name} {value} | {again}"),
+                None => format!("{name} {value}"),
+            })
+            .collect();
+        println!("{:>20}: {}", pass.name, figures.join(", "));
     }
     println!("passes (each submitted and waited for on its own, shadow maps redrawn):");
-    for (name, time) in &profiled.passes {
-        println!("{name:>20}: {:9.3} ms", time.as_secs_f64() * 1e3);
+    for pass in &profiled.passes {
+        let time = pass.time.unwrap_or_default();
+        println!("{:>20}: {:9.3} ms", pass.name, time.as_secs_f64() * 1e3);
     }
 }
 

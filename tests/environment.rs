@@ -174,9 +174,13 @@ fn a_sphere_map_belongs_to_the_view_it_was_made_for() {
         settings.environment.sphere_view = sphere_view;
         let mut headless = Headless::new(gpu, &scene);
         headless.render(gpu, &scene, &settings);
-        assert!(headless.report.sphere_map_made, "the first frame makes the map");
+        assert!(headless.report.flag("environment maps", "sphere map made"), "the first frame makes the map");
         let raster = headless.render(gpu, &turned, &settings);
-        assert_eq!(headless.report.sphere_map_made, !wrong, "{sphere_view:?}: made again for the new view");
+        assert_eq!(
+            headless.report.flag("environment maps", "sphere map made"),
+            !wrong,
+            "{sphere_view:?}: made again for the new view"
+        );
         let error = flip(&mirador::trace::render_image(&turned, &settings), &raster);
         if wrong {
             assert!(error > 0.06, "a fixed sphere map seen from another view: FLIP {error}");
@@ -242,7 +246,7 @@ fn dynamic_cubes_are_drawn_again_only_when_what_they_see_changes_or_when_due() {
     let mut headless = Headless::new(gpu, &scene);
     let mut faces = |scene: &Scene, settings: &RenderSettings| {
         headless.render(gpu, scene, settings);
-        headless.report.environment_faces
+        headless.report.count("environment cubes", "faces")
     };
     assert_eq!(faces(&scene, &settings), 6, "the first frame draws the ball's six faces");
     assert_eq!(faces(&scene, &settings), 0, "nothing changed");
@@ -258,7 +262,7 @@ fn dynamic_cubes_are_drawn_again_only_when_what_they_see_changes_or_when_due() {
     assert_eq!(faces(&scene, &settings), 6, "a new light");
     let mut every_other = settings.clone();
     every_other.environment.refresh = 2;
-    let drawn: Vec<u32> = (0..5).map(|_| faces(&scene, &every_other)).collect();
+    let drawn: Vec<u64> = (0..5).map(|_| faces(&scene, &every_other)).collect();
     assert_eq!(drawn, [6, 0, 6, 0, 6], "the settings changed, then every second frame");
 }
 

@@ -6,7 +6,7 @@
 
 use std::mem::{offset_of, size_of};
 
-use mirador::raster::scene_pass::{self, CONSTANT_NAMES, SHADOW_FILTER_NAMES, shadow_filter_code};
+use mirador::raster::keys::{self, CONSTANT_NAMES, SHADOW_FILTER_NAMES, shadow_filter_code};
 use mirador::raster::shadow::views::MAX_LAYERS;
 use mirador::raster::shadow::{GpuShadowLayer, GpuShadows};
 use mirador::raster::uniforms::{
@@ -223,15 +223,15 @@ fn codes_shared_by_rust_and_wgsl_agree() {
         ("TERM_DIFFUSE", uniforms::TERM_DIFFUSE.into()),
         ("TERM_SPECULAR", uniforms::TERM_SPECULAR.into()),
         ("TERM_EMISSION", uniforms::TERM_EMISSION.into()),
-        ("SHADOWS_OFF", scene_pass::SHADOWS_OFF.into()),
-        ("SHADOWS_MAP", scene_pass::SHADOWS_MAP.into()),
-        ("SHADOWS_PROJECTED", scene_pass::SHADOWS_PROJECTED.into()),
-        ("BUMP_VIEW_NORMALS", scene_pass::BUMP_VIEW_NORMALS.into()),
-        ("BUMP_VIEW_TANGENTS", scene_pass::BUMP_VIEW_TANGENTS.into()),
-        ("HEIGHT_NONE", scene_pass::HEIGHT_NONE.into()),
-        ("HEIGHT_TEXTURE", scene_pass::HEIGHT_TEXTURE.into()),
-        ("HEIGHT_SINE", scene_pass::HEIGHT_SINE.into()),
-        ("HEIGHT_NOISE", scene_pass::HEIGHT_NOISE.into()),
+        ("SHADOWS_OFF", keys::SHADOWS_OFF.into()),
+        ("SHADOWS_MAP", keys::SHADOWS_MAP.into()),
+        ("SHADOWS_PROJECTED", keys::SHADOWS_PROJECTED.into()),
+        ("BUMP_VIEW_NORMALS", keys::BUMP_VIEW_NORMALS.into()),
+        ("BUMP_VIEW_TANGENTS", keys::BUMP_VIEW_TANGENTS.into()),
+        ("HEIGHT_NONE", keys::HEIGHT_NONE.into()),
+        ("HEIGHT_TEXTURE", keys::HEIGHT_TEXTURE.into()),
+        ("HEIGHT_SINE", keys::HEIGHT_SINE.into()),
+        ("HEIGHT_NOISE", keys::HEIGHT_NOISE.into()),
         ("ALPHA_OPAQUE", uniforms::ALPHA_OPAQUE.into()),
         ("ALPHA_MASK", uniforms::ALPHA_MASK.into()),
         ("ALPHA_BLEND", uniforms::ALPHA_BLEND.into()),
@@ -242,10 +242,10 @@ fn codes_shared_by_rust_and_wgsl_agree() {
         ("ENV_LATLONG", uniforms::ENV_LATLONG.into()),
         ("ENV_CUBE", uniforms::ENV_CUBE.into()),
         ("ENV_SPHERE", uniforms::ENV_SPHERE.into()),
-        ("ENV_MAP_CUBE", scene_pass::ENV_MAP_CUBE.into()),
-        ("ENV_MAP_SPHERE", scene_pass::ENV_MAP_SPHERE.into()),
-        ("ENV_MAP_LATLONG", scene_pass::ENV_MAP_LATLONG.into()),
-        ("ENV_MAP_DYNAMIC", scene_pass::ENV_MAP_DYNAMIC.into()),
+        ("ENV_MAP_CUBE", keys::ENV_MAP_CUBE.into()),
+        ("ENV_MAP_SPHERE", keys::ENV_MAP_SPHERE.into()),
+        ("ENV_MAP_LATLONG", keys::ENV_MAP_LATLONG.into()),
+        ("ENV_MAP_DYNAMIC", keys::ENV_MAP_DYNAMIC.into()),
         ("MIP_PALETTE_LAST", (mirador::texture::mipmap::LEVEL_PALETTE.len() - 1) as f64),
     ];
     for (name, rust) in codes {

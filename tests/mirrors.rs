@@ -114,7 +114,7 @@ fn degenerate_mirrors_are_drawn_plain_and_never_panic() {
     edge_on.camera.center = glam::Vec3::new(0.0, 1.0, -0.5);
     let mut headless = mirador::raster::Headless::new(gpu, &edge_on);
     headless.render(gpu, &edge_on, &edge_on.settings);
-    assert!(headless.report.mirror_views >= 1, "the right mirror still reflects");
+    assert!(headless.report.count("mirror views", "views") >= 1, "the right mirror still reflects");
     // The camera behind the left mirror, where its backing hides it: the mirror's view is
     // still planned (about the plane turned towards the camera: planes are two-sided mirrors in
     // both renderers), and the depth test hides it behind the backing, as in the tracer.
@@ -150,7 +150,11 @@ fn each_face_of_a_mirror_box_is_a_planar_mirror() {
     settings.trace.max_depth = 1;
     let raster = headless.render(gpu, &scene, &settings);
     // The left mirror, and the cube's faces that face the camera (a top too, seen from above).
-    assert!(headless.report.mirror_views >= 3, "{} mirrored views", headless.report.mirror_views);
+    assert!(
+        headless.report.count("mirror views", "views") >= 3,
+        "{} mirrored views",
+        headless.report.count("mirror views", "views")
+    );
     let traced = mirador::trace::render_image(&scene, &settings);
     let error = flip(&traced, &raster);
     assert!(error < 0.04, "the mirror cube vs traced: FLIP {error}");

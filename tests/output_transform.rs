@@ -7,6 +7,7 @@ mod common;
 use glam::Vec3;
 use mirador::gpu::{readback, texture::GpuTexture};
 use mirador::output::OutputTransform;
+use mirador::raster::context::FrameEncoder;
 use mirador::raster::present::PresentPass;
 use mirador::raster::{HDR_FORMAT, OUTPUT_FORMAT};
 use mirador::settings::ToneMap;
@@ -71,14 +72,13 @@ fn gpu_present_pass_matches_the_rust_transform() {
     );
     let hdr_view = hdr.create_view(&Default::default());
     let output = GpuTexture::target(&gpu.device, "output_transform::output", (width, height), OUTPUT_FORMAT);
-    let present = PresentPass::new(&gpu.device, OUTPUT_FORMAT);
-    let input = present.bind(&gpu.device, &hdr_view);
+    let mut present = PresentPass::new(&gpu.device, OUTPUT_FORMAT);
     let curves = [ToneMap::Clamp, ToneMap::Reinhard, ToneMap::Aces, ToneMap::PbrNeutral];
     for (exposure, tone_map) in [1.0, 2.0].into_iter().flat_map(|e| curves.map(|c| (e, c))) {
         let transform = OutputTransform { exposure, tone_map };
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        present.record(&gpu.queue, &mut encoder, &input, &output.view, transform);
-        gpu.queue.submit([encoder.finish()]);
+        let mut frame = FrameEncoder::new(gpu, false);
+        present.record(gpu, &mut frame, &hdr_view, &output.view, transform);
+        frame.finish();
         let bytes = readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture).expect("reading the output back");
         let cpu = mirador::output::encode_image(width, height, &exact, transform);
         let worst = bytes.iter().zip(cpu.as_raw()).map(|(&g, &c)| g.abs_diff(c)).max().unwrap();

@@ -25,23 +25,31 @@ fn a_camera_move_redraws_no_shadow_map_and_a_light_move_redraws_its_own() {
     let gpu = common::gpu();
     let mut headless = Headless::new(gpu, &scene);
     headless.render(gpu, &scene, &settings);
-    assert_eq!(headless.report.shadow_layers_drawn, 7, "first frame: six cube faces and one directional layer");
+    assert_eq!(
+        headless.report.count("shadow maps", "layers drawn"),
+        7,
+        "first frame: six cube faces and one directional layer"
+    );
 
     scene.camera.eye = Quat::from_rotation_y(0.02) * scene.camera.eye;
     headless.render(gpu, &scene, &settings);
-    assert_eq!(headless.report.shadow_layers_drawn, 0, "a camera move keeps every layer");
+    assert_eq!(headless.report.count("shadow maps", "layers drawn"), 0, "a camera move keeps every layer");
 
     let LightKind::Point { position } = &mut scene.lights[0].kind else {
         panic!("the showcase's first light is a point")
     };
     *position += Vec3::new(0.2, 0.0, 0.0);
     headless.render(gpu, &scene, &settings);
-    assert_eq!(headless.report.shadow_layers_drawn, 6, "moving the point light redraws its six faces, not the sun's");
+    assert_eq!(
+        headless.report.count("shadow maps", "layers drawn"),
+        6,
+        "moving the point light redraws its six faces, not the sun's"
+    );
 
     let mut biased = settings.clone();
     biased.shadows.depth_bias += 1;
     headless.render(gpu, &scene, &biased);
-    assert_eq!(headless.report.shadow_layers_drawn, 7, "a new bias redraws every layer");
+    assert_eq!(headless.report.count("shadow maps", "layers drawn"), 7, "a new bias redraws every layer");
 }
 
 #[test]
@@ -54,7 +62,11 @@ fn a_view_fitted_directional_map_follows_the_camera() {
     headless.render(gpu, &scene, &settings);
     scene.camera.eye = Quat::from_rotation_y(0.02) * scene.camera.eye;
     headless.render(gpu, &scene, &settings);
-    assert_eq!(headless.report.shadow_layers_drawn, 1, "only the directional light's layer follows the view");
+    assert_eq!(
+        headless.report.count("shadow maps", "layers drawn"),
+        1,
+        "only the directional light's layer follows the view"
+    );
 }
 
 #[test]
@@ -67,7 +79,7 @@ fn kept_shadow_maps_draw_the_same_image_as_fresh_ones() {
     headless.render(gpu, &scene, &settings);
     scene.camera.eye = Quat::from_rotation_y(0.05) * scene.camera.eye;
     let kept = headless.render(gpu, &scene, &settings);
-    assert_eq!(headless.report.shadow_layers_drawn, 0);
+    assert_eq!(headless.report.count("shadow maps", "layers drawn"), 0);
     let fresh = mirador::raster::render_image(gpu, &scene, &settings);
     assert_eq!(kept.as_raw(), fresh.as_raw(), "a kept map is the map that would be drawn");
 }
@@ -80,13 +92,13 @@ fn projected_polygons_are_kept_until_a_light_moves() {
     let gpu = common::gpu();
     let mut headless = Headless::new(gpu, &scene);
     headless.render(gpu, &scene, &settings);
-    assert!(headless.report.projected_recomputed);
+    assert!(headless.report.flag("projected shadows", "recomputed"));
     scene.camera.eye += Vec3::new(0.3, 0.0, 0.0);
     headless.render(gpu, &scene, &settings);
-    assert!(!headless.report.projected_recomputed, "the camera does not change the polygons");
+    assert!(!headless.report.flag("projected shadows", "recomputed"), "the camera does not change the polygons");
     scene.lights[0].intensity *= 0.5;
     headless.render(gpu, &scene, &settings);
-    assert!(headless.report.projected_recomputed, "any change to the lights recomputes them");
+    assert!(headless.report.flag("projected shadows", "recomputed"), "any change to the lights recomputes them");
 }
 
 #[test]
@@ -109,7 +121,7 @@ fn spheres_share_one_mesh_and_far_ones_get_fewer_triangles() {
     let gpu = common::gpu();
     let mut headless = Headless::new(gpu, &scene);
     headless.render(gpu, &scene, &scene.settings);
-    let geometry = &headless.scene_gpu.geometry;
+    let geometry = &headless.renderer.scene_gpu().geometry;
     // 91 spheres in three sizes on screen, and the ground plane.
     assert!(geometry.mesh_count() <= 5, "{} meshes for 91 spheres and a plane", geometry.mesh_count());
     let adaptive = headless.report.triangles;
@@ -162,7 +174,7 @@ fn a_gltf_mesh_used_by_two_nodes_is_one_instanced_draw() {
     let gpu = common::gpu();
     let mut headless = Headless::new(gpu, &scene);
     headless.render(gpu, &scene, &scene.settings);
-    let geometry = &headless.scene_gpu.geometry;
+    let geometry = &headless.renderer.scene_gpu().geometry;
     assert_eq!(geometry.mesh_count(), 2, "each primitive uploaded once");
     let file_batches: Vec<_> =
         geometry.batches.iter().filter(|b| matches!(b.mesh, mirador::raster::geometry::MeshKey::File(_))).collect();

@@ -222,16 +222,14 @@ pub struct SceneGeometry {
     pub transparent: Vec<TransparentObject>,
     /// A world-space box around everything, computed once.
     pub bounds: Option<(Vec3, Vec3)>,
-    /// Names this draw list among all the draw lists ever made: what is drawn from it (shadow
-    /// maps, projected polygons) is kept while it stays the same.
-    version: u64,
+    /// The draw list was built at least once.
+    prepared: bool,
 }
 
-/// A fresh draw-list version, never handed out before.
-fn next_version() -> u64 {
-    static VERSION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
-    VERSION.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
-}
+/// The name of one draw list: its instance buffer, made anew for every list (wgpu's handles
+/// compare by identity). A new scene or a new tessellation is a new name.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DrawListId(Option<wgpu::Buffer>);
 
 impl SceneGeometry {
     /// The geometry of `scene`, in which the objects listed in `mirrors` are planar mirrors and
@@ -257,7 +255,7 @@ impl SceneGeometry {
             batches: Vec::new(),
             transparent: Vec::new(),
             bounds: scene.bounds(),
-            version: next_version(),
+            prepared: false,
         }
     }
 
@@ -267,7 +265,6 @@ impl SceneGeometry {
     pub fn prepare(
         &mut self,
         device: &wgpu::Device,
-        queue: &wgpu::Queue,
         scene: &Scene,
         camera: &Camera,
         max_segments: u32,
@@ -286,7 +283,7 @@ impl SceneGeometry {
                 }
             })
             .collect();
-        if segments == self.segments && self.instances.is_some() {
+        if segments == self.segments && self.prepared {
             return false;
         }
         let mut entries: Vec<Entry> = scene
@@ -357,27 +354,25 @@ impl SceneGeometry {
             }
         }
         self.transparent.sort_by_key(|t| t.object);
+        // A new buffer for every new list, never rewritten: the buffer names the list
+        // ([`Self::draw_list`]).
         let data: Vec<GpuInstance> = entries.iter().map(|e| e.4).collect();
-        let size = std::mem::size_of_val(data.as_slice()) as u64;
-        match &self.instances {
-            Some(buffer) if buffer.size() >= size => queue.write_buffer(buffer, 0, bytemuck::cast_slice(&data)),
-            _ if data.is_empty() => {}
-            _ => {
-                self.instances = Some(device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("geometry::instances"),
-                    contents: bytemuck::cast_slice(&data),
-                    usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-                }));
-            }
-        }
+        self.instances = (!data.is_empty()).then(|| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("geometry::instances"),
+                contents: bytemuck::cast_slice(&data),
+                usage: wgpu::BufferUsages::VERTEX,
+            })
+        });
         self.segments = segments;
-        self.version = next_version();
+        self.prepared = true;
         true
     }
 
-    /// The draw list's version: it changes whenever the list is rebuilt.
-    pub fn version(&self) -> u64 {
-        self.version
+    /// Names the current draw list: what is drawn from it (shadow maps, projected polygons,
+    /// sorted triangles) is kept while the name stays the same.
+    pub fn draw_list(&self) -> DrawListId {
+        DrawListId(self.instances.clone())
     }
 
     /// Records `batch`: binds its mesh and instances and draws them (the pipeline and material

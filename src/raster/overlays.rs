@@ -9,14 +9,15 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-use super::scene_gpu::{SceneGpu, SceneLayouts};
+use super::context::{FrameContext, FrameEncoder};
+use super::scene_gpu::SceneLayouts;
 use super::shadow::ShadowMaps;
 use super::shadow::views::ShadowLayout;
-use super::view::ViewSlot;
-use super::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
+use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
+use super::view::FrameView;
 use crate::gpu::layout;
 use crate::gpu::uniform::UniformBuffer;
-use crate::settings::{ShadowSettings, ShadowView};
+use crate::settings::ShadowView;
 use crate::shaders;
 
 pub struct Overlays {
@@ -39,47 +40,45 @@ impl Overlays {
         Overlays { module, map_view: std::cell::OnceCell::new(), lines }
     }
 
-    /// Draws the overlays that `settings` asks for over `frame`'s HDR image.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
+    /// Draws the shadow technique's overlays that the settings ask for over the view's image:
+    /// a map layer, the lights' frusta.
+    pub fn record_shadows(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
-        settings: &ShadowSettings,
-        scene: &SceneGpu,
-        layout: &ShadowLayout,
-        maps: &ShadowMaps,
-        frame: &FrameTargets,
+        ctx: &FrameContext,
+        frame: &mut FrameEncoder,
+        (view, targets): (&FrameView, &FrameTargets),
+        (layout, maps): (&ShadowLayout, &ShadowMaps),
     ) {
+        let settings = &ctx.settings.shadows;
         if layout.views.is_empty() {
             return;
         }
         if settings.view == ShadowView::Map {
             let layer = settings.view_layer.min(layout.views.len() as u32 - 1);
             let ratio = layout.views[layer as usize].depth_ratio;
-            let map_view = self.map_view.get_or_init(|| MapView::new(device, &self.module));
-            map_view.record(device, queue, encoder, maps.depth, layer, ratio, frame.size, &frame.hdr.view);
+            let map_view = self.map_view.get_or_init(|| MapView::new(ctx.device(), &self.module));
+            map_view.record(ctx, frame, maps.depth, (layer, ratio), targets);
+            frame.end("overlays", &[]);
         }
         if settings.show_frusta {
             let volumes: Vec<[Vec3; 8]> = (0..layout.views.len()).map(|layer| layout.corners(layer)).collect();
-            self.record_lines(device, encoder, scene, &box_edges(&volumes), FRUSTUM_COLOUR, frame);
+            self.record_lines(ctx, frame, (view, targets), &box_edges(&volumes), FRUSTUM_COLOUR);
         }
     }
 
-    /// Draws `lines` (world-space segments, two points each) in `colour` into the scene as the
-    /// main view sees it, depth tested against `frame` (not written).
+    /// Draws `lines` (world-space segments, two points each) in `colour` into the scene as `view`
+    /// sees it, depth tested against its targets (not written).
     pub fn record_lines(
         &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        scene: &SceneGpu,
+        ctx: &FrameContext,
+        frame: &mut FrameEncoder,
+        (view, targets): (&FrameView, &FrameTargets),
         lines: &[Vec3],
         colour: Vec3,
-        frame: &FrameTargets,
     ) {
         if !lines.is_empty() {
-            self.lines.record(device, encoder, scene, lines, colour, &frame.hdr.view, &frame.depth.view);
+            self.lines.record(ctx, frame, (view, targets), lines, colour);
+            frame.end("overlays", &[]);
         }
     }
 }
@@ -140,21 +139,18 @@ impl MapView {
         MapView { pipeline, layout, uniform, sampler }
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn record(
         &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
+        ctx: &FrameContext,
+        frame: &mut FrameEncoder,
         maps: &wgpu::TextureView,
-        layer: u32,
-        depth_ratio: f32,
-        size: (u32, u32),
-        hdr: &wgpu::TextureView,
+        (layer, depth_ratio): (u32, f32),
+        targets: &FrameTargets,
     ) {
-        self.uniform.write(queue, &GpuShownLayer { layer, width: size.0, height: size.1, depth_ratio });
+        let size = targets.size;
+        self.uniform.write(ctx.queue(), &GpuShownLayer { layer, width: size.0, height: size.1, depth_ratio });
         // A teaching view, drawn only while it is on: a bind group made here costs nothing when off.
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        let group = ctx.device().create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("overlays::map_view_group"),
             layout: &self.layout,
             entries: &[
@@ -163,7 +159,8 @@ impl MapView {
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&self.sampler) },
             ],
         });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        let hdr = &targets.hdr.view;
+        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("overlays::map_view_pass"),
             color_attachments: &[Some(layout::color_attachment(hdr, wgpu::LoadOp::Load))],
             depth_stencil_attachment: None,
@@ -218,17 +215,16 @@ impl Lines {
         Lines { pipeline }
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn record(
         &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        scene: &SceneGpu,
+        ctx: &FrameContext,
+        frame: &mut FrameEncoder,
+        (view, targets): (&FrameView, &FrameTargets),
         lines: &[Vec3],
         colour: Vec3,
-        hdr: &wgpu::TextureView,
-        depth: &wgpu::TextureView,
     ) {
+        let device = ctx.device();
+        let scene = ctx.scene_gpu;
         // A teaching view, drawn only while it is on: buffers made here cost nothing when off.
         let buffer = |label, contents: &[Vec3]| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -239,16 +235,16 @@ impl Lines {
         };
         let vertices = buffer("overlays::lines_vertices", lines);
         let colour = buffer("overlays::lines_colour", &[colour]);
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("overlays::lines_pass"),
-            color_attachments: &[Some(layout::color_attachment(hdr, wgpu::LoadOp::Load))],
-            depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Load)),
+            color_attachments: &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
+            depth_stencil_attachment: Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(ViewSlot::Main)]);
+        pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view.slot)]);
         pass.set_vertex_buffer(0, vertices.slice(..));
         pass.set_vertex_buffer(1, colour.slice(..));
         pass.draw(0..lines.len() as u32, 0..1);

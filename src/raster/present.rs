@@ -4,23 +4,20 @@
 //! drawn at a render scale below 1 is upscaled here (bilinear), so the viewer can trade
 //! resolution for frame rate while the camera moves.
 
+use super::context::FrameEncoder;
 use super::uniforms::GpuPresent;
-use crate::gpu::layout;
 use crate::gpu::uniform::UniformBuffer;
+use crate::gpu::{Gpu, layout};
 use crate::output::OutputTransform;
 use crate::settings::ToneMap;
 use crate::shaders;
-
-/// The HDR image the pass reads, bound, and its size.
-pub struct PresentInput {
-    group: wgpu::BindGroup,
-    size: (u32, u32),
-}
 
 pub struct PresentPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     uniform: UniformBuffer<GpuPresent>,
+    /// The group reading the last HDR image presented, kept while that image is.
+    input: Option<(wgpu::TextureView, wgpu::BindGroup)>,
 }
 
 impl PresentPass {
@@ -54,37 +51,35 @@ impl PresentPass {
         );
         let uniform =
             UniformBuffer::new(device, "present::uniform", &GpuPresent { exposure: 1.0, tone_map: 0, scale: [1.0; 2] });
-        PresentPass { pipeline, layout, uniform }
+        PresentPass { pipeline, layout, uniform, input: None }
     }
 
-    /// The pass's input: made once per HDR target, when the targets are (re)created.
-    pub fn bind(&self, device: &wgpu::Device, hdr: &wgpu::TextureView) -> PresentInput {
-        let size = hdr.texture().size();
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("present::bind_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(hdr) },
-                wgpu::BindGroupEntry { binding: 1, resource: self.uniform.binding() },
-            ],
-        });
-        PresentInput { group, size: (size.width, size.height) }
-    }
-
-    /// Draws the HDR target bound in `input` through the output transform into `output`.
+    /// Draws the HDR image `hdr` through the output transform into `output`.
     pub fn record(
-        &self,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
-        input: &PresentInput,
+        &mut self,
+        gpu: &Gpu,
+        frame: &mut FrameEncoder,
+        hdr: &wgpu::TextureView,
         output: &wgpu::TextureView,
         transform: OutputTransform,
     ) {
-        let out = output.texture().size();
-        let scale = [input.size.0 as f32 / out.width as f32, input.size.1 as f32 / out.height as f32];
+        if self.input.as_ref().is_none_or(|(view, _)| view != hdr) {
+            let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("present::bind_group"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(hdr) },
+                    wgpu::BindGroupEntry { binding: 1, resource: self.uniform.binding() },
+                ],
+            });
+            self.input = Some((hdr.clone(), group));
+        }
+        let (_, group) = self.input.as_ref().expect("made just above");
+        let (input, out) = (hdr.texture().size(), output.texture().size());
+        let scale = [input.width as f32 / out.width as f32, input.height as f32 / out.height as f32];
         let tone_map = tone_map_code(transform.tone_map);
-        self.uniform.write(queue, &GpuPresent { exposure: transform.exposure, tone_map, scale });
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        self.uniform.write(&gpu.queue, &GpuPresent { exposure: transform.exposure, tone_map, scale });
+        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("present::pass"),
             color_attachments: &[Some(layout::color_attachment(output, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))],
             depth_stencil_attachment: None,
@@ -94,9 +89,11 @@ impl PresentPass {
         });
         pass.push_debug_group("present");
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &input.group, &[]);
+        pass.set_bind_group(0, group, &[]);
         pass.draw(0..3, 0..1);
         pass.pop_debug_group();
+        drop(pass);
+        frame.end("present", &[]);
     }
 }
 

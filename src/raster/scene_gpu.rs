@@ -2,14 +2,17 @@
 //! they change: 0 per view (the view's slot, chosen by a dynamic offset) and per frame (lights,
 //! numeric settings), 1 per material, 2 the lighting inputs the renderer builds from the shadow
 //! pass's outputs. Built once per scene; a frame rewrites the uniforms and, when tessellations
-//! change, the draw list.
+//! change, the draw list. What a technique keeps per scene (a volume's 3D texture, the
+//! environment maps, the planar mirrors) belongs to its pass.
+//!
+//! [`SceneShader`] is the shading module every scene-module pass compiles its variants from
+//! (`shaders/scene.wgsl` with the transparency and volume entry points composed after it), so
+//! that every variant computes bit-identical positions.
 
 use super::geometry::SceneGeometry;
-use super::mirror::{Mirror, find_mirrors};
-use super::scene_pass::MaterialKey;
-use super::uniforms::{GpuFrame, GpuMaterial};
+use super::keys::MaterialKey;
+use super::uniforms::{GpuFrame, GpuInstance, GpuMaterial, Vertex};
 use super::view::ViewBuffer;
-use super::volume::VolumeGpu;
 use crate::gpu::mipmap::{MipmapGenerator, sampler_descriptor, upload_with_mipmaps};
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::uniform::UniformBuffer;
@@ -17,6 +20,7 @@ use crate::gpu::{Gpu, layout};
 use crate::scene::{Scene, Wrap};
 use crate::settings::RenderSettings;
 use crate::settings::{TextureFilter, TextureSettings};
+use crate::shaders;
 use crate::texture::mipmap::Filter;
 
 /// The bind group layouts every scene pass shares.
@@ -72,6 +76,54 @@ impl SceneLayouts {
     }
 }
 
+/// The scene module and the pipeline layout of groups 0 to 2 that every pass drawing with it
+/// shares; a pass with a group 3 of its own makes its layout with [`Self::layout_with`].
+pub struct SceneShader {
+    pub module: wgpu::ShaderModule,
+    pub layout: wgpu::PipelineLayout,
+}
+
+/// The vertex buffers of every scene pipeline: the mesh's vertices, and the instances.
+pub const VERTEX_BUFFERS: [Option<wgpu::VertexBufferLayout<'static>>; 2] =
+    [Some(Vertex::LAYOUT), Some(GpuInstance::LAYOUT)];
+
+impl SceneShader {
+    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts) -> SceneShader {
+        let module = shaders::module(device, "scene::shader", shaders::SCENE);
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("scene::layout"),
+            bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.material), Some(&layouts.lighting)],
+            immediate_size: 0,
+        });
+        SceneShader { module, layout }
+    }
+
+    /// A pipeline layout of groups 0 to 2 and `group3`.
+    pub fn layout_with(
+        &self,
+        device: &wgpu::Device,
+        layouts: &SceneLayouts,
+        label: &str,
+        group3: &wgpu::BindGroupLayout,
+    ) -> wgpu::PipelineLayout {
+        device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.material), Some(&layouts.lighting), Some(group3)],
+            immediate_size: 0,
+        })
+    }
+
+    /// The vertex stage every scene pipeline shares (`vs_scene`).
+    pub fn vertex(&self) -> wgpu::VertexState<'_> {
+        wgpu::VertexState {
+            module: &self.module,
+            entry_point: Some("vs_scene"),
+            compilation_options: Default::default(),
+            buffers: &VERTEX_BUFFERS,
+        }
+    }
+}
+
 pub struct SceneGpu {
     frame: UniformBuffer<GpuFrame>,
     /// Every view of the frame, a slot each.
@@ -89,15 +141,7 @@ pub struct SceneGpu {
     pub material_keys: Vec<MaterialKey>,
     /// Per material: what it lets through, the blend constant `kt·Mt` of the transparency pass.
     pub transmittance: Vec<glam::Vec3>,
-    /// The scene's planar mirrors (`super::mirror`).
-    pub mirrors: Vec<Mirror>,
-    /// The objects with a dynamic environment cube, by layer (`super::environment`).
-    pub env_objects: Vec<usize>,
-    /// The environment maps, made by the renderer at the first frame (their size is a setting).
-    pub environment: Option<super::environment::EnvironmentMaps>,
     pub geometry: SceneGeometry,
-    /// Each volume's field, transfer table and uniform (`super::volume`).
-    pub volumes: Vec<VolumeGpu>,
 }
 
 /// The filter and its anisotropy: what tells sets of material groups apart.
@@ -112,8 +156,21 @@ struct MaterialInputs {
     wrap: [Wrap; 2],
 }
 
+/// Which objects the geometry draws alone, and why: planar mirrors show their own reflection,
+/// objects with a dynamic environment cube (by layer) are left out of their cube's views.
+pub struct DrawnAlone<'a> {
+    pub mirrors: &'a [usize],
+    pub env_objects: &'a [usize],
+}
+
 impl SceneGpu {
-    pub fn upload(gpu: &Gpu, layouts: &SceneLayouts, mipmaps: &MipmapGenerator, scene: &Scene) -> SceneGpu {
+    pub fn upload(
+        gpu: &Gpu,
+        layouts: &SceneLayouts,
+        mipmaps: &MipmapGenerator,
+        scene: &Scene,
+        alone: DrawnAlone,
+    ) -> SceneGpu {
         let device = &gpu.device;
         if scene.lights.len() > super::uniforms::MAX_LIGHTS {
             log::warn!(
@@ -128,25 +185,6 @@ impl SceneGpu {
             &GpuFrame::new(scene.ambient, &scene.lights, &[], &scene.settings),
         );
         let views = ViewBuffer::new(device);
-        let (mut mirrors, warnings) = find_mirrors(scene);
-        for warning in warnings {
-            log::warn!("{warning}");
-        }
-        // A transparent mirror would need its reflection in the transparency pass: it is drawn as
-        // glass alone.
-        mirrors.retain(|m| {
-            let object = &scene.objects[m.object];
-            let transparent = scene.materials[object.material.0].is_transparent();
-            if transparent {
-                log::warn!("`{}` is transparent: the rasterizer draws it without its reflection", object.name);
-            }
-            !transparent
-        });
-        let mirror_objects: Vec<usize> = mirrors.iter().map(|m| m.object).collect();
-        let (env_objects, warnings) = super::environment::reflective_objects(scene, &mirror_objects);
-        for warning in warnings {
-            log::warn!("{warning}");
-        }
         // Every texture gets its whole mip chain, averaged in linear space (TECHNIQUES.md §2).
         let textures: Vec<GpuTexture> = scene
             .textures
@@ -192,11 +230,7 @@ impl SceneGpu {
             active: 0,
             material_keys: scene.materials.iter().map(MaterialKey::of).collect(),
             transmittance: scene.materials.iter().map(super::uniforms::transmittance).collect(),
-            geometry: SceneGeometry::new(scene, &mirror_objects, &env_objects),
-            mirrors,
-            env_objects,
-            environment: None,
-            volumes: scene.volumes.iter().map(|v| VolumeGpu::upload(device, &gpu.queue, v)).collect(),
+            geometry: SceneGeometry::new(scene, alone.mirrors, alone.env_objects),
         }
     }
 

@@ -34,6 +34,18 @@
 //!
 //! Ties keep the scene's order (stable sorts), so coplanar surfaces do not flicker.
 //!
+//! # Composited volumes in the same order
+//! A composited volume (`super::volume`) lies between transparent surfaces as well as in front
+//! of the opaque ones, so the pass decides when the volumes are marched and over which part of
+//! each ray ([`RaySpan`]), through a callback the frame gives it:
+//! - `exact`: between the peeled layers. After peel `k`'s depth is known, the volumes are
+//!   marched between it and peel `k − 1` (the opaque surface for `k = 0`), then layer `k` is
+//!   blended over them; after the last layer, what lies in front of it. Every ray is cut at every
+//!   transparent surface it crosses, the order the tracer composites in;
+//! - `object` and `triangle`: each volume is one more item of the sorted list, by its box's
+//!   centre, marched whole: right where a volume and the surfaces do not overlap in depth;
+//! - `unsorted`: the volumes first, behind every transparent surface.
+//!
 //! # Against the ray tracer
 //! The tracer refracts for real (`ior`); with `ior = 1` its rays go straight through too, and its
 //! image and the exactly ordered one agree (tests/transparency.rs). Transparent surfaces receive
@@ -46,16 +58,19 @@ use std::time::{Duration, Instant};
 use glam::{Mat3, Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
-use super::geometry::{TransparentObject, build_mesh};
-use super::scene_gpu::SceneGpu;
-use super::scene_pass::{FrameKey, MaterialKey, ScenePass, constants, vertex_state};
+use super::context::{Figure, FrameContext, FrameEncoder};
+use super::geometry::{DrawListId, TransparentObject, build_mesh};
+use super::keys::{FrameKey, MaterialKey, constants};
+use super::scene_gpu::{SceneGpu, SceneLayouts, SceneShader};
+use super::scene_pass::scissor;
+use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
 use super::uniforms::{ALPHA_BLEND, GpuInstance, Vertex};
-use super::view::{View, ViewSlot};
-use super::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
+use super::view::{FrameView, ViewSlot};
+use super::volume::{RaySpan, VolumeSet};
 use crate::gpu::layout;
 use crate::gpu::texture::GpuTexture;
 use crate::scene::Scene;
-use crate::settings::{TransparencySettings, TransparencySort};
+use crate::settings::TransparencySort;
 use crate::texture::tangents::tangents_or_generate;
 
 /// How the blend finds `kt·Mt`.
@@ -88,191 +103,293 @@ enum Depth {
 
 type PipelineKey = (Blend, Faces, Depth, FrameKey, MaterialKey);
 
-/// What one frame of the pass did.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct TransparencyReport {
-    /// Transparent draws recorded (per object, per run of one material, or per peel).
-    pub draws: u32,
-    /// The triangles were sorted anew this frame, and how long the CPU took.
-    pub sorted: bool,
-    pub sort_time: Duration,
-    /// Layers peeled (the exact order).
-    pub layers: u32,
-}
-
 /// One draw of the pass.
+#[derive(Clone, Debug)]
 enum Draw {
     /// One object's triangles, or only its back or front faces; `winding` is the faces in terms
     /// of the triangles' winding (swapped where the object's transform or the view mirrors).
     Object { object: usize, winding: Faces },
-    /// A run of sorted triangles of one material, from the triangle list in `order`'s order.
-    Triangles { material: usize, indices: Range<u32>, order: ViewSlot },
+    /// A run of sorted triangles of one material, from the view's sorted triangle list.
+    Triangles { material: usize, indices: Range<u32> },
+}
+
+/// What a view's transparent phase does, in order.
+#[derive(Clone, Debug)]
+enum Step {
+    Draw(Draw),
+    /// March the composited volumes (one, or all) over whole rays.
+    Volumes(VolumeSet),
 }
 
 pub struct TransparencyPass {
     peel_group_layout: wgpu::BindGroupLayout,
     peel_layout: wgpu::PipelineLayout,
     pipelines: HashMap<PipelineKey, wgpu::RenderPipeline>,
-    peel_pipelines: HashMap<MaterialKey, wgpu::RenderPipeline>,
-    /// Peel depths for each set of frame targets drawn into (the main view's, mirrored views').
-    peel: Vec<PeelTargets>,
+    peel_pipelines: HashMap<(FrameKey, MaterialKey), wgpu::RenderPipeline>,
+    /// Peel depths of each view's targets (by the targets' depth image), kept while those
+    /// targets are drawn into.
+    peels: Vec<(wgpu::TextureView, PeelTargets)>,
     triangles: Option<TriangleList>,
 }
 
+/// One view's part of a prepared frame.
+struct ViewSteps {
+    slot: ViewSlot,
+    steps: Vec<Step>,
+    /// The exact order: the peel depths of the view's targets, and the draws of one layer.
+    peel: Option<usize>,
+}
+
 impl TransparencyPass {
-    pub fn new(device: &wgpu::Device, scene_layouts: &super::scene_gpu::SceneLayouts) -> TransparencyPass {
+    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SceneShader) -> TransparencyPass {
         let depth = |binding| layout::texture(binding, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2);
         let peel_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("transparency::peel_group_layout"),
             entries: &[depth(0), depth(1)],
         });
-        let peel_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("transparency::peel_layout"),
-            bind_group_layouts: &[
-                Some(&scene_layouts.frame),
-                Some(&scene_layouts.material),
-                Some(&scene_layouts.lighting),
-                Some(&peel_group_layout),
-            ],
-            immediate_size: 0,
-        });
+        let peel_layout = shader.layout_with(device, layouts, "transparency::peel_layout", &peel_group_layout);
         TransparencyPass {
             peel_group_layout,
             peel_layout,
             pipelines: HashMap::new(),
             peel_pipelines: HashMap::new(),
-            peel: Vec::new(),
+            peels: Vec::new(),
             triangles: None,
         }
     }
 
-    /// Draws the transparent surfaces of `scene_gpu` seen from `view` (in `slot`) over the opaque
-    /// image and depth of `targets`, in the order `settings` asks for.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
-        scene_pass: &ScenePass,
-        scene: &Scene,
-        scene_gpu: &SceneGpu,
-        lighting: &wgpu::BindGroup,
-        frame: FrameKey,
-        (slot, view): (ViewSlot, &View),
-        targets: &FrameTargets,
-        settings: &TransparencySettings,
-        skip: Option<usize>,
-    ) -> TransparencyReport {
-        let mut report = TransparencyReport::default();
-        if scene_gpu.geometry.transparent.is_empty() {
-            return report;
-        }
-        let forward = -view.view_axis;
-        let objects = &scene_gpu.geometry.transparent;
-        let object_draw = |object: usize, faces: Faces| Draw::Object {
-            object,
-            winding: if objects[object].flipped != view.mirrored { faces.swapped() } else { faces },
-        };
-        // An environment cube's views leave out the object they are drawn from (sorted per object).
-        let kept = (0..objects.len()).filter(|&i| Some(objects[i].object) != skip);
-        let sort = if skip.is_some() { TransparencySort::Object } else { settings.sort };
-        let draws: Vec<Draw> = match sort {
-            TransparencySort::Unsorted => kept.map(|object| object_draw(object, Faces::Both)).collect(),
-            TransparencySort::Object => {
-                let mut order: Vec<usize> = kept.collect();
-                // Farthest first; a stable sort keeps the scene's order between equals.
-                order.sort_by(|&a, &b| {
-                    let depth = |i: usize| (objects[i].centre - view.eye).dot(forward);
-                    depth(b).total_cmp(&depth(a))
-                });
-                order
-                    .into_iter()
-                    .flat_map(|object| [object_draw(object, Faces::Back), object_draw(object, Faces::Front)])
-                    .collect()
-            }
-            TransparencySort::Triangle => {
-                let version = scene_gpu.geometry.version();
-                if self.triangles.as_ref().is_none_or(|t| t.geometry != version) {
-                    self.triangles = Some(TriangleList::new(device, scene, &scene_gpu.geometry.transparent, version));
+    /// Decides each view's order (sorting per object, or the triangles per view, where the view
+    /// moved), compiles the pipelines the order needs and makes each view's peel depths.
+    pub fn prepare<'p>(
+        &'p mut self,
+        ctx: &FrameContext,
+        frame: &mut FrameEncoder,
+        views: &[(&FrameView, &FrameTargets)],
+    ) -> PreparedTransparency<'p> {
+        let settings = &ctx.settings.transparency;
+        let geometry = &ctx.scene_gpu.geometry;
+        let (mut sorted, mut sort_time) = (false, Duration::ZERO);
+        let mut prepared = Vec::new();
+        self.peels.retain(|(depth, _)| views.iter().any(|(_, t)| t.depth.view == *depth));
+        for &(view, targets) in views {
+            // An environment cube's views leave out the object they are drawn from, sorted per
+            // object (the triangle list has no room for a left-out object).
+            let sort = if view.skip.is_some() && settings.sort == TransparencySort::Triangle {
+                TransparencySort::Object
+            } else {
+                settings.sort
+            };
+            let (steps, peel) = match sort {
+                TransparencySort::Exact => {
+                    let draws = (0..geometry.transparent.len())
+                        .filter(|&i| Some(geometry.transparent[i].object) != view.skip)
+                        .map(|object| Step::Draw(Draw::Object { object, winding: Faces::Both }))
+                        .collect();
+                    (draws, Some(self.peel_index(ctx.device(), targets)))
                 }
-                let list = self.triangles.as_mut().expect("made just above");
-                let start = Instant::now();
-                report.sorted = list.sort(device, queue, slot, view.eye, forward);
-                report.sort_time = start.elapsed();
-                list.orders[&slot]
-                    .runs
-                    .iter()
-                    .map(|(material, indices)| Draw::Triangles {
-                        material: *material,
-                        indices: indices.clone(),
-                        order: slot,
-                    })
-                    .collect()
+                TransparencySort::Triangle => {
+                    let start = Instant::now();
+                    sorted |= self.sort_triangles(ctx, view);
+                    sort_time += start.elapsed();
+                    (self.triangle_steps(ctx, view), None)
+                }
+                TransparencySort::Object | TransparencySort::Unsorted => (object_steps(ctx, view, sort), None),
+            };
+            let depth = if peel.is_some() { Depth::Equal } else { Depth::Less };
+            for step in &steps {
+                if let Step::Draw(draw) = step {
+                    let key = pipeline_key(ctx.scene_gpu, view.key, draw, depth);
+                    self.pipelines.entry(key).or_insert_with(|| shading_pipeline(ctx, key));
+                }
             }
-            TransparencySort::Exact => {
-                report.layers = settings.peel_layers;
-                report.draws = self.record_peeled(
-                    device,
-                    encoder,
-                    scene_pass,
-                    scene_gpu,
-                    lighting,
-                    frame,
-                    slot,
-                    targets,
-                    settings.peel_layers,
-                );
-                return report;
+            if peel.is_some() {
+                for object in &geometry.transparent {
+                    let key = (view.key, ctx.scene_gpu.material_keys[object.material]);
+                    if !self.peel_pipelines.contains_key(&key) {
+                        let pipeline = peel_pipeline(ctx, &self.peel_layout, key);
+                        self.peel_pipelines.insert(key, pipeline);
+                    }
+                }
             }
-        };
-        self.prepare(device, scene_pass, scene_gpu, frame, &draws, Depth::Less);
-        let mut pass = begin(encoder, "transparency::sorted", targets, &targets.depth.view);
-        pass.set_bind_group(0, scene_gpu.frame_group(), &[scene_gpu.views.offset(slot)]);
-        pass.set_bind_group(2, lighting, &[]);
-        for draw in &draws {
-            self.record_draw(&mut pass, scene_gpu, frame, draw, Depth::Less);
-            report.draws += 1;
+            prepared.push(ViewSteps { slot: view.slot, steps, peel });
         }
-        report
+        let mut figures = vec![("sorted", Figure::Flag(sorted))];
+        if settings.sort == TransparencySort::Triangle {
+            figures.push(("sort time", Figure::Time(sort_time)));
+        }
+        frame.end("transparency sort", &figures);
+        PreparedTransparency { pass: self, views: prepared }
     }
 
-    /// Compiles the pipelines `draws` need that were not compiled before.
-    fn prepare(
-        &mut self,
-        device: &wgpu::Device,
-        scene_pass: &ScenePass,
-        scene_gpu: &SceneGpu,
-        frame: FrameKey,
-        draws: &[Draw],
-        depth: Depth,
+    /// The index in `self.peels` of the peel depths for `targets`, made if they have none.
+    fn peel_index(&mut self, device: &wgpu::Device, targets: &FrameTargets) -> usize {
+        match self.peels.iter().position(|(depth, _)| *depth == targets.depth.view) {
+            Some(index) => index,
+            None => {
+                let peel = PeelTargets::new(device, &self.peel_group_layout, targets);
+                self.peels.push((targets.depth.view.clone(), peel));
+                self.peels.len() - 1
+            }
+        }
+    }
+
+    /// Sorts the transparent triangles for `view`, unless its order is still right; rebuilds the
+    /// list first when the draw list changed. Returns whether it sorted.
+    fn sort_triangles(&mut self, ctx: &FrameContext, view: &FrameView) -> bool {
+        let geometry = &ctx.scene_gpu.geometry;
+        let current = geometry.draw_list();
+        if self.triangles.as_ref().is_none_or(|t| t.geometry != current) {
+            self.triangles = Some(TriangleList::new(ctx.device(), ctx.scene, &geometry.transparent, current));
+        }
+        let list = self.triangles.as_mut().expect("made just above");
+        list.sort(ctx.device(), ctx.queue(), view.slot, view.view.eye, -view.view.view_axis)
+    }
+
+    /// The sorted triangles of `view` in runs of one material, with each composited volume placed
+    /// by its centre among them.
+    fn triangle_steps(&self, ctx: &FrameContext, view: &FrameView) -> Vec<Step> {
+        let list = self.triangles.as_ref().expect("sorted before");
+        let order = &list.orders[&view.slot];
+        let forward = -view.view.view_axis;
+        let depth = |p: Vec3| (p - view.view.eye).dot(forward);
+        let mut volumes = volume_depths(ctx, view);
+        let mut steps = Vec::new();
+        for (material, indices) in &order.runs {
+            // A run is split where a volume's centre falls between its triangles.
+            let mut start = indices.start;
+            for t in (indices.start..indices.end).step_by(3) {
+                let triangle_depth = depth(list.centroids[order.sequence[(t / 3) as usize] as usize]);
+                while let Some(&(volume_depth, volume)) = volumes.last()
+                    && volume_depth > triangle_depth
+                {
+                    if t > start {
+                        steps.push(Step::Draw(Draw::Triangles { material: *material, indices: start..t }));
+                        start = t;
+                    }
+                    steps.push(Step::Volumes(VolumeSet::One(volume)));
+                    volumes.pop();
+                }
+            }
+            steps.push(Step::Draw(Draw::Triangles { material: *material, indices: start..indices.end }));
+        }
+        steps.extend(volumes.into_iter().rev().map(|(_, v)| Step::Volumes(VolumeSet::One(v))));
+        steps
+    }
+}
+
+/// Each composited volume's depth along the view (its box's centre), nearest first, so the
+/// farthest is last.
+fn volume_depths(ctx: &FrameContext, view: &FrameView) -> Vec<(f32, usize)> {
+    let forward = -view.view.view_axis;
+    let mut volumes: Vec<(f32, usize)> =
+        ctx.scene.volumes.iter().enumerate().map(|(i, v)| ((v.centre() - view.view.eye).dot(forward), i)).collect();
+    volumes.sort_by(|a, b| a.0.total_cmp(&b.0));
+    volumes
+}
+
+/// The order of `object` and `unsorted`: objects farthest first by their bounds' centre, each
+/// drawn back faces then front faces, the volumes among them; or the scene's order after the
+/// volumes.
+fn object_steps(ctx: &FrameContext, view: &FrameView, sort: TransparencySort) -> Vec<Step> {
+    let objects = &ctx.scene_gpu.geometry.transparent;
+    let forward = -view.view.view_axis;
+    let object_draw = |object: usize, faces: Faces| {
+        Step::Draw(Draw::Object {
+            object,
+            winding: if objects[object].flipped != view.view.mirrored { faces.swapped() } else { faces },
+        })
+    };
+    let kept = (0..objects.len()).filter(|&i| Some(objects[i].object) != view.skip);
+    if sort == TransparencySort::Unsorted {
+        let volumes = std::iter::once(Step::Volumes(VolumeSet::All));
+        return volumes.chain(kept.map(|object| object_draw(object, Faces::Both))).collect();
+    }
+    // Farthest first; a stable sort keeps the scene's order between equals, objects before
+    // volumes.
+    let mut items: Vec<(f32, Option<usize>, Option<usize>)> =
+        kept.map(|i| ((objects[i].centre - view.view.eye).dot(forward), Some(i), None)).collect();
+    items.extend(volume_depths(ctx, view).into_iter().map(|(depth, v)| (depth, None, Some(v))));
+    items.sort_by(|a, b| b.0.total_cmp(&a.0));
+    items
+        .into_iter()
+        .flat_map(|item| match item {
+            (_, Some(object), _) => vec![object_draw(object, Faces::Back), object_draw(object, Faces::Front)],
+            (_, None, Some(volume)) => vec![Step::Volumes(VolumeSet::One(volume))],
+            _ => vec![],
+        })
+        .collect()
+}
+
+fn pipeline_key(scene_gpu: &SceneGpu, frame: FrameKey, draw: &Draw, depth: Depth) -> PipelineKey {
+    let (material, faces) = match *draw {
+        Draw::Object { object, winding } => (scene_gpu.geometry.transparent[object].material, winding),
+        Draw::Triangles { material, .. } => (material, Faces::Both),
+    };
+    let key = scene_gpu.material_keys[material];
+    let blend = if key.alpha_mode == ALPHA_BLEND && key.color_texture { Blend::Coverage } else { Blend::Constant };
+    (blend, faces, depth, frame, key)
+}
+
+/// The pass with every view's order decided and its pipelines compiled.
+pub struct PreparedTransparency<'p> {
+    pass: &'p TransparencyPass,
+    views: Vec<ViewSteps>,
+}
+
+/// Marches the composited volumes over a part of every ray: what the transparency pass asks of
+/// the volumes between its layers.
+pub type Composite<'c> = dyn FnMut(&mut FrameEncoder, RaySpan) + 'c;
+
+impl PreparedTransparency<'_> {
+    /// Draws the transparent surfaces seen from `view` over the opaque image and depth of
+    /// `targets` in the chosen order, calling `composite` where the volumes belong in it.
+    pub fn record(
+        &self,
+        ctx: &FrameContext,
+        frame: &mut FrameEncoder,
+        (view, targets): (&FrameView, &FrameTargets),
+        composite: &mut Composite,
     ) {
-        for draw in draws {
-            let key = self.key(scene_gpu, frame, draw, depth);
-            self.pipelines.entry(key).or_insert_with(|| shading_pipeline(device, scene_pass, key));
-        }
-    }
-
-    fn key(&self, scene_gpu: &SceneGpu, frame: FrameKey, draw: &Draw, depth: Depth) -> PipelineKey {
-        let (material, faces) = match *draw {
-            Draw::Object { object, winding } => (scene_gpu.geometry.transparent[object].material, winding),
-            Draw::Triangles { material, .. } => (material, Faces::Both),
+        let prepared = self.views.iter().find(|v| v.slot == view.slot);
+        let prepared = prepared.expect("TransparencyPass::prepare was given every view of the frame");
+        let draws = match prepared.peel {
+            Some(peel) => self.record_peeled(ctx, frame, (view, targets), prepared, peel, composite),
+            None => {
+                let mut draws = 0;
+                let mut steps = prepared.steps.iter().peekable();
+                while steps.peek().is_some() {
+                    if let Some(Step::Volumes(set)) = steps.peek() {
+                        composite(frame, RaySpan { volumes: *set, near: None, far: None });
+                        steps.next();
+                        continue;
+                    }
+                    let mut pass = begin(frame, "transparency::sorted", view, targets, &targets.depth.view);
+                    pass.set_bind_group(0, ctx.scene_gpu.frame_group(), &[ctx.scene_gpu.views.offset(view.slot)]);
+                    pass.set_bind_group(2, ctx.lighting, &[]);
+                    while let Some(Step::Draw(draw)) = steps.peek() {
+                        self.record_draw(ctx, &mut pass, view, draw, Depth::Less);
+                        draws += 1;
+                        steps.next();
+                    }
+                }
+                draws
+            }
         };
-        let key = scene_gpu.material_keys[material];
-        let blend = if key.alpha_mode == ALPHA_BLEND && key.color_texture { Blend::Coverage } else { Blend::Constant };
-        (blend, faces, depth, frame, key)
+        let layers = if prepared.peel.is_some() { ctx.settings.transparency.peel_layers } else { 0 };
+        frame.end("transparency", &[("draws", Figure::Count(draws)), ("layers peeled", Figure::Count(layers.into()))]);
     }
 
     fn record_draw(
         &self,
+        ctx: &FrameContext,
         pass: &mut wgpu::RenderPass<'_>,
-        scene_gpu: &SceneGpu,
-        frame: FrameKey,
+        view: &FrameView,
         draw: &Draw,
         depth: Depth,
     ) {
-        let key = self.key(scene_gpu, frame, draw, depth);
-        pass.set_pipeline(&self.pipelines[&key]);
+        let scene_gpu = ctx.scene_gpu;
+        let key = pipeline_key(scene_gpu, view.key, draw, depth);
+        pass.set_pipeline(&self.pass.pipelines[&key]);
         let material = match *draw {
             Draw::Object { object, .. } => scene_gpu.geometry.transparent[object].material,
             Draw::Triangles { material, .. } => material,
@@ -285,59 +402,38 @@ impl TransparencyPass {
                 let object: &TransparentObject = &scene_gpu.geometry.transparent[*object];
                 scene_gpu.geometry.draw_instances(pass, object.mesh, object.instance..object.instance + 1);
             }
-            Draw::Triangles { indices, order, .. } => {
-                let list = self.triangles.as_ref().expect("sorted before drawing");
+            Draw::Triangles { indices, .. } => {
+                let list = self.pass.triangles.as_ref().expect("sorted in prepare");
                 pass.set_vertex_buffer(0, list.vertices.slice(..));
                 pass.set_vertex_buffer(1, list.identity.slice(..));
-                pass.set_index_buffer(list.orders[order].indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.set_index_buffer(list.orders[&view.slot].indices.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(indices.clone(), 0, 0..1);
             }
         }
     }
 
-    /// The exact order: `layers` peels from the back, each a depth pass and a shading pass.
+    /// The exact order: `peel_layers` peels from the back, each a depth pass, the volumes behind
+    /// the layer, and the layer's shading pass; then the volumes in front of the last layer.
     /// Returns the draws recorded.
-    #[allow(clippy::too_many_arguments)]
     fn record_peeled(
-        &mut self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        scene_pass: &ScenePass,
-        scene_gpu: &SceneGpu,
-        lighting: &wgpu::BindGroup,
-        frame: FrameKey,
-        slot: ViewSlot,
-        targets: &FrameTargets,
-        layers: u32,
-    ) -> u32 {
+        &self,
+        ctx: &FrameContext,
+        frame: &mut FrameEncoder,
+        (view, targets): (&FrameView, &FrameTargets),
+        prepared: &ViewSteps,
+        peel: usize,
+        composite: &mut Composite,
+    ) -> u64 {
+        let scene_gpu = ctx.scene_gpu;
         let objects = &scene_gpu.geometry.transparent;
-        let draws: Vec<Draw> = (0..objects.len()).map(|object| Draw::Object { object, winding: Faces::Both }).collect();
-        self.prepare(device, scene_pass, scene_gpu, frame, &draws, Depth::Equal);
-        for object in objects {
-            let key = scene_gpu.material_keys[object.material];
-            if !self.peel_pipelines.contains_key(&key) {
-                let pipeline = peel_pipeline(device, scene_pass, &self.peel_layout, frame, key);
-                self.peel_pipelines.insert(key, pipeline);
-            }
-        }
-        let index = match self.peel.iter().position(|p| p.for_targets == targets.generation) {
-            Some(index) => index,
-            None => {
-                // Targets are remade on resize: forget the peels of targets that are gone.
-                if self.peel.len() > 2 * super::view::MAX_MIRROR_VIEWS as usize {
-                    self.peel.clear();
-                }
-                self.peel.push(PeelTargets::new(device, &self.peel_group_layout, targets));
-                self.peel.len() - 1
-            }
-        };
-        let peel = &self.peel[index];
-        let view_offset = [scene_gpu.views.offset(slot)];
+        let peel = &self.pass.peels[peel].1;
+        let view_offset = [scene_gpu.views.offset(view.slot)];
         let mut recorded = 0;
-        for layer in 0..layers as usize {
+        let layers = ctx.settings.transparency.peel_layers as usize;
+        for layer in 0..layers {
             let depth = &peel.depth[layer % 2].view;
             {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("transparency::peel"),
                     color_attachments: &[],
                     depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Clear(0.0))),
@@ -345,26 +441,33 @@ impl TransparencyPass {
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
-                scissor(&mut pass, targets);
+                scissor(&mut pass, view);
                 pass.set_bind_group(0, scene_gpu.frame_group(), &view_offset);
-                pass.set_bind_group(2, lighting, &[]);
+                pass.set_bind_group(2, ctx.lighting, &[]);
                 // Layer 0 peels below the opaque depth alone; layer k below layer k − 1 too.
                 let limits = if layer == 0 { &peel.first } else { &peel.below[(layer - 1) % 2] };
                 pass.set_bind_group(3, limits, &[]);
-                for object in objects {
-                    pass.set_pipeline(&self.peel_pipelines[&scene_gpu.material_keys[object.material]]);
+                for object in objects.iter().filter(|o| Some(o.object) != view.skip) {
+                    let key = (view.key, scene_gpu.material_keys[object.material]);
+                    pass.set_pipeline(&self.pass.peel_pipelines[&key]);
                     pass.set_bind_group(1, &scene_gpu.materials()[object.material], &[]);
                     scene_gpu.geometry.draw_instances(&mut pass, object.mesh, object.instance..object.instance + 1);
                 }
             }
-            let mut pass = begin(encoder, "transparency::peeled_layer", targets, depth);
+            let far = (layer > 0).then(|| &peel.depth[(layer - 1) % 2].view);
+            composite(frame, RaySpan { volumes: VolumeSet::All, near: Some(depth), far });
+            let mut pass = begin(frame, "transparency::peeled_layer", view, targets, depth);
             pass.set_bind_group(0, scene_gpu.frame_group(), &view_offset);
-            pass.set_bind_group(2, lighting, &[]);
-            for draw in &draws {
-                self.record_draw(&mut pass, scene_gpu, frame, draw, Depth::Equal);
+            pass.set_bind_group(2, ctx.lighting, &[]);
+            for step in &prepared.steps {
+                if let Step::Draw(draw) = step {
+                    self.record_draw(ctx, &mut pass, view, draw, Depth::Equal);
+                }
             }
-            recorded += 2 * objects.len() as u32;
+            recorded += 2 * objects.len() as u64;
         }
+        let last = &peel.depth[(layers - 1) % 2].view;
+        composite(frame, RaySpan { volumes: VolumeSet::All, near: None, far: Some(last) });
         recorded
     }
 }
@@ -380,15 +483,16 @@ impl Faces {
     }
 }
 
-/// A render pass over the frame's colour, testing against `depth` without writing it, inside
-/// the targets' scissor.
+/// A render pass over the view's colour, testing against `depth` without writing it, inside the
+/// view's scissor.
 fn begin<'e>(
-    encoder: &'e mut wgpu::CommandEncoder,
+    frame: &'e mut FrameEncoder,
     label: &'static str,
+    view: &FrameView,
     targets: &FrameTargets,
     depth: &wgpu::TextureView,
 ) -> wgpu::RenderPass<'e> {
-    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+    let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
         depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Load)),
@@ -396,15 +500,8 @@ fn begin<'e>(
         occlusion_query_set: None,
         multiview_mask: None,
     });
-    scissor(&mut pass, targets);
+    scissor(&mut pass, view);
     pass
-}
-
-/// Limits `pass` to the targets' scissor, if they have one.
-fn scissor(pass: &mut wgpu::RenderPass<'_>, targets: &FrameTargets) {
-    if let Some([x, y, width, height]) = targets.scissor {
-        pass.set_scissor_rect(x, y, width, height);
-    }
 }
 
 /// `I = Im + kt·Mt·I`; the target's alpha is left as it is.
@@ -427,7 +524,7 @@ fn blend_state(blend: Blend) -> wgpu::BlendState {
     }
 }
 
-fn shading_pipeline(device: &wgpu::Device, scene_pass: &ScenePass, key: PipelineKey) -> wgpu::RenderPipeline {
+fn shading_pipeline(ctx: &FrameContext, key: PipelineKey) -> wgpu::RenderPipeline {
     let (blend, faces, depth, frame, material) = key;
     let constants = constants(&frame, &material);
     let cull_mode = match faces {
@@ -439,15 +536,15 @@ fn shading_pipeline(device: &wgpu::Device, scene_pass: &ScenePass, key: Pipeline
         Depth::Less => wgpu::CompareFunction::Less,
         Depth::Equal => wgpu::CompareFunction::Equal,
     };
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    ctx.device().create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("transparency::shading_pipeline"),
-        layout: Some(scene_pass.layout()),
-        vertex: vertex_state(scene_pass.module()),
+        layout: Some(&ctx.shader.layout),
+        vertex: ctx.shader.vertex(),
         primitive: wgpu::PrimitiveState { cull_mode, ..Default::default() },
         depth_stencil: layout::depth_test(DEPTH_FORMAT, compare, false),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: scene_pass.module(),
+            module: &ctx.shader.module,
             entry_point: Some("fs_transparent"),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             targets: &[Some(wgpu::ColorTargetState {
@@ -463,22 +560,20 @@ fn shading_pipeline(device: &wgpu::Device, scene_pass: &ScenePass, key: Pipeline
 
 /// The depth-only pass of one peel: the farthest surviving fragment wins (`Greater`, cleared to 0).
 fn peel_pipeline(
-    device: &wgpu::Device,
-    scene_pass: &ScenePass,
+    ctx: &FrameContext,
     peel_layout: &wgpu::PipelineLayout,
-    frame: FrameKey,
-    material: MaterialKey,
+    (frame, material): (FrameKey, MaterialKey),
 ) -> wgpu::RenderPipeline {
     let constants = constants(&frame, &material);
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+    ctx.device().create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("transparency::peel_pipeline"),
         layout: Some(peel_layout),
-        vertex: vertex_state(scene_pass.module()),
+        vertex: ctx.shader.vertex(),
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
         depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Greater, true),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: scene_pass.module(),
+            module: &ctx.shader.module,
             entry_point: Some("fs_peel"),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             targets: &[],
@@ -495,7 +590,6 @@ struct PeelTargets {
     first: wgpu::BindGroup,
     /// Layer k's limits: the opaque depth and peel `(k − 1) % 2`.
     below: [wgpu::BindGroup; 2],
-    for_targets: u64,
 }
 
 impl PeelTargets {
@@ -517,7 +611,7 @@ impl PeelTargets {
         };
         let first = group(&targets.depth.view);
         let below = [group(&depth[0].view), group(&depth[1].view)];
-        PeelTargets { depth, first, below, for_targets: targets.generation }
+        PeelTargets { depth, first, below }
     }
 }
 
@@ -526,7 +620,8 @@ impl PeelTargets {
 /// view: buffer writes land before the frame's commands run, so views sharing one would all draw
 /// the last view's order.)
 struct TriangleList {
-    geometry: u64,
+    /// The draw list the triangles were taken from.
+    geometry: DrawListId,
     vertices: wgpu::Buffer,
     /// One identity instance: the vertices are already in world space.
     identity: wgpu::Buffer,
@@ -544,10 +639,12 @@ struct SortedOrder {
     sorted_for: (Vec3, Vec3),
     /// Runs of one material in the sorted index buffer.
     runs: Vec<(usize, Range<u32>)>,
+    /// The triangles in sorted order (indices into the list's triangles).
+    sequence: Vec<u32>,
 }
 
 impl TriangleList {
-    fn new(device: &wgpu::Device, scene: &Scene, objects: &[TransparentObject], geometry: u64) -> TriangleList {
+    fn new(device: &wgpu::Device, scene: &Scene, objects: &[TransparentObject], geometry: DrawListId) -> TriangleList {
         let mut vertices = Vec::new();
         let mut triangles = Vec::new();
         let mut centroids = Vec::new();
@@ -615,6 +712,7 @@ impl TriangleList {
                 queue.write_buffer(&existing.indices, 0, bytemuck::cast_slice(&indices));
                 existing.sorted_for = (eye, forward);
                 existing.runs = runs;
+                existing.sequence = order;
             }
             None => {
                 let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -622,7 +720,8 @@ impl TriangleList {
                     contents: bytemuck::cast_slice(&indices),
                     usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
                 });
-                self.orders.insert(slot, SortedOrder { indices, sorted_for: (eye, forward), runs });
+                let sorted = SortedOrder { indices, sorted_for: (eye, forward), runs, sequence: order };
+                self.orders.insert(slot, sorted);
             }
         }
         true

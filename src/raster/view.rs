@@ -1,7 +1,7 @@
 //! Views: a camera as one pass sees it. One frame draws the scene from several cameras (the main
-//! camera, each light's view for pass 1 of the shadow maps, and, as their techniques land,
-//! mirrored cameras and the six faces of environment cubes), so each view has its own slot in one
-//! uniform buffer, chosen per pass by a dynamic offset of group 0.
+//! camera, each light's view for pass 1 of the shadow maps, mirrored cameras and the six faces of
+//! environment cubes), so each view has its own slot in one uniform buffer, chosen per pass by a
+//! dynamic offset of group 0.
 //!
 //! Slots are written with `queue.write_buffer` before the frame's commands are submitted: every
 //! pass of the frame reads its own slot, so no write can overtake another within the frame.
@@ -65,38 +65,46 @@ impl View {
     }
 }
 
-/// Where each view of a frame lives in the view buffer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ViewSlot {
-    /// The scene camera.
+/// Where a view lives in the frame's view buffer: an index the frame's plan hands out, one per
+/// camera drawn this frame (the main camera, each shadow-map layer drawn, each mirrored camera,
+/// each cube face).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ViewSlot(pub u32);
+
+/// Slots one frame can hold: the main camera, 24 shadow-map layers, 32 mirrored cameras and the
+/// faces of 8 cubes fit with room to spare (the plan checks its views against it).
+pub const VIEW_SLOTS: u32 = 128;
+
+/// What kind of camera a view is, and what it is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViewKind {
+    /// The scene's camera.
     Main,
-    /// Layer `n` of the shadow maps.
-    ShadowLayer(u32),
-    /// The `n`th mirrored camera of the frame (`super::mirror`).
-    Mirror(u32),
-    /// Face `n % 6` of dynamic environment cube `n / 6` (`super::environment`).
-    Cube(u32),
+    /// The mirrored camera of node `n` of the mirror tree (`super::mirror::pass`).
+    Mirror(usize),
+    /// Face `face` of the dynamic environment cube of the object with cube layer `cube`.
+    CubeFace { cube: usize, face: usize },
 }
 
-impl ViewSlot {
-    fn index(self) -> u64 {
-        match self {
-            ViewSlot::Main => 0,
-            ViewSlot::ShadowLayer(layer) => 1 + u64::from(layer),
-            ViewSlot::Mirror(n) => 1 + super::shadow::views::MAX_LAYERS as u64 + u64::from(n),
-            ViewSlot::Cube(n) => 1 + super::shadow::views::MAX_LAYERS as u64 + MAX_MIRROR_VIEWS as u64 + u64::from(n),
-        }
-    }
+/// One camera of the frame, as every per-view phase (opaque, volumes, transparent) draws it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameView {
+    pub kind: ViewKind,
+    pub slot: ViewSlot,
+    pub view: View,
+    /// The toggles its shading variants are compiled with.
+    pub key: super::keys::FrameKey,
+    /// The object the view looks out of, left out of it: the mirror a mirrored camera looks
+    /// through (it lies on the view's near plane), or the object a cube is drawn from.
+    pub skip: Option<usize>,
+    /// Draw only inside `[x, y, width, height]` of the targets; `None`: everywhere.
+    pub scissor: Option<[u32; 4]>,
+    /// Draw a depth prepass first, then shade only the nearest surface.
+    pub prepass: bool,
+    /// Draw object-precision shadows into the targets' mask (the main view of the projected
+    /// method: the mask holds that view's pixels).
+    pub projected: bool,
 }
-
-/// Slots for every view a frame can hold.
-pub const VIEW_SLOTS: u64 = 1
-    + super::shadow::views::MAX_LAYERS as u64
-    + MAX_MIRROR_VIEWS as u64
-    + 6 * super::environment::MAX_ENV_CUBES as u64;
-
-/// The most mirrored cameras one frame draws (mirrors that see each other, at every depth).
-pub const MAX_MIRROR_VIEWS: u32 = 32;
 
 /// The eight world-space corners of the volume a `clip_from_world` matrix sees (`x, y` = ±1,
 /// `z` = 0 or 1), corner `k` with bit 0 for `x`, bit 1 for `y`, bit 2 for `z`.
@@ -122,7 +130,7 @@ impl ViewBuffer {
         let stride = (std::mem::size_of::<GpuView>() as u64).next_multiple_of(alignment);
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("view::buffer"),
-            size: stride * VIEW_SLOTS,
+            size: stride * u64::from(VIEW_SLOTS),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -130,12 +138,12 @@ impl ViewBuffer {
     }
 
     pub fn write(&self, queue: &wgpu::Queue, slot: ViewSlot, view: &View) {
-        queue.write_buffer(&self.buffer, slot.index() * self.stride, bytemuck::bytes_of(&view.to_gpu()));
+        queue.write_buffer(&self.buffer, u64::from(slot.0) * self.stride, bytemuck::bytes_of(&view.to_gpu()));
     }
 
     /// The dynamic offset that selects `slot` in group 0.
     pub fn offset(&self, slot: ViewSlot) -> u32 {
-        (slot.index() * self.stride) as u32
+        (u64::from(slot.0) * self.stride) as u32
     }
 
     /// The binding of one slot (a dynamic-offset uniform of one view's size).

@@ -3,18 +3,20 @@
 //!
 //! Per scene, each volume's normalized field becomes a 3D texture (`R16Float`, filterable, so the
 //! hardware does the nearest or trilinear reconstruction) and its transfer function a 256 × 1
-//! table. Per frame, after the opaque surfaces and before the transparent ones, the frame's depth
-//! is copied (the pass reads it to end each ray at the opaque surface while the isosurfaces write
-//! their own), and each volume's box is drawn: back faces only, so a camera inside the box still
-//! marches it. Composited volumes blend `C + (1 − α)·L_behind` (One, OneMinusSrcAlpha);
-//! isosurfaces replace the pixel and write their depth, so transparent surfaces behind them are
-//! hidden.
+//! table ([`VolumePass::load`]). In every view (the main camera, mirrored cameras, cube faces),
+//! each volume's box is drawn, back faces only, so a camera inside the box still marches it:
+//! - **isosurfaces** with the opaque surfaces ([`PreparedVolumes::record_isosurfaces`]): the
+//!   view's depth is copied, rays end at it, and each crossing writes its colour and depth like
+//!   any surface, so what lies behind it is hidden;
+//! - **composited volumes** in the transparency pass's order ([`PreparedVolumes::composite`]):
+//!   each ray is marched over the span the order gives it (between two peeled transparent layers,
+//!   or whole) and blended `C + (1 − α)·L_behind` (One, OneMinusSrcAlpha).
 //!
 //! Where the rasterizer differs from the tracer, and why:
-//! - volumes are drawn in the main view only: planar mirrors and environment cubes do not show
-//!   them, and an isosurface shows its local model without mirror reflections;
-//! - the field is stored as 16-bit floats (about 3 decimal digits of the normalized value), and a
-//!   transparent surface behind a composited volume is drawn over it, not behind it;
+//! - an isosurface shows its local model without mirror reflections;
+//! - the field is stored as 16-bit floats (about 3 decimal digits of the normalized value);
+//! - with the sorted transparency orders a volume is placed among the transparent surfaces by its
+//!   centre, whole; only `exact` cuts each ray at every transparent layer as the tracer does;
 //! - early termination ends the march, but the blend still adds the last `1 − α` of what is
 //!   behind, which the tracer leaves out.
 //!
@@ -22,15 +24,17 @@
 //! warning: the rasterizer then shows a coarser field than the tracer.
 
 use std::collections::HashMap;
-use std::sync::Mutex;
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, UVec3, Vec3};
 
-use super::scene_gpu::{SceneGpu, SceneLayouts};
-use super::scene_pass::{FrameKey, MaterialKey, ScenePass, constants};
-use super::view::ViewSlot;
-use super::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
+use super::context::{Figure, FrameContext, FrameEncoder};
+use super::keys::{FrameKey, MaterialKey, constants};
+use super::scene_gpu::{SceneLayouts, SceneShader};
+use super::scene_pass::scissor;
+use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
+use super::view::FrameView;
+use crate::gpu::Gpu;
 use crate::gpu::layout;
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::uniform::UniformBuffer;
@@ -59,7 +63,8 @@ pub struct GpuVolume {
 }
 
 /// The volume pipelines' own `override`s in `shaders/volume.wgsl`, besides the scene's.
-pub const VOLUME_CONSTANT_NAMES: [&str; 2] = ["VOLUME_GRADIENT", "VOLUME_SHADOWS"];
+pub const VOLUME_CONSTANT_NAMES: [&str; 4] =
+    ["VOLUME_GRADIENT", "VOLUME_SHADOWS", "VOLUME_FAR_LIMIT", "VOLUME_NEAR_LIMIT"];
 
 /// `VOLUME_GRADIENT` codes.
 pub const VOLUME_GRADIENT_NAMES: [(&str, VolumeGradient); 3] = [
@@ -83,13 +88,7 @@ pub struct VolumeGpu {
     uniform: UniformBuffer<GpuVolume>,
     /// The grid the texture holds (smaller than the scene's when it was resampled to fit).
     grid_on_gpu: Grid,
-    /// Group 3, kept while the depth copy and the reconstruction it was made for stay.
-    group: Mutex<Option<(GroupKey, wgpu::BindGroup)>>,
 }
-
-/// What a volume's group 3 depends on besides the volume: the depth copy (by its generation) and
-/// the sampler.
-type GroupKey = (u64, VolumeReconstruction);
 
 impl VolumeGpu {
     pub fn upload(device: &wgpu::Device, queue: &wgpu::Queue, volume: &Volume) -> VolumeGpu {
@@ -143,7 +142,6 @@ impl VolumeGpu {
             table: table.create_view(&Default::default()),
             uniform,
             grid_on_gpu: grid,
-            group: Mutex::new(None),
         }
     }
 
@@ -191,9 +189,27 @@ fn fit_to_limit(grid: &Grid, limit: u32, name: &str) -> Grid {
     Grid { dims, spacing: grid.spacing * scale, values }
 }
 
-/// What tells the pass's pipelines apart: the frame's toggles (shadows), the gradient, whether
-/// samples are shadowed, and the rendering.
-type PipelineKey = (FrameKey, u32, bool, bool);
+/// Which composited volumes a span is for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VolumeSet {
+    All,
+    One(usize),
+}
+
+/// The part of every camera ray of a view that composited volumes are marched over: from the
+/// depth image `near` (the camera when `None`) to the nearer of the opaque surface and `far`
+/// (the opaque surface when `None`). Depth 0 in `near` means no bound there.
+#[derive(Clone, Copy, Debug)]
+pub struct RaySpan<'a> {
+    pub volumes: VolumeSet,
+    pub near: Option<&'a wgpu::TextureView>,
+    pub far: Option<&'a wgpu::TextureView>,
+}
+
+/// What tells the pass's pipelines apart: the view's toggles (shadows), the gradient, whether
+/// samples are shadowed, the rendering, whether the view is mirrored (its back faces are the
+/// other winding), and which limits bound the rays (far, near).
+type PipelineKey = (FrameKey, u32, bool, bool, bool, (bool, bool));
 
 pub struct VolumePass {
     group_layout: wgpu::BindGroupLayout,
@@ -201,18 +217,22 @@ pub struct VolumePass {
     pipelines: HashMap<PipelineKey, wgpu::RenderPipeline>,
     nearest: wgpu::Sampler,
     trilinear: wgpu::Sampler,
-    /// A copy of the frame's depth: where each ray meets the opaque surfaces; and how many have
-    /// been made (the volumes' groups name the one they read).
-    depth_copy: Option<GpuTexture>,
-    depth_copies: u64,
+    /// Each volume of the scene, made by [`Self::load`].
+    volumes: Vec<VolumeGpu>,
+    /// A copy of each view's depth (by the view's depth image), which isosurfaces read while
+    /// they write the depth itself; kept while those targets are drawn into.
+    depth_copies: Vec<(wgpu::TextureView, GpuTexture)>,
 }
 
 impl VolumePass {
-    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts) -> VolumePass {
+    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SceneShader) -> VolumePass {
+        let depth = |binding| layout::texture(binding, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2);
         let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("volume::group_layout"),
             entries: &[
-                layout::texture(0, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2),
+                depth(0),
+                depth(1),
+                depth(3),
                 layout::uniform(4, wgpu::ShaderStages::VERTEX_FRAGMENT),
                 layout::texture(5, wgpu::TextureSampleType::Float { filterable: true }, wgpu::TextureViewDimension::D3),
                 layout::sampler(6, wgpu::SamplerBindingType::Filtering),
@@ -223,16 +243,7 @@ impl VolumePass {
                 ),
             ],
         });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("volume::layout"),
-            bind_group_layouts: &[
-                Some(&layouts.frame),
-                Some(&layouts.material),
-                Some(&layouts.lighting),
-                Some(&group_layout),
-            ],
-            immediate_size: 0,
-        });
+        let layout = shader.layout_with(device, layouts, "volume::layout", &group_layout);
         let sampler = |label, filter| {
             device.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some(label),
@@ -247,18 +258,28 @@ impl VolumePass {
             pipelines: HashMap::new(),
             nearest: sampler("volume::nearest", wgpu::FilterMode::Nearest),
             trilinear: sampler("volume::trilinear", wgpu::FilterMode::Linear),
-            depth_copy: None,
-            depth_copies: 0,
+            volumes: Vec::new(),
+            depth_copies: Vec::new(),
         }
     }
 
-    fn pipeline(&mut self, device: &wgpu::Device, scene_pass: &ScenePass, key: PipelineKey) -> &wgpu::RenderPipeline {
+    /// Uploads every volume of `scene`, in place of the last scene's.
+    pub fn load(&mut self, gpu: &Gpu, scene: &Scene) {
+        self.volumes = scene.volumes.iter().map(|v| VolumeGpu::upload(&gpu.device, &gpu.queue, v)).collect();
+    }
+
+    fn pipeline(&mut self, ctx: &FrameContext, key: PipelineKey) {
         let layout = &self.layout;
         self.pipelines.entry(key).or_insert_with(|| {
-            let (frame, gradient, shadows, isosurface) = key;
+            let (frame, gradient, shadows, isosurface, mirrored, (far, near)) = key;
+            let flag = |b: bool| f64::from(u8::from(b));
             let mut constants: Vec<(&str, f64)> = constants(&frame, &MaterialKey::default()).to_vec();
-            constants
-                .extend(VOLUME_CONSTANT_NAMES.into_iter().zip([f64::from(gradient), f64::from(u8::from(shadows))]));
+            constants.extend(VOLUME_CONSTANT_NAMES.into_iter().zip([
+                f64::from(gradient),
+                flag(shadows),
+                flag(far),
+                flag(near),
+            ]));
             let blend = (!isosurface).then_some(wgpu::BlendState {
                 color: wgpu::BlendComponent {
                     src_factor: wgpu::BlendFactor::One,
@@ -267,11 +288,14 @@ impl VolumePass {
                 },
                 alpha: wgpu::BlendComponent::OVER,
             });
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            // Back faces only: a camera inside the box still sees them. A mirrored view's winding
+            // is the other way round.
+            let cull_mode = Some(if mirrored { wgpu::Face::Back } else { wgpu::Face::Front });
+            ctx.device().create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("volume::pipeline"),
                 layout: Some(layout),
                 vertex: wgpu::VertexState {
-                    module: scene_pass.module(),
+                    module: &ctx.shader.module,
                     entry_point: Some("vs_volume"),
                     compilation_options: wgpu::PipelineCompilationOptions {
                         constants: &constants,
@@ -279,12 +303,15 @@ impl VolumePass {
                     },
                     buffers: &[],
                 },
-                // Back faces: a camera inside the box still sees them.
-                primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Front), ..Default::default() },
-                depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Always, isosurface),
+                primitive: wgpu::PrimitiveState { cull_mode, ..Default::default() },
+                // Isosurfaces write their depth, tested by hand against the copy; composited
+                // volumes read the view's depth itself and draw with no depth attachment.
+                depth_stencil: isosurface
+                    .then(|| layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Always, true))
+                    .flatten(),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
-                    module: scene_pass.module(),
+                    module: &ctx.shader.module,
                     entry_point: Some(if isosurface { "fs_volume_isosurface" } else { "fs_volume_composite" }),
                     compilation_options: wgpu::PipelineCompilationOptions {
                         constants: &constants,
@@ -299,90 +326,177 @@ impl VolumePass {
                 multiview_mask: None,
                 cache: None,
             })
+        });
+    }
+
+    /// Writes each volume's uniform for the frame's settings, compiles the pipelines `views`
+    /// need and makes the depth copies of their targets.
+    pub fn prepare<'p>(&'p mut self, ctx: &FrameContext, views: &[(&FrameView, &FrameTargets)]) -> PreparedVolumes<'p> {
+        let settings = &ctx.settings.volume;
+        let drawn = settings.enabled && !self.volumes.is_empty();
+        let renderings: Vec<Rendering> = ctx.scene.volumes.iter().map(|v| v.rendering(settings)).collect();
+        if drawn {
+            for (volume, gpu) in ctx.scene.volumes.iter().zip(&self.volumes) {
+                gpu.uniform.write(ctx.queue(), &gpu.uniform_of(volume, settings));
+            }
+            let gradient = gradient_code(settings.gradient);
+            let isosurfaces = renderings.contains(&Rendering::Isosurface);
+            for &(view, targets) in views {
+                let key =
+                    |isosurface, limits| (view.key, gradient, settings.shadows, isosurface, view.view.mirrored, limits);
+                if isosurfaces {
+                    self.pipeline(ctx, key(true, (false, false)));
+                    if !self.depth_copies.iter().any(|(depth, _)| *depth == targets.depth.view) {
+                        let copy = depth_copy_target(ctx.device(), targets.size);
+                        self.depth_copies.push((targets.depth.view.clone(), copy));
+                    }
+                }
+                if renderings.contains(&Rendering::Composite) {
+                    for limits in [(false, false), (false, true), (true, true), (true, false)] {
+                        self.pipeline(ctx, key(false, limits));
+                    }
+                }
+            }
+        }
+        self.depth_copies.retain(|(depth, _)| views.iter().any(|(_, t)| t.depth.view == *depth));
+        PreparedVolumes { pass: self, renderings, drawn }
+    }
+}
+
+/// The volume pass ready to draw the frame's views.
+pub struct PreparedVolumes<'p> {
+    pass: &'p VolumePass,
+    /// How each volume of the scene is drawn this frame.
+    renderings: Vec<Rendering>,
+    /// Volumes are on and the scene has some.
+    drawn: bool,
+}
+
+impl PreparedVolumes<'_> {
+    fn key(&self, ctx: &FrameContext, view: &FrameView, isosurface: bool, limits: (bool, bool)) -> PipelineKey {
+        let settings = &ctx.settings.volume;
+        (view.key, gradient_code(settings.gradient), settings.shadows, isosurface, view.view.mirrored, limits)
+    }
+
+    /// Group 3 of volume `index`: the depth its rays end at (`depth`), the transparent layers
+    /// that bound them (`far`, `near`), and the volume's field, sampler and transfer table.
+    fn group(
+        &self,
+        ctx: &FrameContext,
+        index: usize,
+        depth: &wgpu::TextureView,
+        (far, near): (&wgpu::TextureView, &wgpu::TextureView),
+    ) -> wgpu::BindGroup {
+        let gpu = &self.pass.volumes[index];
+        let sampler = match ctx.settings.volume.reconstruction {
+            VolumeReconstruction::Nearest => &self.pass.nearest,
+            VolumeReconstruction::Trilinear => &self.pass.trilinear,
+        };
+        let texture =
+            |binding, view| wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(view) };
+        ctx.device().create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("volume::group"),
+            layout: &self.pass.group_layout,
+            entries: &[
+                texture(0, depth),
+                texture(1, far),
+                texture(3, near),
+                wgpu::BindGroupEntry { binding: 4, resource: gpu.uniform.binding() },
+                texture(5, &gpu.field),
+                wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(sampler) },
+                texture(7, &gpu.table),
+            ],
         })
     }
 
-    /// Draws every volume of `scene` over the main view's opaque image in `targets`.
-    #[allow(clippy::too_many_arguments)]
-    pub fn record(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
-        scene_pass: &ScenePass,
-        scene: &Scene,
-        scene_gpu: &SceneGpu,
-        lighting: &wgpu::BindGroup,
-        frame: FrameKey,
+    /// Draws the view's isosurfaces over its opaque image, writing their depth.
+    pub fn record_isosurfaces(
+        &self,
+        ctx: &FrameContext,
+        frame: &mut FrameEncoder,
+        view: &FrameView,
         targets: &FrameTargets,
-        settings: &VolumeSettings,
     ) {
-        let gradient = gradient_code(settings.gradient);
-        let keys: Vec<PipelineKey> = scene
-            .volumes
-            .iter()
-            .map(|volume| {
-                let isosurface = volume.rendering(settings) == Rendering::Isosurface;
-                (frame, gradient, settings.shadows, isosurface)
-            })
-            .collect();
-        for &key in &keys {
-            self.pipeline(device, scene_pass, key);
+        let isosurfaces: Vec<usize> =
+            (0..self.renderings.len()).filter(|&i| self.renderings[i] == Rendering::Isosurface).collect();
+        if !self.drawn || isosurfaces.is_empty() {
+            return;
         }
-        let size = targets.size;
-        if self.depth_copy.as_ref().is_none_or(|d| (d.texture.width(), d.texture.height()) != size) {
-            self.depth_copy = Some(depth_copy_target(device, size));
-            self.depth_copies += 1;
-        }
-        let depth_copy = self.depth_copy.as_ref().expect("made above");
-        encoder.copy_texture_to_texture(
+        let copy = self.pass.depth_copies.iter().find(|(depth, _)| *depth == targets.depth.view);
+        let copy = &copy.expect("VolumePass::prepare made a copy for every view").1;
+        frame.encoder.copy_texture_to_texture(
             targets.depth.texture.as_image_copy(),
-            depth_copy.texture.as_image_copy(),
+            copy.texture.as_image_copy(),
             targets.depth.texture.size(),
         );
-        let sampler = match settings.reconstruction {
-            VolumeReconstruction::Nearest => &self.nearest,
-            VolumeReconstruction::Trilinear => &self.trilinear,
-        };
-        let group_key = (self.depth_copies, settings.reconstruction);
-        let mut draws = Vec::new();
-        for ((volume, gpu), key) in scene.volumes.iter().zip(&scene_gpu.volumes).zip(keys) {
-            gpu.uniform.write(queue, &gpu.uniform_of(volume, settings));
-            let mut group = gpu.group.lock().expect("no panics while the lock is held");
-            if group.as_ref().is_none_or(|(k, _)| *k != group_key) {
-                let made = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some("volume::group"),
-                    layout: &self.group_layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: wgpu::BindingResource::TextureView(&depth_copy.view),
-                        },
-                        wgpu::BindGroupEntry { binding: 4, resource: gpu.uniform.binding() },
-                        wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&gpu.field) },
-                        wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(sampler) },
-                        wgpu::BindGroupEntry { binding: 7, resource: wgpu::BindingResource::TextureView(&gpu.table) },
-                    ],
-                });
-                *group = Some((group_key, made));
-            }
-            let (_, group) = group.as_ref().expect("made above");
-            draws.push((key, group.clone(), volume.material.0));
-        }
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("volume::pass"),
+        let groups: Vec<wgpu::BindGroup> =
+            isosurfaces.iter().map(|&i| self.group(ctx, i, &copy.view, (&copy.view, &copy.view))).collect();
+        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("volume::isosurfaces"),
             color_attachments: &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
             depth_stencil_attachment: Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_bind_group(0, scene_gpu.frame_group(), &[scene_gpu.views.offset(ViewSlot::Main)]);
-        pass.set_bind_group(2, lighting, &[]);
-        for (key, group, material) in &draws {
-            pass.set_pipeline(&self.pipelines[key]);
-            pass.set_bind_group(1, &scene_gpu.materials()[*material], &[]);
-            pass.set_bind_group(3, group, &[]);
+        scissor(&mut pass, view);
+        pass.set_pipeline(&self.pass.pipelines[&self.key(ctx, view, true, (false, false))]);
+        self.draw(ctx, &mut pass, view, isosurfaces.iter().copied().zip(groups));
+        drop(pass);
+        frame.end("volumes", &[("isosurfaces", Figure::Count(isosurfaces.len() as u64))]);
+    }
+
+    /// Marches the composited volumes of `span` over that part of every ray of the view, blended
+    /// over what the view's targets hold.
+    pub fn composite(
+        &self,
+        ctx: &FrameContext,
+        frame: &mut FrameEncoder,
+        view: &FrameView,
+        targets: &FrameTargets,
+        span: RaySpan,
+    ) {
+        let chosen = |i: usize| match span.volumes {
+            VolumeSet::All => true,
+            VolumeSet::One(one) => one == i,
+        };
+        let volumes: Vec<usize> =
+            (0..self.renderings.len()).filter(|&i| self.renderings[i] == Rendering::Composite && chosen(i)).collect();
+        if !self.drawn || volumes.is_empty() {
+            return;
+        }
+        let depth = &targets.depth.view;
+        let limits = (span.far.is_some(), span.near.is_some());
+        let bounds = (span.far.unwrap_or(depth), span.near.unwrap_or(depth));
+        let groups: Vec<wgpu::BindGroup> = volumes.iter().map(|&i| self.group(ctx, i, depth, bounds)).collect();
+        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("volume::composite"),
+            color_attachments: &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        scissor(&mut pass, view);
+        pass.set_pipeline(&self.pass.pipelines[&self.key(ctx, view, false, limits)]);
+        self.draw(ctx, &mut pass, view, volumes.iter().copied().zip(groups));
+        drop(pass);
+        frame.end("volumes", &[("composited", Figure::Count(volumes.len() as u64))]);
+    }
+
+    fn draw(
+        &self,
+        ctx: &FrameContext,
+        pass: &mut wgpu::RenderPass<'_>,
+        view: &FrameView,
+        volumes: impl Iterator<Item = (usize, wgpu::BindGroup)>,
+    ) {
+        let scene_gpu = ctx.scene_gpu;
+        pass.set_bind_group(0, scene_gpu.frame_group(), &[scene_gpu.views.offset(view.slot)]);
+        pass.set_bind_group(2, ctx.lighting, &[]);
+        for (index, group) in volumes {
+            pass.set_bind_group(1, &scene_gpu.materials()[ctx.scene.volumes[index].material.0], &[]);
+            pass.set_bind_group(3, &group, &[]);
             pass.draw(0..36, 0..1);
         }
     }

@@ -11,7 +11,6 @@ use std::time::{Duration, Instant};
 
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::{Gpu, readback};
-use crate::raster::scene_gpu::SceneGpu;
 use crate::raster::{FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer};
 use crate::{RenderSettings, Scene};
 
@@ -20,8 +19,7 @@ const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 pub struct RasterView {
     renderer: Renderer,
-    scene_gpu: SceneGpu,
-    /// The scene revision `scene_gpu` was uploaded from.
+    /// The scene revision the renderer loaded.
     revision: u64,
     /// Everything that depends on the image size.
     frame: Option<SizedTargets>,
@@ -46,8 +44,7 @@ struct SizedTargets {
 
 impl RasterView {
     pub fn new(gpu: &Gpu, egui_renderer: &mut egui_wgpu::Renderer, scene: &Scene, revision: u64) -> RasterView {
-        let renderer = Renderer::new(&gpu.device, OUTPUT_FORMAT);
-        let scene_gpu = renderer.upload(gpu, scene);
+        let renderer = Renderer::new(gpu, scene, OUTPUT_FORMAT);
         let placeholder = display_texture(&gpu.device, (1, 1));
         let view = placeholder.create_view(&wgpu::TextureViewDescriptor {
             label: Some("viewer::raster::placeholder_view"),
@@ -56,7 +53,6 @@ impl RasterView {
         let texture_id = egui_renderer.register_native_texture(&gpu.device, &view, wgpu::FilterMode::Nearest);
         RasterView {
             renderer,
-            scene_gpu,
             revision,
             frame: None,
             texture_id,
@@ -84,7 +80,7 @@ impl RasterView {
         timed: bool,
     ) -> (egui::TextureId, Option<Duration>) {
         if revision != self.revision {
-            self.scene_gpu = self.renderer.upload(gpu, scene);
+            self.renderer.load(gpu, scene);
             self.revision = revision;
         }
         let size = (scene.camera.width, scene.camera.height);
@@ -94,8 +90,7 @@ impl RasterView {
         let frame = self.frame.as_mut().expect("made just above");
         let start = Instant::now();
         self.renderer.profile = timed;
-        self.report =
-            self.renderer.render(gpu, scene, &mut self.scene_gpu, settings, &mut frame.targets, &frame.output.view);
+        self.report = self.renderer.render(gpu, scene, settings, &mut frame.targets, &frame.output.view);
         let mut encoder =
             gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer::raster::copy") });
         encoder.copy_texture_to_texture(
@@ -121,7 +116,7 @@ impl RasterView {
     }
 
     fn sized_targets(&self, gpu: &Gpu, size: (u32, u32)) -> SizedTargets {
-        let targets = self.renderer.targets(&gpu.device, size);
+        let targets = FrameTargets::new(&gpu.device, size);
         // The renderer remakes the targets itself when `raster.render_scale` asks for less.
         let output = GpuTexture::target(&gpu.device, "viewer::raster::output", size, OUTPUT_FORMAT);
         let display = display_texture(&gpu.device, size);

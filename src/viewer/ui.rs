@@ -29,8 +29,8 @@ pub struct UiModel<'a> {
     /// The key of the request the current view shows (to tell stale traced images).
     pub key: u64,
     pub stats: &'a FrameStats,
-    /// The rasterizer's passes and their times in the last frame.
-    pub passes: &'a [(&'static str, std::time::Duration)],
+    /// The rasterizer's passes in the last frame: their times (when timed) and figures.
+    pub passes: &'a [crate::raster::PassReport],
     /// The render scale of this frame's raster image.
     pub scale: f32,
     pub camera_error: &'a mut Option<String>,
@@ -375,8 +375,14 @@ fn divider(ui: &mut egui::Ui, model: &mut UiModel, rect: Rect, x: f32) {
 /// corner.
 fn overlay(ui: &egui::Ui, model: &UiModel, rect: Rect) {
     let mut text = model.stats.overlay_text(model.scale);
-    for (name, time) in model.passes {
-        text += &format!("\n  {name} {:.1} ms", time.as_secs_f64() * 1e3);
+    for pass in model.passes {
+        text += &format!("\n  {}", pass.name);
+        if let Some(time) = pass.time {
+            text += &format!(" {:.1} ms", time.as_secs_f64() * 1e3);
+        }
+        for (figure, value) in &pass.figures {
+            text += &format!(", {figure} {value}");
+        }
     }
     text += &format!(
         "\nview: {}  ({})",

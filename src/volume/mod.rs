@@ -68,6 +68,12 @@ pub struct Volume {
 }
 
 impl Volume {
+    /// The centre of the volume's box in the world: where the sorted transparency orders place
+    /// it among transparent surfaces.
+    pub fn centre(&self) -> glam::Vec3 {
+        self.world_from_local.transform_point3(glam::Vec3::ZERO)
+    }
+
     /// The rendering the settings ask for: the volume's own, or every volume composited or shown
     /// as its isosurface.
     pub fn rendering(&self, settings: &VolumeSettings) -> Rendering {

@@ -27,6 +27,9 @@ use std::hash::{Hash, Hasher};
 
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
+pub mod pass;
+
+use super::targets::HDR_FORMAT;
 use super::uniforms::{ENV_CUBE, ENV_LATLONG, ENV_NONE, ENV_SKY, ENV_SPHERE, GpuEnvironment, mat3_columns};
 use super::view::View;
 use crate::gpu::layout;
@@ -134,8 +137,9 @@ pub fn capture_range(inner: f32, bounds: Option<(Vec3, Vec3)>) -> (f32, f32) {
     ((0.5 * inner).max(1e-5 * diagonal), 4.0 * diagonal)
 }
 
-/// The passes that make maps and draw the teaching views. Built once per device.
-pub struct EnvironmentPass {
+/// The pipelines that make maps from the world's source and draw them as teaching views. Built
+/// once per device.
+pub struct Converter {
     group_layout: wgpu::BindGroupLayout,
     to_cube: wgpu::RenderPipeline,
     to_latlong: wgpu::RenderPipeline,
@@ -147,8 +151,8 @@ pub struct EnvironmentPass {
     pub sampler: wgpu::Sampler,
 }
 
-impl EnvironmentPass {
-    pub fn new(device: &wgpu::Device) -> EnvironmentPass {
+impl Converter {
+    pub fn new(device: &wgpu::Device) -> Converter {
         let module = shaders::module(device, "environment::shader", shaders::ENVIRONMENT);
         let filterable = wgpu::TextureSampleType::Float { filterable: true };
         let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -175,8 +179,8 @@ impl EnvironmentPass {
                 &[Some(format.into())],
             )
         };
-        let hdr = super::HDR_FORMAT;
-        EnvironmentPass {
+        let hdr = HDR_FORMAT;
+        Converter {
             to_cube: pipeline("fs_to_cube", ENV_FORMAT),
             to_latlong: pipeline("fs_to_latlong", ENV_FORMAT),
             to_sphere: pipeline("fs_to_sphere", ENV_FORMAT),
@@ -389,8 +393,6 @@ pub struct EnvironmentMaps {
     /// What the dynamic cubes were drawn from, and the frames since.
     captured: Option<u64>,
     frames_since_capture: u32,
-    /// Changes whenever a texture is remade: the scene pass's groups are remade with it.
-    pub generation: u64,
 }
 
 impl EnvironmentMaps {
@@ -399,7 +401,7 @@ impl EnvironmentMaps {
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        pass: &EnvironmentPass,
+        pass: &Converter,
         mipmaps: &MipmapGenerator,
         scene: &Scene,
         cube_size: u32,
@@ -464,14 +466,14 @@ impl EnvironmentMaps {
         if !matches!(source, Some(EnvironmentSource::Cube(_))) {
             let group = pass.group(device, &params, source_2d, &stand_in_cube.view);
             for face in 0..6 {
-                EnvironmentPass::draw(&mut encoder, &pass.to_cube, &group, &cube.layer(face), face);
+                Converter::draw(&mut encoder, &pass.to_cube, &group, &cube.layer(face), face);
             }
             mipmaps.record(device, &mut encoder, &cube.texture);
         }
         // Reads the source, or the world's cube made from it (what the sphere map is made from).
         let reads_world = pass.group(device, &params, &sphere_source.view, &cube.view);
         if !matches!(source, Some(EnvironmentSource::LatLong(_))) {
-            EnvironmentPass::draw(&mut encoder, &pass.to_latlong, &reads_world, &latlong.layer(0), 0);
+            Converter::draw(&mut encoder, &pass.to_latlong, &reads_world, &latlong.layer(0), 0);
             mipmaps.record(device, &mut encoder, &latlong.texture);
         }
         let sphere =
@@ -491,7 +493,7 @@ impl EnvironmentMaps {
             let group = pass.group(device, &params, source_2d, &cube.view);
             for layer in 0..layers {
                 // The world's radiance at the dynamic cube's texels.
-                EnvironmentPass::draw(&mut encoder, &pass.to_cube, &group, &dynamic.layer(layer), layer % 6);
+                Converter::draw(&mut encoder, &pass.to_cube, &group, &dynamic.layer(layer), layer % 6);
             }
             mipmaps.record(device, &mut encoder, &dynamic.texture);
         }
@@ -516,7 +518,6 @@ impl EnvironmentMaps {
             sphere_made_for: None,
             captured: None,
             frames_since_capture: 0,
-            generation: next_generation(),
         }
     }
 
@@ -527,7 +528,7 @@ impl EnvironmentMaps {
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        pass: &EnvironmentPass,
+        pass: &Converter,
         mipmaps: &MipmapGenerator,
         settings: &RenderSettings,
         rotation: Mat3,
@@ -556,7 +557,7 @@ impl EnvironmentMaps {
             // The map is made from the world's cube, for the view `made_for`.
             let mut encoder =
                 device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("environment::sphere") });
-            EnvironmentPass::draw(&mut encoder, &pass.to_sphere, &self.reads_world, &self.sphere.layer(0), 0);
+            Converter::draw(&mut encoder, &pass.to_sphere, &self.reads_world, &self.sphere.layer(0), 0);
             mipmaps.record(device, &mut encoder, &self.sphere.texture);
             queue.submit([encoder.finish()]);
         }
@@ -597,27 +598,23 @@ impl EnvironmentMaps {
     /// Draws the teaching view `view` over `target` (a frame of `size` pixels), inset in its
     /// corner or over all of it ([`view_rect`]): the cube unfolded (object 0's dynamic cube when
     /// it has one, else the world's), the sphere map or the lat–long map.
-    #[allow(clippy::too_many_arguments)]
     pub fn record_view(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        pass: &EnvironmentPass,
-        view: EnvironmentView,
-        dynamic: bool,
-        inset: bool,
-        target: &wgpu::TextureView,
-        size: (u32, u32),
+        pass: &Converter,
+        settings: &crate::settings::EnvironmentSettings,
+        (target, size): (&wgpu::TextureView, (u32, u32)),
     ) {
         let aspect = |map: &MapTexture| map.texture.width() as f32 / map.texture.height() as f32;
-        let (pipeline, group, aspect) = match view {
+        let (pipeline, group, aspect) = match settings.view {
             EnvironmentView::Off => return,
-            EnvironmentView::Cross if dynamic => (&pass.view_cross, &self.views.cross_dynamic, 4.0 / 3.0),
+            EnvironmentView::Cross if settings.dynamic => (&pass.view_cross, &self.views.cross_dynamic, 4.0 / 3.0),
             EnvironmentView::Cross => (&pass.view_cross, &self.views.cross_world, 4.0 / 3.0),
             EnvironmentView::Sphere => (&pass.view_image, &self.views.sphere, aspect(&self.sphere)),
             EnvironmentView::Latlong => (&pass.view_image, &self.views.latlong, aspect(&self.latlong)),
         };
-        let viewport = inset.then(|| view_rect(size, aspect, true));
-        EnvironmentPass::draw_into(encoder, pipeline, group, target, 0, viewport);
+        let viewport = settings.inset.then(|| view_rect(size, aspect, true));
+        Converter::draw_into(encoder, pipeline, group, target, 0, viewport);
     }
 }
 
@@ -667,11 +664,6 @@ fn world_uniform(scene: &Scene) -> GpuEnvironment {
         EnvironmentSource::Sphere(_) => ENV_SPHERE,
     };
     gpu
-}
-
-fn next_generation() -> u64 {
-    static GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
-    GENERATION.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 /// What the dynamic cubes see, hashed: every object's transform, every material, light and

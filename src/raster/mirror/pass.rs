@@ -21,10 +21,76 @@
 //!   chosen order (its winding flipped). Shadow maps are the frame's; object-precision shadows
 //!   are a mask of the main view's pixels, so mirrored views draw without them.
 
-use std::collections::HashMap;
+use super::{Mirror, Side, camera_side, find_mirrors, mirrored_view};
+use crate::raster::scene_pass::{MirrorImages, ScenePass};
+use crate::raster::targets::FrameTargets;
+use crate::raster::view::{View, frustum_corners};
+use crate::scene::Scene;
 
-use super::{Mirror, Side, camera_side, mirrored_view};
-use crate::raster::view::{MAX_MIRROR_VIEWS, View, frustum_corners};
+/// The most mirrored cameras one frame draws (mirrors that see each other, at every depth).
+pub const MAX_MIRROR_VIEWS: u32 = 32;
+
+/// The planar mirrors of a scene and the targets their mirrored cameras draw into.
+#[derive(Default)]
+pub struct MirrorPass {
+    /// The scene's mirrors, found by [`Self::load`]; transparent ones are left out (a mirror's
+    /// reflection is drawn by the opaque pass, so glass that reflects is drawn as glass alone).
+    pub mirrors: Vec<Mirror>,
+    /// One mirrored camera's targets per node of the largest frame so far, and the group 3
+    /// through which its mirror reads its image (made once with the targets).
+    targets: Vec<(FrameTargets, wgpu::BindGroup)>,
+}
+
+impl MirrorPass {
+    /// Finds the planar mirrors of `scene`, in place of the last scene's; returns their objects.
+    pub fn load(&mut self, scene: &Scene) -> Vec<usize> {
+        let (mut mirrors, warnings) = find_mirrors(scene);
+        for warning in warnings {
+            log::warn!("{warning}");
+        }
+        mirrors.retain(|m| {
+            let object = &scene.objects[m.object];
+            let transparent = scene.materials[object.material.0].is_transparent();
+            if transparent {
+                log::warn!("`{}` is transparent: the rasterizer draws it without its reflection", object.name);
+            }
+            !transparent
+        });
+        self.mirrors = mirrors;
+        self.targets.clear();
+        self.mirrors.iter().map(|m| m.object).collect()
+    }
+
+    /// Makes targets of `size` for `nodes` mirrored cameras (the targets of another size are
+    /// remade).
+    pub fn prepare(&mut self, device: &wgpu::Device, scene_pass: &ScenePass, nodes: usize, size: (u32, u32)) {
+        if self.targets.first().is_some_and(|(t, _)| t.size != size) {
+            self.targets.clear();
+        }
+        while self.targets.len() < nodes {
+            let targets = FrameTargets::new(device, size);
+            let image = scene_pass.mirror_image_group(device, &targets.hdr.view);
+            self.targets.push((targets, image));
+        }
+    }
+
+    /// The targets node `k`'s camera draws into.
+    pub fn targets(&self, k: usize) -> &FrameTargets {
+        &self.targets[k].0
+    }
+
+    /// The reflections the mirrors seen from `parent` (`None`: the main view) show: every part of
+    /// every mirror, with the image of the node that looks out of it, where there is one.
+    pub fn images(&self, nodes: &[MirrorNode], parent: Option<usize>) -> MirrorImages {
+        let mut images = MirrorImages::default();
+        for (index, mirror) in self.mirrors.iter().enumerate() {
+            let child = nodes.iter().position(|n| n.parent == parent && n.mirror == index);
+            let image = child.map(|k| self.targets[k].1.clone());
+            images.parts.entry(mirror.object).or_default().push((mirror.indices.clone(), image));
+        }
+        images
+    }
+}
 
 /// One mirrored camera of the frame.
 #[derive(Clone, Debug, PartialEq)]
@@ -133,16 +199,6 @@ fn in_view(view: &View, mirror: &Mirror) -> bool {
         || outside(|c| c.y > c.w)
         || outside(|c| c.z < 0.0)
         || outside(|c| c.z > c.w))
-}
-
-/// The children of each node (`None`: the main view), as (mirror object… ) pairs: which node's
-/// image each mirror of a view shows.
-pub fn children(nodes: &[MirrorNode]) -> HashMap<Option<usize>, Vec<(usize, usize)>> {
-    let mut map: HashMap<Option<usize>, Vec<(usize, usize)>> = HashMap::new();
-    for (index, node) in nodes.iter().enumerate() {
-        map.entry(node.parent).or_default().push((node.mirror, index));
-    }
-    map
 }
 
 /// The corners of every mirrored camera's view volume, for the `camera` teaching view.

@@ -32,13 +32,14 @@ pub mod views;
 
 use bytemuck::{Pod, Zeroable};
 
-use super::DEPTH_FORMAT;
-use super::scene_gpu::{SceneGpu, SceneLayouts};
-use super::scene_pass::VERTEX_BUFFERS;
+use super::context::{Figure, FrameEncoder};
+use super::geometry::DrawListId;
+use super::scene_gpu::{SceneGpu, SceneLayouts, VERTEX_BUFFERS};
+use super::targets::DEPTH_FORMAT;
 use super::uniforms::ALPHA_MASK;
 use super::view::{View, ViewSlot};
-use crate::gpu::layout;
 use crate::gpu::uniform::UniformBuffer;
+use crate::gpu::{Gpu, layout};
 use crate::settings::ShadowSettings;
 use crate::shaders;
 use views::{MAX_LAYERS, ShadowLayout};
@@ -162,10 +163,11 @@ struct Bias {
 }
 
 /// What a layer's content depends on: when it matches the last drawn one, the layer is kept.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 struct LayerInputs {
     clip_from_world: glam::Mat4,
-    geometry: u64,
+    /// The casters: the scene's draw list.
+    geometry: DrawListId,
     bias: Bias,
 }
 
@@ -176,10 +178,6 @@ pub struct ShadowMaps<'a> {
     pub transmission: &'a wgpu::TextureView,
     /// The comparison sampler (bilinear, clamped to the edge) every filter reads the maps with.
     pub sampler: &'a wgpu::Sampler,
-    /// Changes whenever the textures are recreated, so bind groups that read them can follow.
-    pub generation: u64,
-    /// How many layers were drawn this frame (the others were kept from earlier frames).
-    pub layers_drawn: u32,
 }
 
 /// Pass 1 of the shadow-map algorithm and its targets, kept across frames.
@@ -192,7 +190,6 @@ pub struct ShadowPass {
     targets: Option<ShadowTargets>,
     /// What each layer was last drawn from.
     drawn: Vec<Option<LayerInputs>>,
-    generation: u64,
     uniform: UniformBuffer<GpuShadows>,
     sampler: wgpu::Sampler,
 }
@@ -254,7 +251,6 @@ impl ShadowPass {
             transmission_pipeline,
             targets: None,
             drawn: Vec::new(),
-            generation: 0,
             uniform: UniformBuffer::new(device, "shadow::uniform", &GpuShadows::zeroed()),
             sampler,
         }
@@ -293,19 +289,18 @@ impl ShadowPass {
         self.drawn.clear();
     }
 
-    /// Pass 1: makes the targets fit `layout` and `settings`, writes the light views and the
-    /// shadow uniform, and records every layer whose inputs changed since it was last drawn:
-    /// its depth, then its transparent occluders' transmission. `geometry` identifies the
-    /// scene's draw list (see [`SceneGpu::geometry_version`]).
+    /// Pass 1: makes the targets fit `layout` and `settings`, writes the light views (layer `k`
+    /// into view slot `first_slot + k`) and the shadow uniform, and records every layer whose
+    /// inputs changed since it was last drawn: its depth, then its transparent occluders'
+    /// transmission.
     pub fn record(
         &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        encoder: &mut wgpu::CommandEncoder,
+        gpu: &Gpu,
+        frame: &mut FrameEncoder,
         scene: &SceneGpu,
-        layout: &ShadowLayout,
+        (layout, first_slot): (&ShadowLayout, u32),
         settings: &ShadowSettings,
-    ) -> ShadowMaps<'_> {
+    ) {
         let has_transparent = scene.geometry.has_transparent();
         let layers = layout.views.len() as u32;
         let with_transmission = settings.transmission && has_transparent && layers > 0;
@@ -315,48 +310,49 @@ impl ShadowPass {
             .as_ref()
             .is_some_and(|t| t.size == size && t.layers == layers.max(1) && t.with_transmission == with_transmission);
         if !fits {
-            self.targets = Some(ShadowTargets::new(device, size, layers, with_transmission));
-            self.generation += 1;
+            self.targets = Some(ShadowTargets::new(&gpu.device, size, layers, with_transmission));
             self.drawn.clear();
         }
         let bias = Bias { constant: settings.depth_bias, slope: settings.slope_bias };
         if self.depth_pipeline.as_ref().is_none_or(|(b, _)| *b != bias) {
-            let pipelines = [false, true].map(|masked| self.depth_pipeline(device, bias, masked));
+            let pipelines = [false, true].map(|masked| self.depth_pipeline(&gpu.device, bias, masked));
             self.depth_pipeline = Some((bias, pipelines));
         }
-        self.uniform.write(queue, &GpuShadows::new(layout, settings));
+        self.uniform.write(&gpu.queue, &GpuShadows::new(layout, settings));
         self.drawn.resize(layout.views.len(), None);
-        let mut layers_drawn = 0;
+        let geometry = scene.geometry.draw_list();
         let stale: Vec<usize> = (0..layout.views.len())
             .filter(|&layer| {
                 let inputs = LayerInputs {
                     clip_from_world: layout.views[layer].clip_from_world,
-                    geometry: scene.geometry.version(),
+                    geometry: geometry.clone(),
                     bias,
                 };
-                let keep = settings.cache && self.drawn[layer] == Some(inputs);
+                let keep = settings.cache && self.drawn[layer].as_ref() == Some(&inputs);
                 self.drawn[layer] = Some(inputs);
                 !keep
             })
             .collect();
         if !stale.is_empty() {
-            encoder.push_debug_group("shadow maps");
+            frame.encoder.push_debug_group("shadow maps");
             for &layer in &stale {
-                let slot = ViewSlot::ShadowLayer(layer as u32);
-                scene.views.write(queue, slot, &View::projection_only(layout.views[layer].clip_from_world));
-                self.record_layer(encoder, scene, layer, slot);
-                layers_drawn += 1;
+                let slot = ViewSlot(first_slot + layer as u32);
+                scene.views.write(&gpu.queue, slot, &View::projection_only(layout.views[layer].clip_from_world));
+                self.record_layer(&mut frame.encoder, scene, layer, slot);
             }
-            encoder.pop_debug_group();
+            frame.encoder.pop_debug_group();
         }
-        let targets = self.targets.as_ref().expect("made above");
+        frame.end("shadow maps", &[("layers drawn", Figure::Count(stale.len() as u64))]);
+    }
+
+    /// What the last [`Self::record`] made, for pass 2.
+    pub fn maps(&self) -> ShadowMaps<'_> {
+        let targets = self.targets.as_ref().expect("ShadowPass::record runs before the maps are read");
         ShadowMaps {
             uniform: &self.uniform,
             depth: &targets.depth_array,
             transmission: &targets.transmission_array,
             sampler: &self.sampler,
-            generation: self.generation,
-            layers_drawn,
         }
     }
 

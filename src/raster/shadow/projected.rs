@@ -22,14 +22,13 @@ use wgpu::util::DeviceExt;
 
 use super::views::ShadowLayout;
 use crate::gpu::layout;
-use crate::raster::scene_gpu::{SceneGpu, SceneLayouts};
-use crate::raster::view::ViewSlot;
-use crate::raster::{DEPTH_FORMAT, FrameTargets};
+use crate::raster::context::{Figure, FrameContext, FrameEncoder};
+use crate::raster::geometry::DrawListId;
+use crate::raster::scene_gpu::SceneLayouts;
+use crate::raster::targets::{DEPTH_FORMAT, FrameTargets, MASK_FORMAT};
+use crate::raster::view::FrameView;
 use crate::scene::{Light, LightKind, Scene, Shape};
 use crate::shaders;
-
-/// The screen-sized mask the polygons are drawn into: one channel per shadowed light.
-pub const MASK_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 /// A convex shadow polygon on a receiver, for the shadowed light in mask channel `slot`.
 #[derive(Clone, Debug, PartialEq)]
@@ -174,7 +173,8 @@ struct MaskVertex {
 struct PolygonInputs {
     lights: Vec<Light>,
     first_layer: Vec<Option<u32>>,
-    geometry: u64,
+    /// The scene's draw list: a new one is a new scene, or new tessellations.
+    geometry: DrawListId,
 }
 
 /// The polygons of the last computation, as triangles ready to draw.
@@ -238,48 +238,51 @@ impl ProjectedPass {
         ProjectedPass { pipeline, polygons: None }
     }
 
-    /// Computes the polygons if the lights or the geometry changed since the last call, clears
-    /// the frame's shadow mask and draws them into it, seen from the main view and depth-tested
-    /// against the frame's depth prepass. The mask starts cleared even when
-    /// there is nothing to draw, since the opaque pass reads it whenever this method is chosen.
-    /// Returns whether the polygons were computed anew.
-    pub fn record(
+    /// Computes the polygons if the lights or the geometry changed since the last call; returns
+    /// whether it did.
+    pub fn prepare(
         &mut self,
         device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
         scene: &Scene,
-        scene_gpu: &SceneGpu,
+        geometry: DrawListId,
         layout: &ShadowLayout,
-        targets: &FrameTargets,
     ) -> bool {
-        let (mask, depth) = (&targets.shadow_mask.view, &targets.depth.view);
-        let inputs = PolygonInputs {
-            lights: scene.lights.clone(),
-            first_layer: layout.first_layer.clone(),
-            geometry: scene_gpu.geometry.version(),
-        };
+        let inputs = PolygonInputs { lights: scene.lights.clone(), first_layer: layout.first_layer.clone(), geometry };
         let fresh = self.polygons.as_ref().is_none_or(|p| p.inputs != inputs);
         if fresh {
             self.polygons = Some(Polygons::new(device, inputs, &projected_shadows(scene, layout)));
         }
-        let polygons = self.polygons.as_ref().expect("computed above");
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        fresh
+    }
+
+    /// Clears the view's shadow mask and draws the polygons into it, depth-tested against the
+    /// view's depth prepass. The mask starts cleared even when there is nothing to draw, since
+    /// the opaque pass reads it whenever this method is chosen.
+    pub fn record(&self, ctx: &FrameContext, frame: &mut FrameEncoder, view: &FrameView, targets: &FrameTargets) {
+        let scene_gpu = ctx.scene_gpu;
+        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("shadow_projected::pass"),
-            color_attachments: &[Some(layout::color_attachment(mask, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)))],
-            depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Load)),
+            color_attachments: &[Some(layout::color_attachment(
+                &targets.shadow_mask.view,
+                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+            ))],
+            depth_stencil_attachment: Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        if let Some(vertices) = &polygons.vertices {
+        let polygons = self.polygons.as_ref().filter(|p| p.vertices.is_some());
+        if let Some(Polygons { vertices: Some(vertices), count, .. }) = polygons {
             pass.push_debug_group("projected shadows");
             pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, scene_gpu.frame_group(), &[scene_gpu.views.offset(ViewSlot::Main)]);
+            pass.set_bind_group(0, scene_gpu.frame_group(), &[scene_gpu.views.offset(view.slot)]);
             pass.set_vertex_buffer(0, vertices.slice(..));
-            pass.draw(0..polygons.count, 0..1);
+            pass.draw(0..*count, 0..1);
             pass.pop_debug_group();
         }
-        fresh
+        drop(pass);
+        let polygons = self.polygons.as_ref().map_or(0, |p| u64::from(p.count / 3));
+        frame.end("projected shadows", &[("triangles", Figure::Count(polygons))]);
     }
 }
 

@@ -1,0 +1,344 @@
+//! The frame: [`Renderer::render`] plans what to draw ([`plan`]), fills the shadow maps, then
+//! draws every view with the same phases ([`record_view`]): the cube faces due, the mirrored
+//! cameras deepest first, the main camera; then the teaching overlays and the output transform.
+//!
+//! ```text
+//! plan ──► shadow maps (pass 1 of §4; layers kept while their light and the casters stay)
+//!      ──► lighting inputs (group 2: maps, projected mask, environment maps)
+//!      ──► per view: [depth prepass → projected polygons] → opaque + mirrors + world
+//!                    → isosurfaces → transparent surfaces and composited volumes, in order
+//!          cube faces (copied into their cube) · mirrored cameras, deepest first · main camera
+//!      ──► teaching overlays ──► present (output transform, upscale)
+//! ```
+//!
+//! A technique draws in every view by being one of the phases of [`record_view`]; what it keeps
+//! per scene and per target lives in its pass.
+
+pub mod plan;
+
+use glam::Vec3;
+
+use super::context::{Figure, FrameContext, FrameEncoder, FrameReport};
+use super::environment::pass::EnvironmentPass;
+use super::mirror::pass::{MirrorPass, volumes as mirror_volumes};
+use super::overlays::{FRUSTUM_COLOUR, Overlays, WIREFRAME_COLOUR, box_edges};
+use super::present::PresentPass;
+use super::scene_gpu::{DrawnAlone, SceneGpu, SceneLayouts, SceneShader};
+use super::scene_pass::{MirrorImages, PreparedScene, ScenePass};
+use super::shadow::projected::ProjectedPass;
+use super::shadow::{ShadowMaps, ShadowPass};
+use super::targets::{FrameTargets, drawn_size};
+use super::transparency::{PreparedTransparency, TransparencyPass};
+use super::view::{FrameView, ViewKind};
+use super::volume::{PreparedVolumes, RaySpan, VolumePass, VolumeSet};
+use crate::gpu::Gpu;
+use crate::gpu::mipmap::MipmapGenerator;
+use crate::output::OutputTransform;
+use crate::scene::Scene;
+use crate::settings::{MirrorView, RenderSettings};
+use crate::volume::WIREFRAME_CELLS;
+use plan::{FramePlan, plan};
+
+/// The passes, built once per device and output format, and the scene they draw.
+pub struct Renderer {
+    pub layouts: SceneLayouts,
+    pub mipmaps: MipmapGenerator,
+    shader: SceneShader,
+    scene_gpu: SceneGpu,
+    shadow: ShadowPass,
+    projected: ProjectedPass,
+    scene: ScenePass,
+    transparency: TransparencyPass,
+    volumes: VolumePass,
+    mirrors: MirrorPass,
+    environment: EnvironmentPass,
+    overlays: Overlays,
+    present: PresentPass,
+    /// The lighting inputs (group 2), kept while the images it reads are the same ones.
+    lighting: Option<([wgpu::TextureView; 7], wgpu::BindGroup)>,
+    /// Submit and time each pass on its own (`render --stats`): slower, but it says where the
+    /// frame's time goes.
+    pub profile: bool,
+}
+
+/// The phases every view draws, prepared for one frame.
+struct Phases<'p> {
+    scene: PreparedScene<'p>,
+    projected: &'p ProjectedPass,
+    volumes: PreparedVolumes<'p>,
+    /// `None`: transparent surfaces are drawn with the opaque ones (or there are none).
+    transparency: Option<PreparedTransparency<'p>>,
+}
+
+impl Renderer {
+    /// The passes, with `scene` loaded.
+    pub fn new(gpu: &Gpu, scene: &Scene, output_format: wgpu::TextureFormat) -> Renderer {
+        let device = &gpu.device;
+        let layouts = SceneLayouts::new(device);
+        let shader = SceneShader::new(device, &layouts);
+        let mipmaps = MipmapGenerator::new(device);
+        let mut mirrors = MirrorPass::default();
+        let mut environment = EnvironmentPass::new(device);
+        let mut volumes = VolumePass::new(device, &layouts, &shader);
+        let scene_gpu = load(gpu, scene, (&layouts, &mipmaps), (&mut mirrors, &mut environment, &mut volumes));
+        Renderer {
+            shadow: ShadowPass::new(device, &layouts),
+            projected: ProjectedPass::new(device, &layouts),
+            scene: ScenePass::new(device, &layouts, &shader),
+            transparency: TransparencyPass::new(device, &layouts, &shader),
+            overlays: Overlays::new(device, &layouts),
+            present: PresentPass::new(device, output_format),
+            scene_gpu,
+            volumes,
+            mirrors,
+            environment,
+            mipmaps,
+            shader,
+            layouts,
+            lighting: None,
+            profile: false,
+        }
+    }
+
+    /// Loads `scene` in place of the last one: uploads it, and every pass forgets what it kept of
+    /// the last (a kept shadow map or sorted list is named by the draw list it was made from).
+    pub fn load(&mut self, gpu: &Gpu, scene: &Scene) {
+        let passes = (&mut self.mirrors, &mut self.environment, &mut self.volumes);
+        self.scene_gpu = load(gpu, scene, (&self.layouts, &self.mipmaps), passes);
+    }
+
+    /// The scene as uploaded.
+    pub fn scene_gpu(&self) -> &SceneGpu {
+        &self.scene_gpu
+    }
+
+    /// The number of scene-pass shader variants compiled so far.
+    pub fn shader_variants(&self) -> usize {
+        self.scene.variant_count()
+    }
+
+    /// Forgets the kept shadow maps, so the next frame draws them all.
+    pub fn invalidate_shadows(&mut self) {
+        self.shadow.invalidate();
+    }
+
+    /// Records and submits one frame of `scene` (the one loaded, whose camera may have moved)
+    /// into `output`. `targets` are remade when the output's size times the render scale no
+    /// longer matches them.
+    pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        scene: &Scene,
+        settings: &RenderSettings,
+        targets: &mut FrameTargets,
+        output: &wgpu::TextureView,
+    ) -> FrameReport {
+        let out = output.texture().size();
+        let size = drawn_size((out.width, out.height), settings.raster.render_scale);
+        if targets.size != size {
+            *targets = FrameTargets::new(&gpu.device, size);
+        }
+        let targets = &*targets;
+        let mut frame = FrameEncoder::new(gpu, self.profile);
+        let plan = self.plan(gpu, scene, settings, size, &mut frame);
+        let layers = (&plan.maps, plan.first_shadow_slot);
+        self.shadow.record(gpu, &mut frame, &self.scene_gpu, layers, &settings.shadows);
+        let maps = self.shadow.maps();
+        let lighting = lighting_group(&mut self.lighting, gpu, &self.layouts, (&maps, targets), &self.environment);
+        let lighting = &lighting.clone();
+        let ctx = FrameContext { gpu, scene, scene_gpu: &self.scene_gpu, settings, shader: &self.shader, lighting };
+        let (mirrors, environment) = (&self.mirrors, &self.environment);
+        let views: Vec<(&FrameView, &FrameTargets)> = plan
+            .views()
+            .map(|view| match view.kind {
+                ViewKind::Main => (view, targets),
+                ViewKind::Mirror(k) => (view, mirrors.targets(k)),
+                ViewKind::CubeFace { .. } => (view, environment.capture_targets()),
+            })
+            .collect();
+        let phases = Phases {
+            scene: self.scene.prepare(&ctx, &views, !plan.mirror_nodes.is_empty()),
+            projected: &self.projected,
+            volumes: self.volumes.prepare(&ctx, &views),
+            transparency: plan.transparency.then(|| self.transparency.prepare(&ctx, &mut frame, &views)),
+        };
+        // Cube faces first (a mirror may reflect a curved mirror), each copied into its cube;
+        // then the mirrored cameras deepest first, so every view's mirrors find their images.
+        for view in &plan.cube_views {
+            record_view(&ctx, &mut frame, &phases, (view, environment.capture_targets()), &MirrorImages::default());
+            if let ViewKind::CubeFace { cube, face } = view.kind {
+                environment.store_face(&mut frame, cube, face);
+            }
+        }
+        if !plan.cube_views.is_empty() {
+            environment.finish_faces(gpu, &self.mipmaps, &mut frame, plan.cube_views.len());
+        }
+        for (k, view) in plan.mirror_views.iter().enumerate().rev() {
+            let images = mirrors.images(&plan.mirror_nodes, Some(k));
+            record_view(&ctx, &mut frame, &phases, (view, mirrors.targets(k)), &images);
+        }
+        let images = mirrors.images(&plan.mirror_nodes, None);
+        record_view(&ctx, &mut frame, &phases, (&plan.main, targets), &images);
+        self.record_overlays(&ctx, &mut frame, &plan, (targets, &maps));
+        // The first mirrored camera's own image, in place of the frame.
+        let shown = match plan.mirror_views.first() {
+            Some(_) if settings.mirrors.view == MirrorView::Image => &mirrors.targets(0).hdr.view,
+            _ => &targets.hdr.view,
+        };
+        self.present.record(gpu, &mut frame, shown, output, OutputTransform::of(settings));
+        frame.report.drawn_size = size;
+        frame.report.triangles = self.scene_gpu.geometry.triangles();
+        frame.finish()
+    }
+
+    /// Prepares what the plan depends on (materials for the texture filter, tessellations, the
+    /// environment maps) and plans the frame; writes every view's slot and the frame uniform.
+    fn plan(
+        &mut self,
+        gpu: &Gpu,
+        scene: &Scene,
+        settings: &RenderSettings,
+        size: (u32, u32),
+        frame: &mut FrameEncoder,
+    ) -> FramePlan {
+        let scene_gpu = &mut self.scene_gpu;
+        scene_gpu.prepare_materials(&gpu.device, &self.layouts, &settings.textures);
+        let (segments, adaptive) = (settings.sphere_segments, settings.raster.adaptive_tessellation);
+        scene_gpu.geometry.prepare(&gpu.device, scene, &scene.camera, segments, adaptive);
+        let bounds = scene_gpu.geometry.bounds;
+        let faces = self.environment.prepare(gpu, (&self.mipmaps, frame), scene, settings, bounds);
+        let plan = plan(scene, &scene_gpu.geometry, settings, (size, &self.mirrors.mirrors), faces);
+        for view in plan.views() {
+            scene_gpu.views.write(&gpu.queue, view.slot, &view.view);
+        }
+        scene_gpu.update_frame(&gpu.queue, scene, &plan.lights.first_layer, settings);
+        self.mirrors.prepare(&gpu.device, &self.scene, plan.mirror_nodes.len(), size);
+        if plan.projected {
+            let recomputed = self.projected.prepare(&gpu.device, scene, scene_gpu.geometry.draw_list(), &plan.lights);
+            frame.end("projected shadows", &[("recomputed", Figure::Flag(recomputed))]);
+        }
+        let views = Figure::Count(plan.mirror_views.len() as u64);
+        frame.end("mirror views", &[("views", views)]);
+        plan
+    }
+
+    /// The teaching views over the main view's image: shadow maps and light frusta, the volumes'
+    /// grids, the mirrored cameras' view volumes, the environment maps.
+    fn record_overlays(
+        &self,
+        ctx: &FrameContext,
+        frame: &mut FrameEncoder,
+        plan: &FramePlan,
+        (targets, maps): (&FrameTargets, &ShadowMaps),
+    ) {
+        let settings = ctx.settings;
+        let main = (&plan.main, targets);
+        self.overlays.record_shadows(ctx, frame, main, (&plan.maps, maps));
+        if settings.volume.enabled && settings.volume.wireframe {
+            let lines: Vec<[Vec3; 2]> =
+                ctx.scene.volumes.iter().flat_map(|v| v.wireframe_lines(WIREFRAME_CELLS)).collect();
+            self.overlays.record_lines(ctx, frame, main, lines.as_flattened(), WIREFRAME_COLOUR);
+        }
+        if settings.mirrors.view == MirrorView::Camera {
+            let edges = box_edges(&mirror_volumes(&plan.mirror_nodes));
+            self.overlays.record_lines(ctx, frame, main, &edges, FRUSTUM_COLOUR);
+        }
+        self.environment.record_view(frame, settings, targets);
+    }
+}
+
+/// Draws one view's phases into its targets, the same for the main camera, a mirrored camera
+/// and a cube face: the opaque surfaces (after a depth prepass and the projected-shadow mask
+/// where the view has them), with the reflections `mirrors` show; the isosurfaces; then the
+/// transparent surfaces and the composited volumes in one order.
+fn record_view(
+    ctx: &FrameContext,
+    frame: &mut FrameEncoder,
+    phases: &Phases,
+    (view, targets): (&FrameView, &FrameTargets),
+    mirrors: &MirrorImages,
+) {
+    let transparent_later = phases.transparency.is_some();
+    if view.prepass {
+        phases.scene.record_prepass(ctx, frame, view, targets, transparent_later);
+    }
+    if view.projected {
+        phases.projected.record(ctx, frame, view, targets);
+    }
+    phases.scene.record_opaque(ctx, frame, view, targets, (transparent_later, mirrors));
+    phases.volumes.record_isosurfaces(ctx, frame, view, targets);
+    let mut composite =
+        |frame: &mut FrameEncoder, span: RaySpan| phases.volumes.composite(ctx, frame, view, targets, span);
+    match &phases.transparency {
+        Some(transparency) => transparency.record(ctx, frame, (view, targets), &mut composite),
+        None => composite(frame, RaySpan { volumes: VolumeSet::All, near: None, far: None }),
+    }
+}
+
+/// Uploads `scene` and lets each pass find what it keeps per scene: the planar mirrors, the
+/// curved ones' cubes, the volumes' textures.
+fn load(
+    gpu: &Gpu,
+    scene: &Scene,
+    (layouts, mipmaps): (&SceneLayouts, &MipmapGenerator),
+    (mirrors, environment, volumes): (&mut MirrorPass, &mut EnvironmentPass, &mut VolumePass),
+) -> SceneGpu {
+    if scene.lights.len() > super::uniforms::MAX_LIGHTS {
+        log::warn!(
+            "the scene has {} lights; the rasterizer draws the first {}",
+            scene.lights.len(),
+            super::uniforms::MAX_LIGHTS
+        );
+    }
+    let planar = mirrors.load(scene);
+    let curved = environment.load(scene, &planar);
+    volumes.load(gpu, scene);
+    SceneGpu::upload(gpu, layouts, mipmaps, scene, DrawnAlone { mirrors: &planar, env_objects: &curved })
+}
+
+/// Group 2 of the scene module: the shadow pass's outputs, the main view's projected-shadow
+/// mask and the environment maps; made again only when one of those images is a new one.
+fn lighting_group<'c>(
+    cache: &'c mut Option<([wgpu::TextureView; 7], wgpu::BindGroup)>,
+    gpu: &Gpu,
+    layouts: &SceneLayouts,
+    (maps, targets): (&ShadowMaps, &FrameTargets),
+    environment: &EnvironmentPass,
+) -> &'c wgpu::BindGroup {
+    let env = environment.maps();
+    let images = [
+        maps.depth,
+        maps.transmission,
+        &targets.shadow_mask.view,
+        &env.cube.view,
+        &env.dynamic.view,
+        &env.sphere.view,
+        &env.latlong.view,
+    ];
+    if cache.as_ref().is_none_or(|(kept, _)| kept.iter().zip(images).any(|(a, b)| a != b)) {
+        let texture =
+            |binding, view| wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(view) };
+        let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("frame::lighting_group"),
+            layout: &layouts.lighting,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: maps.uniform.binding() },
+                texture(1, maps.depth),
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(maps.sampler) },
+                texture(3, maps.transmission),
+                texture(4, &targets.shadow_mask.view),
+                wgpu::BindGroupEntry { binding: 5, resource: env.params.binding() },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::Sampler(&environment.converter.sampler),
+                },
+                texture(7, &env.cube.view),
+                texture(8, &env.dynamic.view),
+                texture(9, &env.sphere.view),
+                texture(10, &env.latlong.view),
+            ],
+        });
+        *cache = Some((images.map(Clone::clone), group));
+    }
+    &cache.as_ref().expect("made just above").1
+}
