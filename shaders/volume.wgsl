@@ -97,15 +97,18 @@ struct VolumeRay {
 fn volume_ray(pixel: vec2f) -> VolumeRay {
     let size = vec2f(textureDimensions(opaque_depth));
     let ndc = vec2f(2.0 * pixel.x / size.x - 1.0, 1.0 - 2.0 * pixel.y / size.y);
-    let far = view.world_from_clip * vec4f(ndc, 1.0, 1.0);
     var ray: VolumeRay;
     if view.orthographic != 0u {
         let near = view.world_from_clip * vec4f(ndc, 0.0, 1.0);
         ray.origin = near.xyz / near.w;
         ray.direction = -view.view_axis;
     } else {
+        // Any point on the pixel's ray, unprojected: q.xyz − eye·q.w points away from the eye
+        // whatever the sign of q.w (a mirrored view's oblique projection puts some depths
+        // behind the eye), as fs_background finds it.
+        let q = view.world_from_clip * vec4f(ndc, 0.5, 1.0);
         ray.origin = view.eye;
-        ray.direction = normalize(far.xyz / far.w - view.eye);
+        ray.direction = normalize(q.xyz - view.eye * q.w);
     }
     var t_end = depth_distance(ray, ndc, textureLoad(opaque_depth, vec2i(pixel), 0));
     var t_start = 0.0;
