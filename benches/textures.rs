@@ -13,7 +13,8 @@ use std::time::{Duration, Instant};
 
 use image::imageops::{FilterType, resize};
 use mirador::gpu::Gpu;
-use mirador::gpu::mipmap::{MIPMAP_USAGE, MipmapGenerator, mip_level_count, texture_format};
+use mirador::gpu::mipmap::{MIPMAP_USAGE, MipmapGenerator, mip_level_count};
+use mirador::raster::scene_gpu::texture_format;
 use mirador::scene::{ColorSpace, Texture};
 use mirador::texture::MipChain;
 

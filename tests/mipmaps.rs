@@ -5,12 +5,28 @@
 mod common;
 
 use glam::{Vec2, Vec4};
-use mirador::gpu::mipmap::{
-    MipmapGenerator, mip_level_count, read_level_rgba8, sampler_descriptor, texture_format, upload_with_mipmaps,
-};
+use mirador::gpu::mipmap::{MipmapGenerator, mip_level_count, read_level_rgba8, sampler_descriptor};
 use mirador::output::srgb_decode;
+use mirador::raster::scene_gpu::texture_format;
 use mirador::scene::{ColorSpace, Texture};
 use mirador::texture::mipmap::{Filter, LEVEL_PALETTE, MipChain, MipLevel, level_colour};
+
+/// Uploads `image` with its mip chain, in the format the rasterizer gives its colour space.
+fn upload(
+    gpu: &mirador::gpu::Gpu,
+    generator: &MipmapGenerator,
+    label: &str,
+    image: &Texture,
+) -> mirador::gpu::texture::GpuTexture {
+    let pixels = ((image.width, image.height), image.rgba8.as_slice());
+    mirador::gpu::mipmap::upload_with_mipmaps(
+        (&gpu.device, &gpu.queue),
+        generator,
+        label,
+        pixels,
+        texture_format(image.color_space),
+    )
+}
 
 fn texture(width: u32, height: u32, rgba8: Vec<u8>, color_space: ColorSpace) -> Texture {
     assert_eq!(rgba8.len(), (4 * width * height) as usize);
@@ -173,7 +189,7 @@ fn gpu_chain_matches_cpu_chain_on_every_level() {
     for color_space in [ColorSpace::Srgb, ColorSpace::Linear] {
         for (w, h) in [(8, 8), (64, 32), (256, 256), (5, 3), (13, 7), (1, 7), (7, 1), (3, 3), (33, 17), (257, 129)] {
             let image = texture(w, h, test_pattern(w, h, w ^ (h << 8)), color_space);
-            let uploaded = upload_with_mipmaps(&gpu.device, &gpu.queue, &generator, "mipmaps::test", &image);
+            let uploaded = upload(gpu, &generator, "mipmaps::test", &image);
             assert_eq!(uploaded.texture.mip_level_count(), mip_level_count(w, h));
             assert_eq!(uploaded.texture.format(), texture_format(color_space));
             let chain = MipChain::build(&image);
@@ -284,7 +300,7 @@ fn gpu_sampler_matches_cpu_sampling() {
     let generator = MipmapGenerator::new(device);
     let (w, h) = (16, 8);
     let image = texture(w, h, test_pattern(w, h, 99), ColorSpace::Srgb);
-    let uploaded = upload_with_mipmaps(device, &gpu.queue, &generator, "mipmaps::sampled", &image);
+    let uploaded = upload(gpu, &generator, "mipmaps::sampled", &image);
     let levels = (0..mip_level_count(w, h))
         .map(|level| {
             let bytes = read_level_rgba8(device, &gpu.queue, &uploaded.texture, level);

@@ -34,7 +34,6 @@ use std::sync::Mutex;
 
 use super::texture::GpuTexture;
 use crate::gpu::layout;
-use crate::scene::{ColorSpace, Texture};
 use crate::shaders;
 use crate::texture::mipmap::Filter;
 
@@ -50,15 +49,6 @@ pub const MIPMAP_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::TEXTURE_BINDI
     .union(wgpu::TextureUsages::RENDER_ATTACHMENT)
     .union(wgpu::TextureUsages::COPY_DST)
     .union(wgpu::TextureUsages::COPY_SRC);
-
-/// The format a [`Texture`] is uploaded as: sRGB colour as `Rgba8UnormSrgb` (the sampler decodes
-/// before filtering), data as `Rgba8Unorm`.
-pub fn texture_format(color_space: ColorSpace) -> wgpu::TextureFormat {
-    match color_space {
-        ColorSpace::Srgb => wgpu::TextureFormat::Rgba8UnormSrgb,
-        ColorSpace::Linear => wgpu::TextureFormat::Rgba8Unorm,
-    }
-}
 
 /// The format of the unrounded chain the levels are computed from: renderable and readable on
 /// every backend, with 11 significant bits (an error under 1/16 of an 8-bit step per level).
@@ -220,43 +210,42 @@ pub fn generate_mipmaps(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wg
     queue.submit([encoder.finish()]);
 }
 
-/// Uploads `image` as a texture with a full mip chain (`Rgba8UnormSrgb` for sRGB colour,
-/// `Rgba8Unorm` for data, usage [`MIPMAP_USAGE`]), writes level 0 and submits the generation of
-/// the other levels. The view covers every level.
+/// Uploads an RGBA8 image of `width × height` texels as a texture of `format` with a full mip
+/// chain (usage [`MIPMAP_USAGE`]), writes level 0 and submits the generation of the other levels.
+/// The view covers every level. A short pixel buffer (a malformed file) is padded with
+/// transparent black rather than rejected by wgpu's validation.
 pub fn upload_with_mipmaps(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
+    (device, queue): (&wgpu::Device, &wgpu::Queue),
     generator: &MipmapGenerator,
     label: &str,
-    image: &Texture,
+    ((width, height), rgba8): ((u32, u32), &[u8]),
+    format: wgpu::TextureFormat,
 ) -> GpuTexture {
-    let size = wgpu::Extent3d { width: image.width, height: image.height, depth_or_array_layers: 1 };
+    let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size,
-        mip_level_count: mip_level_count(image.width, image.height),
+        mip_level_count: mip_level_count(width, height),
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: texture_format(image.color_space),
+        format,
         usage: MIPMAP_USAGE,
         view_formats: &[],
     });
-    let row = 4 * image.width as usize;
-    let expected = row * image.height as usize;
-    // A short pixel buffer (a malformed file) is padded with transparent black rather than
-    // rejected by wgpu's validation.
+    let row = 4 * width as usize;
+    let expected = row * height as usize;
     let mut padded;
-    let data = if image.rgba8.len() >= expected {
-        &image.rgba8[..expected]
+    let data = if rgba8.len() >= expected {
+        &rgba8[..expected]
     } else {
-        padded = image.rgba8.clone();
+        padded = rgba8.to_vec();
         padded.resize(expected, 0);
         &padded[..]
     };
     queue.write_texture(
         texture.as_image_copy(),
         data,
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row as u32), rows_per_image: Some(image.height) },
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row as u32), rows_per_image: Some(height) },
         size,
     );
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("mipmap::encoder") });

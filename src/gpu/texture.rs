@@ -1,7 +1,5 @@
 //! Textures: render targets and sampled images.
 
-use crate::scene::{ColorSpace, Texture};
-
 /// A texture with the default view of all its levels.
 pub struct GpuTexture {
     pub texture: wgpu::Texture,
@@ -25,16 +23,6 @@ impl GpuTexture {
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
         GpuTexture { texture, view }
-    }
-
-    /// Uploads an image for sampling: sRGB colour textures as `Rgba8UnormSrgb`, so the sampler
-    /// decodes before it filters; data textures as `Rgba8Unorm`.
-    pub fn upload(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, image: &Texture) -> GpuTexture {
-        let format = match image.color_space {
-            ColorSpace::Srgb => wgpu::TextureFormat::Rgba8UnormSrgb,
-            ColorSpace::Linear => wgpu::TextureFormat::Rgba8Unorm,
-        };
-        Self::from_rgba8(device, queue, label, (image.width, image.height), &image.rgba8, format)
     }
 
     pub fn from_rgba8(

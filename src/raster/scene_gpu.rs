@@ -17,7 +17,7 @@ use crate::gpu::mipmap::{MipmapGenerator, sampler_descriptor, upload_with_mipmap
 use crate::gpu::texture::GpuTexture;
 use crate::gpu::uniform::UniformBuffer;
 use crate::gpu::{Gpu, layout};
-use crate::scene::{Scene, Wrap};
+use crate::scene::{ColorSpace, Scene, Wrap};
 use crate::settings::RenderSettings;
 use crate::settings::{TextureFilter, TextureSettings};
 use crate::shaders;
@@ -190,7 +190,9 @@ impl SceneGpu {
             .textures
             .iter()
             .map(|t| {
-                upload_with_mipmaps(device, &gpu.queue, mipmaps, &format!("scene::texture {}", t.path.display()), t)
+                let label = format!("scene::texture {}", t.path.display());
+                let image = ((t.width, t.height), t.rgba8.as_slice());
+                upload_with_mipmaps((device, &gpu.queue), mipmaps, &label, image, texture_format(t.color_space))
             })
             .collect();
         let one_texel =
@@ -303,6 +305,15 @@ impl SceneGpu {
         settings: &RenderSettings,
     ) {
         self.frame.write(queue, &GpuFrame::new(scene.ambient, &scene.lights, shadow_layers, settings));
+    }
+}
+
+/// The format a scene texture is uploaded as: sRGB colour as `Rgba8UnormSrgb` (the sampler
+/// decodes before filtering), data as `Rgba8Unorm`.
+pub fn texture_format(color_space: ColorSpace) -> wgpu::TextureFormat {
+    match color_space {
+        ColorSpace::Srgb => wgpu::TextureFormat::Rgba8UnormSrgb,
+        ColorSpace::Linear => wgpu::TextureFormat::Rgba8Unorm,
     }
 }
 

@@ -14,19 +14,17 @@
 //!   viewer; where the gradient vanishes a sample gets the ambient term alone. With
 //!   `volume.shadows` each sample casts a shadow ray per light (volumes cast none).
 //! - **Isosurface**: the first crossing of `f = iso` in front of the nearest surface becomes a hit
-//!   like any other, shaded by [`Whitted::shade`] with the volume's material: lights, shadows,
+//!   like any other, shaded by `Whitted::shade` with the volume's material: lights, shadows,
 //!   reflections and refraction. Its outward normal is `−∇f` (values rise inwards; distance
 //!   fields are read as positive inside). Textures and bumps do not apply to it.
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use super::geometry::SurfaceHit;
-use super::whitted::{RayCounts, Whitted};
 use crate::scene::light::Incidence;
 use crate::scene::shading::{SurfaceSample, Terms, direct, emitted_and_ambient, facing_viewer};
 use crate::scene::{Ray, Scene};
 use crate::settings::{VolumeSettings, VolumeView};
-use crate::texture::RayCone;
 use crate::volume::march::{self, LocalRay};
 use crate::volume::{March, Rendering, Volume};
 
@@ -38,10 +36,11 @@ pub struct TracedVolumes<'s> {
     pub view: VolumeView,
 }
 
-struct Prepared<'s> {
+/// One volume, with the matrices its rays and normals need.
+pub struct Prepared<'s> {
     volume: &'s Volume,
     local_from_world: Mat4,
-    normal_from_local: Mat3,
+    pub normal_from_local: Mat3,
     rendering: Rendering,
 }
 
@@ -85,26 +84,18 @@ pub fn heat_colour(samples: u32) -> Vec3 {
     (Vec3::new(3.0 * x, 3.0 * x - 1.0, 3.0 * x - 2.0)).clamp(Vec3::ZERO, Vec3::ONE)
 }
 
-impl Whitted<'_> {
-    /// `RayTracing(o, u, n)` where the scene has volumes: the nearest surface or isosurface, with
-    /// the composited volumes in front of it.
-    pub(super) fn radiance_through_volumes(
+impl TracedVolumes<'_> {
+    /// The composited volumes `ray` crosses before `t_end`, marched front to back in the order
+    /// the ray enters their boxes; `shade` gives a sample's colour from its volume, `t`, local
+    /// gradient and classified colour.
+    pub fn composite(
         &self,
         ray: &Ray,
-        cone: RayCone,
-        depth: u32,
-        counts: &mut RayCounts,
-    ) -> Vec3 {
-        let nearest = self.nearest_surface(ray, cone);
-        let t_surface = nearest
-            .as_ref()
-            .map_or(f32::INFINITY, |(hit, moved, _)| (moved.origin - ray.origin).dot(ray.direction) + hit.t);
-        let isosurface = self.nearest_isosurface(ray, t_surface);
-        let t_end = isosurface.as_ref().map_or(t_surface, |hit| hit.t);
-
-        // The composited volumes in front, in the order the ray enters them.
+        t_end: f32,
+        shade: &mut dyn FnMut(&Prepared, f32, Vec3, Vec3) -> Vec3,
+    ) -> Crossing {
         let mut segments: Vec<(&Prepared, LocalRay, (f32, f32))> = Vec::new();
-        for prepared in &self.volumes.volumes {
+        for prepared in &self.volumes {
             if prepared.rendering != Rendering::Composite {
                 continue;
             }
@@ -114,40 +105,23 @@ impl Whitted<'_> {
             }
         }
         segments.sort_by(|a, b| a.2.0.total_cmp(&b.2.0));
-        let march = &self.volumes.march;
-        let (mut colour, mut alpha, mut taken) = (Vec3::ZERO, 0.0, 0);
-        let crossed = !segments.is_empty();
+        let mut crossing = Crossing { crossed: !segments.is_empty(), ..Crossing::default() };
         for (prepared, local, segment) in segments {
             let grid = &prepared.volume.grid;
-            let out = {
-                let mut shade =
-                    |t: f32, gradient: Vec3, c: Vec3| self.shade_sample(prepared, ray, t, gradient, c, counts);
-                march::composite(grid, &prepared.volume.table, &local, segment, march, &mut shade, None)
-            };
-            counts.volume_samples += u64::from(out.taken);
-            counts.volume_samples_saved += u64::from(out.planned - out.taken);
-            taken += out.taken;
-            colour += (1.0 - alpha) * out.colour;
-            alpha += (1.0 - alpha) * out.alpha;
+            let mut shade = |t: f32, gradient: Vec3, c: Vec3| shade(prepared, t, gradient, c);
+            let out = march::composite(grid, &prepared.volume.table, &local, segment, &self.march, &mut shade, None);
+            crossing.taken += out.taken;
+            crossing.saved += out.planned - out.taken;
+            crossing.colour += (1.0 - crossing.alpha) * out.colour;
+            crossing.alpha += (1.0 - crossing.alpha) * out.alpha;
         }
-        if depth == 0 && crossed && self.volumes.view == VolumeView::Samples {
-            return heat_colour(taken);
-        }
-        if march.termination.is_some_and(|threshold| alpha >= threshold) {
-            return colour;
-        }
-        let behind = match (isosurface, nearest) {
-            (Some(hit), _) => self.shade(ray, cone, &hit, depth, counts),
-            (None, Some((surface, moved, cone))) => self.shade(&moved, cone, &surface, depth, counts),
-            (None, None) => self.scene.environment_radiance(ray.direction),
-        };
-        colour + (1.0 - alpha) * behind
+        crossing
     }
 
     /// The nearest crossing of an isosurface volume before `t_max`, as a surface hit.
-    fn nearest_isosurface(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
+    pub fn nearest_isosurface(&self, ray: &Ray, t_max: f32) -> Option<SurfaceHit> {
         let mut nearest: Option<SurfaceHit> = None;
-        for prepared in &self.volumes.volumes {
+        for prepared in &self.volumes {
             if prepared.rendering != Rendering::Isosurface {
                 continue;
             }
@@ -156,10 +130,10 @@ impl Whitted<'_> {
             let local = prepared.local_ray(ray);
             let Some(segment) = prepared.volume.segment(&local, limit) else { continue };
             let grid = &prepared.volume.grid;
-            let Some(t) = march::isosurface(grid, &local, segment, iso, &self.volumes.march) else { continue };
+            let Some(t) = march::isosurface(grid, &local, segment, iso, &self.march) else { continue };
             let g = grid.grid_coordinates(local.at(t));
-            let differences = self.volumes.march.gradient.unwrap_or(crate::volume::Differences::Central);
-            let gradient = grid.gradient(g, self.volumes.march.reconstruction, differences);
+            let differences = self.march.gradient.unwrap_or(crate::volume::Differences::Central);
+            let gradient = grid.gradient(g, self.march.reconstruction, differences);
             // Outward is where values fall; a vanishing gradient faces the ray.
             let normal = world_normal(prepared.normal_from_local, -gradient).unwrap_or(-ray.direction);
             nearest = Some(SurfaceHit {
@@ -176,24 +150,17 @@ impl Whitted<'_> {
         }
         nearest
     }
+}
 
-    /// One composited sample's colour (see [`voxel_illumination`]), with shadow rays when
-    /// `volume.shadows` is on.
-    fn shade_sample(
-        &self,
-        prepared: &Prepared,
-        ray: &Ray,
-        t: f32,
-        gradient: Vec3,
-        colour: Vec3,
-        counts: &mut RayCounts,
-    ) -> Vec3 {
-        let p = ray.at(t);
-        let normal = world_normal(prepared.normal_from_local, gradient);
-        voxel_illumination(self.scene, self.terms, colour, normal, -ray.direction, p, &mut |incidence| {
-            if self.volumes.shadows { self.visibility(p, incidence.l, incidence.distance, counts) } else { Vec3::ONE }
-        })
-    }
+/// What a ray gathered crossing the composited volumes: premultiplied colour, opacity, and the
+/// samples taken and saved by early termination.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Crossing {
+    pub crossed: bool,
+    pub colour: Vec3,
+    pub alpha: f32,
+    pub taken: u32,
+    pub saved: u32,
 }
 
 /// The world-space unit normal of a local gradient (`normal_from_local`: the inverse transpose),

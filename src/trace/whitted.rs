@@ -58,10 +58,10 @@ use glam::Vec3;
 use super::accel::Accelerator;
 use super::geometry::{Primitive, SurfaceHit};
 use super::texture::SceneTextures;
-use super::volume::TracedVolumes;
+use super::volume::{TracedVolumes, heat_colour, voxel_illumination, world_normal};
 use crate::scene::shading::{SurfaceSample, Terms, direct, emitted_and_ambient, facing_viewer};
 use crate::scene::{AlphaMode, Material, Ray, Scene};
-use crate::settings::{BumpSettings, BumpView, TextureSettings};
+use crate::settings::{BumpSettings, BumpView, TextureSettings, VolumeView};
 use crate::texture::RayCone;
 
 /// Rays traced, by kind.
@@ -133,6 +133,44 @@ impl Whitted<'_> {
             Some((surface, ray, cone)) => self.shade(&ray, cone, &surface, depth, counts),
             None => self.scene.environment_radiance(ray.direction),
         }
+    }
+
+    /// `RayTracing(o, u, n)` where the scene has volumes: the nearest surface or isosurface, with
+    /// the composited volumes in front of it (`super::volume`).
+    fn radiance_through_volumes(&self, ray: &Ray, cone: RayCone, depth: u32, counts: &mut RayCounts) -> Vec3 {
+        let nearest = self.nearest_surface(ray, cone);
+        let t_surface = nearest
+            .as_ref()
+            .map_or(f32::INFINITY, |(hit, moved, _)| (moved.origin - ray.origin).dot(ray.direction) + hit.t);
+        let isosurface = self.volumes.nearest_isosurface(ray, t_surface);
+        let t_end = isosurface.as_ref().map_or(t_surface, |hit| hit.t);
+        let crossing = self.volumes.composite(ray, t_end, &mut |prepared, t, gradient, colour| {
+            // One composited sample: the seed's voxel illumination, with shadow rays when
+            // `volume.shadows` is on.
+            let p = ray.at(t);
+            let normal = world_normal(prepared.normal_from_local, gradient);
+            voxel_illumination(self.scene, self.terms, colour, normal, -ray.direction, p, &mut |incidence| {
+                if self.volumes.shadows {
+                    self.visibility(p, incidence.l, incidence.distance, counts)
+                } else {
+                    Vec3::ONE
+                }
+            })
+        });
+        counts.volume_samples += u64::from(crossing.taken);
+        counts.volume_samples_saved += u64::from(crossing.saved);
+        if depth == 0 && crossing.crossed && self.volumes.view == VolumeView::Samples {
+            return heat_colour(crossing.taken);
+        }
+        if self.volumes.march.termination.is_some_and(|threshold| crossing.alpha >= threshold) {
+            return crossing.colour;
+        }
+        let behind = match (isosurface, nearest) {
+            (Some(hit), _) => self.shade(ray, cone, &hit, depth, counts),
+            (None, Some((surface, moved, cone))) => self.shade(&moved, cone, &surface, depth, counts),
+            (None, None) => self.scene.environment_radiance(ray.direction),
+        };
+        crossing.colour + (1.0 - crossing.alpha) * behind
     }
 
     /// The level of detail at which the nearest hit of `ray` (carrying `cone`) reads its colour

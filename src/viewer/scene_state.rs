@@ -7,7 +7,6 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant, SystemTime};
 
 use super::picking::{Picked, Picker, SeenDirection};
-use super::volume_probe::{self, Probe};
 use crate::scene::Camera;
 use crate::{RenderSettings, Scene};
 
@@ -132,21 +131,9 @@ impl SceneState {
         self.with_picker(size, |picker, scene| picker.seen_direction(scene, pixel))
     }
 
-    /// What the volume ray through `pixel` of an image of `size` pixels taken by the current
-    /// camera does (`volume_probe`): `None` where it enters no volume in front of the surfaces.
-    pub fn volume_probe(&mut self, pixel: glam::Vec2, size: (u32, u32), settings: &RenderSettings) -> Option<Probe> {
-        if self.scene.volumes.is_empty() {
-            return None;
-        }
-        self.with_picker(size, |picker, scene| {
-            let ray = scene.camera.ray_through(pixel.x, pixel.y);
-            volume_probe::probe(scene, settings, &ray, picker.nearest(&ray))
-        })
-    }
-
     /// Runs `f` with the picker (built once per scene) and the scene, its camera taking images
     /// of `size` pixels (the view's, not the render size the camera was loaded with).
-    fn with_picker<T>(&mut self, size: (u32, u32), f: impl FnOnce(&Picker, &Scene) -> T) -> T {
+    pub fn with_picker<T>(&mut self, size: (u32, u32), f: impl FnOnce(&Picker, &Scene) -> T) -> T {
         let picker = self.picker.get_or_insert_with(|| Picker::new(&self.scene));
         let (width, height) = (self.scene.camera.width, self.scene.camera.height);
         (self.scene.camera.width, self.scene.camera.height) = size;

@@ -160,7 +160,7 @@ pub fn show(
     if scene.scene.volumes.is_empty() || !settings.volume.enabled {
         return None;
     }
-    let probe = scene.volume_probe(pixel, size, settings);
+    let probe = probe_at(scene, pixel, size, settings);
     let at = rect.min + vec2(pixel.x, pixel.y) / ppp;
     ctx.layer_painter(egui::LayerId::new(egui::Order::Foreground, egui::Id::unique("mirador::volume_probe_ring")))
         .circle_stroke(at, 4.0, Stroke::new(2.0, CROSSING_COLOUR));
@@ -273,4 +273,21 @@ fn probe_ui(ui: &mut egui::Ui, probe: &Probe, output: OutputTransform) {
             painter.rect_filled(cell, 0.0, Color32::from_rgb(r, g, b));
         }
     }
+}
+
+/// What the volume ray through `pixel` of an image of `size` pixels taken by the current camera
+/// does: `None` where it enters no volume in front of the surfaces.
+pub fn probe_at(
+    scene: &mut SceneState,
+    pixel: glam::Vec2,
+    size: (u32, u32),
+    settings: &RenderSettings,
+) -> Option<Probe> {
+    if scene.scene.volumes.is_empty() {
+        return None;
+    }
+    scene.with_picker(size, |picker, scene| {
+        let ray = scene.camera.ray_through(pixel.x, pixel.y);
+        probe(scene, settings, &ray, picker.nearest(&ray))
+    })
 }

@@ -31,7 +31,8 @@ pub use grid::{Differences, Grid, Reconstruction};
 pub use march::{Composite, LocalRay, March, Sample};
 pub use transfer::{ControlPoint, Preset, Table, TransferFunction};
 
-use crate::scene::{MaterialId, Ray};
+use crate::scene::camera::Ray;
+use crate::scene::material::MaterialId;
 use crate::settings::{VolumeGradient, VolumeMode, VolumeReconstruction, VolumeSettings};
 
 /// Cells a side up to which the rasterizer's wireframe (`volume.wireframe`) draws every grid
