@@ -96,6 +96,7 @@ struct VertexOut {
     @location(3) tangent: vec4f,
     // The object's dynamic environment cube, −1 for the world's.
     @location(4) @interpolate(flat) env_layer: i32,
+    @location(5) @interpolate(flat) object: u32,
 }
 
 @vertex
@@ -109,6 +110,7 @@ fn vs_scene(in: VertexIn, instance: Instance) -> VertexOut {
     out.uv = in.uv;
     out.tangent = vec4f((world_from_local * vec4f(in.tangent.xyz, 0.0)).xyz, in.tangent.w);
     out.env_layer = instance.env_layer;
+    out.object = instance.object;
     return out;
 }
 
@@ -128,6 +130,9 @@ fn visibility(light: Light, p: vec3f, facing: vec3f, pixel: vec2f) -> vec3f {
     }
     if SHADOW_METHOD == SHADOWS_PROJECTED {
         let mask = textureLoad(projected_mask, vec2i(pixel), 0);
+        if INSPECT {
+            probe.lights[probe_light].lit = 1.0 - mask[light.shadow_slot];
+        }
         return vec3f(1.0 - mask[light.shadow_slot]);
     }
     var layer = u32(light.shadow_layer);
@@ -142,6 +147,14 @@ fn visibility(light: Light, p: vec3f, facing: vec3f, pixel: vec2f) -> vec3f {
         shadow_maps, shadow_sampler, coordinates.xy, coordinates.z, layer, SHADOW_FILTER,
         shadows.map_size,
     ));
+    if INSPECT {
+        let texel = min(vec2u(coordinates.xy * f32(shadows.map_size)), vec2u(shadows.map_size - 1u));
+        probe.lights[probe_light].layer = i32(layer);
+        probe.lights[probe_light].texel = vec2f(texel);
+        probe.lights[probe_light].stored_depth = textureLoad(shadow_maps, texel, layer, 0);
+        probe.lights[probe_light].receiver_depth = coordinates.z;
+        probe.lights[probe_light].lit = v.x;
+    }
     // A transparent receiver is not tinted by transparent occluders: the transmission map holds
     // one product over every transparent surface in front of the nearest opaque one, the
     // receiver's own share included, and its nearest depth, with no bias to tell a surface from
@@ -230,6 +243,11 @@ fn shading_normal(in: VertexOut, tangents: SurfaceTangents) -> vec3f {
     if HEIGHT_KIND != HEIGHT_NONE {
         let g = height_slopes(in.uv, material.bump_scale * frame.bump_scale);
         n = perturbed_normal(n, tangents.tu, tangents.tv, g.x, g.y);
+        if INSPECT {
+            probe.bump = g;
+            probe.bump_k = material.bump_scale * frame.bump_scale;
+            probe.bump_delta = height_delta();
+        }
     }
     if NORMAL_MAP {
         // glTF's frame: t along ∂p/∂u (in n's plane), the bitangent's sign from ∂p/∂v.
@@ -249,6 +267,18 @@ fn shade(in: VertexOut) -> vec3f {
     let duv_dy = dpdy(in.uv);
     var tangents = tangents_from_derivatives(dpdx(in.world), dpdy(in.world), duv_dx, duv_dy);
     let color = surface_color(in.uv, duv_dx, duv_dy);
+    if INSPECT {
+        probe.world = in.world;
+        probe.uv = in.uv;
+        probe.colour = color;
+        probe.geometric = normalize(in.normal);
+        probe.lod = -1.0;
+        if COLOR_TEXTURE {
+            let size = vec2f(textureDimensions(color_texture));
+            probe.lod = mip_lod(duv_dx, duv_dy, size, frame.lod_bias);
+            probe.footprint = vec2f(length(duv_dx * size), length(duv_dy * size));
+        }
+    }
     if FLAT_COLOUR {
         return color;
     }
@@ -270,13 +300,31 @@ fn shade(in: VertexOut) -> vec3f {
         material.specular_color, material.shininess, material.emission,
     );
     var radiance = emitted_and_ambient(surface, frame.ambient, frame.terms);
+    if INSPECT {
+        probe.normal = n;
+        probe.emission = select(vec3f(0.0), surface.emission, (frame.terms & TERM_EMISSION) != 0u);
+        probe.global_ambient = select(vec3f(0.0), frame.ambient * surface.kd * surface.color, (frame.terms & TERM_AMBIENT) != 0u);
+    }
     var checker = -1.0;
     for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {
         let light = frame.lights[i];
         let incidence = light_incidence(light, in.world);
         if incidence.valid {
             let facing = select(-n, n, dot(n, incidence.l) >= 0.0);
-            radiance += visibility(light, in.world, facing, in.clip.xy) * direct(surface, n, v, incidence, frame.terms);
+            if INSPECT {
+                probe_light = i;
+                probe.lights[i].layer = -1;
+                probe.lights[i].lit = 1.0;
+            }
+            let visible = visibility(light, in.world, facing, in.clip.xy);
+            if INSPECT {
+                let parts = direct_terms(surface, n, v, incidence, frame.terms);
+                probe.lights[i].ambient = parts[0];
+                probe.lights[i].diffuse = parts[1];
+                probe.lights[i].specular = parts[2];
+                probe.lights[i].visibility = visible;
+            }
+            radiance += visible * direct(surface, n, v, incidence, frame.terms);
             if SHADOW_TEXELS_VIEW && SHADOW_METHOD == SHADOWS_MAP && light.shadow_layer >= 0 && checker < 0.0 {
                 var layer = u32(light.shadow_layer);
                 if light.kind == LIGHT_POINT {
@@ -294,6 +342,11 @@ fn shade(in: VertexOut) -> vec3f {
         // object reflects through a map.
         let reflected = material.reflectance * environment_reflection(n, v, in.env_layer);
         radiance += select(vec3f(0.0), reflected, in.env_layer != ENV_LAYER_NONE);
+        if INSPECT {
+            probe.environment = select(vec3f(0.0), reflected, in.env_layer != ENV_LAYER_NONE);
+            probe.env_direction = 2.0 * dot(n, v) * n - v;
+            probe.env_layer = in.env_layer;
+        }
     }
     return radiance;
 }
@@ -333,26 +386,38 @@ fn masked_out(uv: vec2f) -> bool {
     return ALPHA_MODE == ALPHA_MASK && coverage(uv) < material.alpha_cutoff;
 }
 
-@fragment
-fn fs_scene(in: VertexOut) -> @location(0) vec4f {
+fn scene_fragment(in: VertexOut) -> vec4f {
     if masked_out(in.uv) {
         discard;
     }
     return vec4f(shade(in), 1.0);
 }
 
+@fragment
+fn fs_scene(in: VertexOut) -> @location(0) vec4f {
+    return scene_fragment(in);
+}
+
 // A planar mirror drawn with its reflection (src/raster/mirror): its model plus the mirror term
 // kps·MPS·L(r), as the tracer adds its reflected ray, L(r) read from the mirrored camera's image.
-@fragment
-fn fs_mirror(in: VertexOut) -> @location(0) vec4f {
+fn mirror_fragment(in: VertexOut) -> vec4f {
     if masked_out(in.uv) {
         discard;
     }
     var radiance = shade(in);
     if !FLAT_COLOUR && BUMP_VIEW == 0u {
-        radiance += material.reflectance * textureLoad(mirror_image, vec2i(in.clip.xy), 0).rgb;
+        let reflected = material.reflectance * textureLoad(mirror_image, vec2i(in.clip.xy), 0).rgb;
+        radiance += reflected;
+        if INSPECT {
+            probe.mirror = reflected;
+        }
     }
     return vec4f(radiance, 1.0);
+}
+
+@fragment
+fn fs_mirror(in: VertexOut) -> @location(0) vec4f {
+    return mirror_fragment(in);
 }
 
 // The depth prepass of a cut-out material: depth only where the surface is.
@@ -382,6 +447,10 @@ fn vs_background(@builtin(vertex_index) index: u32) -> BackgroundOut {
 
 @fragment
 fn fs_background(in: BackgroundOut) -> @location(0) vec4f {
+    return background_fragment(in);
+}
+
+fn background_fragment(in: BackgroundOut) -> vec4f {
     // Any point on the pixel's ray, unprojected; q.xyz − eye·q.w points away from the eye along
     // the ray whatever the sign of q.w (oblique projections of mirrored views included).
     let q = view.world_from_clip * vec4f(in.ndc, 0.5, 1.0);

@@ -5,6 +5,10 @@
 
 @fragment
 fn fs_transparent(in: VertexOut) -> @location(0) vec4f {
+    return transparent_fragment(in);
+}
+
+fn transparent_fragment(in: VertexOut) -> vec4f {
     if masked_out(in.uv) {
         discard;
     }

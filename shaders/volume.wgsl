@@ -248,6 +248,10 @@ fn heat_colour(samples: u32) -> vec3f {
 // Premultiplied colour and opacity, blended One, OneMinusSrcAlpha over the opaque image.
 @fragment
 fn fs_volume_composite(in: VolumeVertex) -> @location(0) vec4f {
+    return composite_fragment(in);
+}
+
+fn composite_fragment(in: VolumeVertex) -> vec4f {
     let ray = volume_ray(in.clip.xy);
     if ray.t0 >= ray.t1 {
         discard;
@@ -277,6 +281,11 @@ fn fs_volume_composite(in: VolumeVertex) -> @location(0) vec4f {
             alpha += (1.0 - alpha) * classified.a;
         }
     }
+    if INSPECT {
+        probe.samples = f32(taken);
+        probe.world = ray.origin + ray.t0 * ray.direction;
+        probe.env_direction = ray.origin + ray.t1 * ray.direction;
+    }
     if volume.view == VOLUME_VIEW_SAMPLES {
         return vec4f(heat_colour(taken), 1.0);
     }
@@ -291,6 +300,10 @@ struct IsosurfaceOut {
 // The first crossing of f = iso, shaded with the volume's material like any surface.
 @fragment
 fn fs_volume_isosurface(in: VolumeVertex) -> IsosurfaceOut {
+    return isosurface_fragment(in);
+}
+
+fn isosurface_fragment(in: VolumeVertex) -> IsosurfaceOut {
     let ray = volume_ray(in.clip.xy);
     if ray.t0 >= ray.t1 {
         discard;
@@ -339,14 +352,35 @@ fn fs_volume_isosurface(in: VolumeVertex) -> IsosurfaceOut {
         material.specular_color, material.shininess, material.emission,
     );
     var radiance = emitted_and_ambient(surface, frame.ambient, frame.terms);
+    if INSPECT {
+        probe.world = p;
+        probe.normal = n;
+        probe.geometric = normal;
+        probe.colour = material.color;
+        probe.lod = -1.0;
+        probe.emission = select(vec3f(0.0), surface.emission, (frame.terms & TERM_EMISSION) != 0u);
+        probe.global_ambient = select(vec3f(0.0), frame.ambient * surface.kd * surface.color, (frame.terms & TERM_AMBIENT) != 0u);
+    }
     for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {
         let light = frame.lights[i];
         let incidence = light_incidence(light, p);
         if incidence.valid {
             let facing = select(-n, n, dot(n, incidence.l) >= 0.0);
+            if INSPECT {
+                probe_light = i;
+                probe.lights[i].layer = -1;
+                probe.lights[i].lit = 1.0;
+            }
             var shadowed = vec3f(1.0);
             if SHADOW_METHOD == SHADOWS_MAP {
                 shadowed = visibility(light, p, facing, in.clip.xy);
+            }
+            if INSPECT {
+                let parts = direct_terms(surface, n, v, incidence, frame.terms);
+                probe.lights[i].ambient = parts[0];
+                probe.lights[i].diffuse = parts[1];
+                probe.lights[i].specular = parts[2];
+                probe.lights[i].visibility = shadowed;
             }
             radiance += shadowed * direct(surface, n, v, incidence, frame.terms);
         }

@@ -16,6 +16,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod compare;
+pub mod explain;
 pub mod gpu;
 pub mod linear_output;
 pub mod output;

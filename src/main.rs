@@ -83,6 +83,20 @@ enum Command {
         #[arg(long, value_name = "FILE.exr")]
         exr: Option<PathBuf>,
     },
+    /// Explain one pixel: what each renderer computed there, term by term (the rasterizer's
+    /// values read back from the GPU, the tracer's ray tree), and why they differ.
+    Explain {
+        #[command(flatten)]
+        scene: SceneArgs,
+        #[command(flatten)]
+        trace: TraceArgs,
+        /// The pixel, `X,Y` from the image's top-left corner.
+        #[arg(long, value_name = "X,Y", value_parser = parse_pixel)]
+        pixel: [u32; 2],
+        /// Write the explanation as JSON to this file (`-`: standard output, instead of the text).
+        #[arg(long, value_name = "FILE.json")]
+        json: Option<PathBuf>,
+    },
 }
 
 #[derive(clap::Args)]
@@ -134,6 +148,14 @@ struct ViewArgs {
     size: Option<[u32; 2]>,
 }
 
+fn parse_pixel(text: &str) -> Result<[u32; 2], String> {
+    let (x, y) = text.split_once(',').ok_or("expected X,Y, e.g. 320,180")?;
+    match (x.trim().parse::<u32>(), y.trim().parse::<u32>()) {
+        (Ok(x), Ok(y)) => Ok([x, y]),
+        _ => Err("each coordinate must be a whole number of pixels from 0".into()),
+    }
+}
+
 fn parse_size(text: &str) -> Result<[u32; 2], String> {
     let (w, h) = text.split_once(['x', 'X', '×']).ok_or("expected WIDTHxHEIGHT, e.g. 1280x720")?;
     let side = |s: &str| s.trim().parse::<u32>().ok().filter(|v| (64..=8192).contains(v));
@@ -174,6 +196,7 @@ fn main() -> ExitCode {
         Some(Command::Compare { scene, trace, output, raster_out, trace_out, error_out, exr }) => {
             compare(scene, trace, &output, [raster_out, trace_out, error_out], exr.as_deref())
         }
+        Some(Command::Explain { scene, trace, pixel, json }) => explain(scene, trace, pixel, json.as_deref()),
         Some(Command::View(args)) => view(args),
         None => view(ViewArgs::default()),
     };
@@ -233,6 +256,25 @@ fn write_png(image: &image::RgbaImage, path: &Path) -> anyhow::Result<()> {
 
 fn write_exr(image: &LinearImage, path: &Path) -> anyhow::Result<()> {
     image.write_exr_atomically(path).with_context(|| format!("{}: cannot write the image", path.display()))
+}
+
+fn explain(args: SceneArgs, trace_args: TraceArgs, [x, y]: [u32; 2], json: Option<&Path>) -> anyhow::Result<()> {
+    let mut clock = Stopwatch::default();
+    let mut scene = prepare(&args, &mut clock)?;
+    apply_trace_args(&mut scene.settings, &trace_args)?;
+    let gpu = Gpu::headless()?;
+    gpu.check_image_size((scene.camera.width, scene.camera.height))?;
+    let explanation = gpu.checked(|| mirador::explain::explain(&gpu, &scene, &scene.settings, (x, y)))??;
+    match json {
+        Some(path) if path.as_os_str() == "-" => println!("{}", explanation.to_json()),
+        Some(path) => {
+            output::write_atomically(explanation.to_json().as_bytes(), path)
+                .with_context(|| format!("writing {}", path.display()))?;
+            print!("{}", mirador::explain::text::render(&explanation));
+        }
+        None => print!("{}", mirador::explain::text::render(&explanation)),
+    }
+    Ok(())
 }
 
 /// Loads the scene (or the built-in showcase), applies `--set` and the size options.

@@ -18,7 +18,9 @@ pub const SCENE: &str = concat!(
     "\n// ---- transparency.wgsl\n",
     include_str!("../shaders/transparency.wgsl"),
     "\n// ---- volume.wgsl\n",
-    include_str!("../shaders/volume.wgsl")
+    include_str!("../shaders/volume.wgsl"),
+    "\n// ---- inspect.wgsl\n",
+    include_str!("../shaders/inspect.wgsl")
 );
 pub const PRESENT: &str = include_str!("../shaders/present.wgsl");
 pub const MIPMAP: &str = include_str!("../shaders/mipmap.wgsl");

@@ -127,6 +127,7 @@ fn gpu_structs_match_their_wgsl_twins_field_by_field() {
             alpha_cutoff,
             alpha_mode,
             reflectance,
+            index,
         }),
     );
     check_struct(
@@ -180,8 +181,8 @@ fn instance_attributes_match_the_wgsl_locations() {
     let offsets: Vec<u64> = GpuInstance::ATTRIBUTES.iter().map(|a| a.offset).collect();
     assert_eq!(
         offsets,
-        [0, 16, 32, 48, 64, 76, 88, 100],
-        "the matrix columns, the normal matrix's, then the environment layer"
+        [0, 16, 32, 48, 64, 76, 88, 100, 104],
+        "the matrix columns, the normal matrix's, the environment layer, then the object"
     );
     use mirador::raster::volume::GpuVolume;
     let scene = structs(&parse(&shaders::compose(shaders::SCENE)));
@@ -205,7 +206,7 @@ fn instance_attributes_match_the_wgsl_locations() {
             samples_white
         }),
     );
-    assert_eq!(size_of::<GpuInstance>(), 104);
+    assert_eq!(size_of::<GpuInstance>(), 108);
 }
 
 #[test]

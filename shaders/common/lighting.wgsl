@@ -81,6 +81,26 @@ fn direct(s: Surface, n: vec3f, v: vec3f, light: Incidence, terms: u32) -> vec3f
     return light.radiance * rad;
 }
 
+// direct()'s three parts, each times S_i: ka·C, kd·C·(n·l), ks·Sc·max(0, r·v)^e (for inspecting
+// a pixel; src/scene/shading.rs's direct_terms).
+fn direct_terms(s: Surface, n: vec3f, v: vec3f, light: Incidence, terms: u32) -> array<vec3f, 3> {
+    var parts = array<vec3f, 3>(vec3f(0.0), vec3f(0.0), vec3f(0.0));
+    if (terms & TERM_AMBIENT) != 0u {
+        parts[0] = light.radiance * s.ka * s.color;
+    }
+    let n_dot_l = dot(n, light.l);
+    if n_dot_l > 0.0 {
+        if (terms & TERM_DIFFUSE) != 0u {
+            parts[1] = light.radiance * s.kd * s.color * n_dot_l;
+        }
+        if (terms & TERM_SPECULAR) != 0u && s.ks > 0.0 {
+            let r = 2.0 * n_dot_l * n - light.l;
+            parts[2] = light.radiance * s.ks * s.specular_color * pow(max(dot(r, v), 0.0), s.shininess);
+        }
+    }
+    return parts;
+}
+
 // ME + AG(p).
 fn emitted_and_ambient(s: Surface, ambient: vec3f, terms: u32) -> vec3f {
     var rad = vec3f(0.0);

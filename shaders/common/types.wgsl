@@ -99,7 +99,8 @@ struct Material {
     alpha_mode: u32,
     // kps·MPS: what a mirror reflects.
     reflectance: vec3f,
-    _pad0: f32,
+    // The material's index in the scene (for inspecting a pixel).
+    index: u32,
 }
 
 // What a transparent surface lets through, the factor of I = Im + kt·Mt·I (TECHNIQUES.md §5):
@@ -125,6 +126,8 @@ struct Instance {
     // Layer of the object's own cube among the dynamic environment cubes; ENV_LAYER_WORLD: the
     // world's; ENV_LAYER_NONE: no lookup (planar mirrors reflect through their mirrored camera).
     @location(11) env_layer: i32,
+    // The object's index in the scene (for inspecting a pixel); u32 max where unknown.
+    @location(12) object: u32,
 }
 
 const ENV_LAYER_WORLD: i32 = -1;

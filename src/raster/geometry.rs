@@ -300,7 +300,7 @@ impl SceneGeometry {
                     info.material,
                     alone,
                     key,
-                    GpuInstance::new(world_from_mesh, env_layer(info)),
+                    GpuInstance::new(world_from_mesh, env_layer(info), index as u32),
                     index,
                     world_from_mesh,
                 )

@@ -26,6 +26,9 @@ pub struct FrameKey {
     pub flat_colour: bool,
     /// `ENV_MAP_*`: where curved mirrors look their reflection up; 0: nowhere.
     pub environment: u32,
+    /// Record what the shading computes at the inspected pixel (`shaders/inspect.wgsl`): the
+    /// main view of an inspected frame only.
+    pub inspect: bool,
 }
 
 /// `ENVIRONMENT` codes: the world's cube, its sphere map, its lat–long map, or each reflective
@@ -65,6 +68,7 @@ impl FrameKey {
             bump_analytic: settings.bump.analytic,
             flat_colour: settings.raster.flat_colour,
             environment: environment_code(&settings.environment),
+            inspect: false,
         }
     }
 }
@@ -137,7 +141,7 @@ pub const HEIGHT_SINE: u32 = 2;
 pub const HEIGHT_NOISE: u32 = 3;
 
 /// The names of the pipeline constants, in the order [`constants`] gives their values.
-pub const CONSTANT_NAMES: [&str; 15] = [
+pub const CONSTANT_NAMES: [&str; 16] = [
     "SHADOW_METHOD",
     "SHADOW_FILTER",
     "SHADOW_TRANSMISSION",
@@ -153,10 +157,11 @@ pub const CONSTANT_NAMES: [&str; 15] = [
     "HEIGHT_KIND",
     "NORMAL_MAP",
     "ALPHA_MODE",
+    "INSPECT",
 ];
 
 /// The pipeline constants of one variant.
-pub fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f64); 15] {
+pub fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f64); 16] {
     let flag = |b: bool| f64::from(u8::from(b));
     let values = [
         f64::from(frame.shadow_method),
@@ -174,6 +179,7 @@ pub fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f6
         f64::from(material.height_kind),
         flag(material.normal_map),
         f64::from(material.alpha_mode),
+        flag(frame.inspect),
     ];
     std::array::from_fn(|i| (CONSTANT_NAMES[i], values[i]))
 }

@@ -6,14 +6,15 @@
 //!   [`geometry`], [`scene_gpu`] (the scene's buffers, textures, bind groups and the scene
 //!   shader), [`context`] (the frame context, encoder and report);
 //! - **passes**: [`shadow`], [`scene_pass`], [`transparency`], [`volume`], [`mirror`],
-//!   [`environment`], [`overlays`], [`present`], each owning what it keeps per scene and per
-//!   target, with a `prepare` that hands out what can record;
+//!   [`environment`], [`overlays`], [`present`], [`inspect`], each owning what it keeps per scene
+//!   and per target, with a `prepare` that hands out what can record;
 //! - **frame**: [`frame`] (the plan, [`Renderer`], and the one function that draws a view).
 
 pub mod context;
 pub mod environment;
 pub mod frame;
 pub mod geometry;
+pub mod inspect;
 pub mod keys;
 pub mod mirror;
 pub mod overlays;

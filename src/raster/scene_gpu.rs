@@ -34,7 +34,9 @@ pub struct SceneLayouts {
 }
 
 impl SceneLayouts {
-    pub fn new(device: &wgpu::Device) -> SceneLayouts {
+    /// The layouts; `inspect` adds the inspection buffer to the lighting group (binding 11,
+    /// `shaders/inspect.wgsl`), for a renderer that inspects pixels.
+    pub fn new(device: &wgpu::Device, inspect: bool) -> SceneLayouts {
         let both = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let frame = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::frame_layout"),
@@ -56,21 +58,34 @@ impl SceneLayouts {
         });
         let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
         let filterable = wgpu::TextureSampleType::Float { filterable: true };
+        let mut lighting_entries = vec![
+            layout::uniform(0, wgpu::ShaderStages::FRAGMENT),
+            layout::texture(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
+            layout::sampler(2, wgpu::SamplerBindingType::Comparison),
+            layout::texture(3, unfilterable, wgpu::TextureViewDimension::D2Array),
+            layout::texture(4, unfilterable, wgpu::TextureViewDimension::D2),
+            layout::uniform(5, wgpu::ShaderStages::FRAGMENT),
+            layout::sampler(6, wgpu::SamplerBindingType::Filtering),
+            layout::texture(7, filterable, wgpu::TextureViewDimension::Cube),
+            layout::texture(8, filterable, wgpu::TextureViewDimension::CubeArray),
+            layout::texture(9, filterable, wgpu::TextureViewDimension::D2),
+            layout::texture(10, filterable, wgpu::TextureViewDimension::D2),
+        ];
+        if inspect {
+            lighting_entries.push(wgpu::BindGroupLayoutEntry {
+                binding: 11,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: false },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            });
+        }
         let lighting = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::lighting_layout"),
-            entries: &[
-                layout::uniform(0, wgpu::ShaderStages::FRAGMENT),
-                layout::texture(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
-                layout::sampler(2, wgpu::SamplerBindingType::Comparison),
-                layout::texture(3, unfilterable, wgpu::TextureViewDimension::D2Array),
-                layout::texture(4, unfilterable, wgpu::TextureViewDimension::D2),
-                layout::uniform(5, wgpu::ShaderStages::FRAGMENT),
-                layout::sampler(6, wgpu::SamplerBindingType::Filtering),
-                layout::texture(7, filterable, wgpu::TextureViewDimension::Cube),
-                layout::texture(8, filterable, wgpu::TextureViewDimension::CubeArray),
-                layout::texture(9, filterable, wgpu::TextureViewDimension::D2),
-                layout::texture(10, filterable, wgpu::TextureViewDimension::D2),
-            ],
+            entries: &lighting_entries,
         });
         SceneLayouts { frame, material, lighting }
     }
@@ -213,9 +228,14 @@ impl SceneGpu {
         let material_inputs = scene
             .materials
             .iter()
-            .map(|m| MaterialInputs {
+            .enumerate()
+            .map(|(index, m)| MaterialInputs {
                 name: m.name.clone(),
-                uniform: UniformBuffer::new(device, &format!("scene::material {}", m.name), &m.to_gpu()),
+                uniform: UniformBuffer::new(
+                    device,
+                    &format!("scene::material {}", m.name),
+                    &GpuMaterial { index: index as u32, ..m.to_gpu() },
+                ),
                 color: m.texture.map_or(&white.view, |id| &textures[id.0].view).clone(),
                 height: m.height_map.map_or(&flat.view, |id| &textures[id.0].view).clone(),
                 normal: m.normal_map.map_or(&straight.view, |id| &textures[id.0].view).clone(),

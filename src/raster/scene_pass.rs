@@ -57,6 +57,9 @@ pub struct ScenePass {
     /// The world where no surface is (`fs_background`), and its (empty) group 1.
     background: wgpu::RenderPipeline,
     empty_group: wgpu::BindGroup,
+    /// `fs_background_inspect`, made for the first inspected frame.
+    background_inspect: Option<wgpu::RenderPipeline>,
+    background_layout: wgpu::PipelineLayout,
 }
 
 /// The reflections a view's mirrors show: per mirror object, each part of it that is a mirror
@@ -121,35 +124,17 @@ impl ScenePass {
             layout: &empty_layout,
             entries: &[],
         });
-        let background = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("scene::background_pipeline"),
-            layout: Some(&device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("scene::background_layout"),
-                bind_group_layouts: &[Some(&layouts.frame), Some(&empty_layout), Some(&layouts.lighting)],
-                immediate_size: 0,
-            })),
-            vertex: wgpu::VertexState {
-                module: &shader.module,
-                entry_point: Some("vs_background"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            // At the far plane, where nothing was drawn.
-            depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::LessEqual, false),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &shader.module,
-                entry_point: Some("fs_background"),
-                compilation_options: Default::default(),
-                targets: &[Some(HDR_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
+        let background_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("scene::background_layout"),
+            bind_group_layouts: &[Some(&layouts.frame), Some(&empty_layout), Some(&layouts.lighting)],
+            immediate_size: 0,
         });
+        let background = background_pipeline(device, shader, &background_layout, "fs_background");
         ScenePass {
             background,
             empty_group,
+            background_inspect: None,
+            background_layout,
             mirror_group_layout,
             mirror_layout,
             prepass,
@@ -192,6 +177,11 @@ impl ScenePass {
                 self.shading.insert(key, pipeline);
             }
         }
+        if views.iter().any(|(view, _)| view.key.inspect) && self.background_inspect.is_none() {
+            let device = ctx.device();
+            let pipeline = background_pipeline(device, ctx.shader, &self.background_layout, "fs_background_inspect");
+            self.background_inspect = Some(pipeline);
+        }
         let this = &*self;
         let views = keyed
             .into_iter()
@@ -225,7 +215,12 @@ impl ScenePass {
             fragment: Some(wgpu::FragmentState {
                 module: &ctx.shader.module,
                 // A mirror drawn with its reflection reads group 3 (`fs_mirror`).
-                entry_point: Some(if mirror { "fs_mirror" } else { "fs_scene" }),
+                entry_point: Some(match (mirror, frame.inspect) {
+                    (false, false) => "fs_scene",
+                    (true, false) => "fs_mirror",
+                    (false, true) => "fs_scene_inspect",
+                    (true, true) => "fs_mirror_inspect",
+                }),
                 compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
                 targets: &[Some(HDR_FORMAT.into())],
             }),
@@ -361,7 +356,8 @@ impl PreparedScene<'_> {
             }
         }
         if ctx.scene.environment.is_some() {
-            pass.set_pipeline(&self.pass.background);
+            let inspected = self.pass.background_inspect.as_ref().filter(|_| view.key.inspect);
+            pass.set_pipeline(inspected.unwrap_or(&self.pass.background));
             pass.set_bind_group(1, &self.pass.empty_group, &[]);
             pass.draw(0..3, 0..1);
         }
@@ -374,4 +370,35 @@ pub fn scissor(pass: &mut wgpu::RenderPass<'_>, view: &FrameView) {
     if let Some([x, y, width, height]) = view.scissor {
         pass.set_scissor_rect(x, y, width, height);
     }
+}
+
+/// The world where nothing is drawn: one triangle at the far plane, drawn where no surface is.
+fn background_pipeline(
+    device: &wgpu::Device,
+    shader: &SceneShader,
+    layout: &wgpu::PipelineLayout,
+    entry_point: &str,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("scene::background_pipeline"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module: &shader.module,
+            entry_point: Some("vs_background"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        // At the far plane, where nothing was drawn.
+        depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::LessEqual, false),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &shader.module,
+            entry_point: Some(entry_point),
+            compilation_options: Default::default(),
+            targets: &[Some(HDR_FORMAT.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }

@@ -545,7 +545,7 @@ fn shading_pipeline(ctx: &FrameContext, key: PipelineKey) -> wgpu::RenderPipelin
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module: &ctx.shader.module,
-            entry_point: Some("fs_transparent"),
+            entry_point: Some(if frame.inspect { "fs_transparent_inspect" } else { "fs_transparent" }),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             targets: &[Some(wgpu::ColorTargetState {
                 format: HDR_FORMAT,
@@ -680,7 +680,11 @@ impl TriangleList {
             vertices: buffer("transparency::vertices", bytemuck::cast_slice(&vertices), wgpu::BufferUsages::VERTEX),
             identity: buffer(
                 "transparency::identity_instance",
-                bytemuck::bytes_of(&GpuInstance::new(Mat4::IDENTITY, super::uniforms::ENV_LAYER_WORLD)),
+                bytemuck::bytes_of(&GpuInstance::new(
+                    Mat4::IDENTITY,
+                    super::uniforms::ENV_LAYER_WORLD,
+                    super::uniforms::UNKNOWN_OBJECT,
+                )),
                 wgpu::BufferUsages::VERTEX,
             ),
             triangles,

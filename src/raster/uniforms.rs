@@ -136,7 +136,8 @@ pub struct GpuMaterial {
     pub alpha_mode: u32,
     /// `kps·MPS`: what a mirror reflects.
     pub reflectance: [f32; 3],
-    pub _pad: f32,
+    /// The material's index in the scene (set by the upload; for inspecting a pixel).
+    pub index: u32,
 }
 
 /// `ALPHA_*` codes: how a material's coverage is read.
@@ -196,7 +197,7 @@ impl Material {
             },
             alpha_mode: alpha_mode_code(self.alpha_mode),
             reflectance: (self.mirror * self.mirror_color).to_array(),
-            _pad: 0.0,
+            index: 0,
         }
     }
 }
@@ -216,12 +217,17 @@ pub struct GpuInstance {
     pub normal_from_local: [[f32; 3]; 3],
     /// Layer of the object's own cube among the dynamic environment cubes; −1: the world's.
     pub env_layer: i32,
+    /// The object's index in the scene, [`UNKNOWN_OBJECT`] where the instance stands for many.
+    pub object: u32,
 }
 
+/// `GpuInstance::object` of an instance that draws several objects' triangles.
+pub const UNKNOWN_OBJECT: u32 = u32::MAX;
+
 impl GpuInstance {
-    pub const ATTRIBUTES: [wgpu::VertexAttribute; 8] = wgpu::vertex_attr_array![
+    pub const ATTRIBUTES: [wgpu::VertexAttribute; 9] = wgpu::vertex_attr_array![
         4 => Float32x4, 5 => Float32x4, 6 => Float32x4, 7 => Float32x4,
-        8 => Float32x3, 9 => Float32x3, 10 => Float32x3, 11 => Sint32,
+        8 => Float32x3, 9 => Float32x3, 10 => Float32x3, 11 => Sint32, 12 => Uint32,
     ];
 
     pub const LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
@@ -233,11 +239,12 @@ impl GpuInstance {
     /// An instance whose environment lookups read `env_layer`: a dynamic cube's layer, or
     /// [`ENV_LAYER_WORLD`], or [`ENV_LAYER_NONE`] for planar mirrors (their mirrored camera
     /// reflects for them, and past `mirrors.depth` nothing does, as the tracer's `max_depth`).
-    pub fn new(world_from_local: Mat4, env_layer: i32) -> GpuInstance {
+    pub fn new(world_from_local: Mat4, env_layer: i32, object: u32) -> GpuInstance {
         GpuInstance {
             world_from_local: world_from_local.to_cols_array_2d(),
             normal_from_local: Mat3::from_mat4(world_from_local).inverse().transpose().to_cols_array_2d(),
             env_layer,
+            object,
         }
     }
 }

@@ -312,7 +312,12 @@ impl VolumePass {
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module: &ctx.shader.module,
-                    entry_point: Some(if isosurface { "fs_volume_isosurface" } else { "fs_volume_composite" }),
+                    entry_point: Some(match (isosurface, frame.inspect) {
+                        (true, false) => "fs_volume_isosurface",
+                        (false, false) => "fs_volume_composite",
+                        (true, true) => "fs_volume_isosurface_inspect",
+                        (false, true) => "fs_volume_composite_inspect",
+                    }),
                     compilation_options: wgpu::PipelineCompilationOptions {
                         constants: &constants,
                         ..Default::default()

@@ -81,6 +81,14 @@ pub struct Incidence {
 }
 
 impl Light {
+    /// Where a point or spot light is; `None` for a directional light.
+    pub fn position(&self) -> Option<Vec3> {
+        match self.kind {
+            LightKind::Point { position } | LightKind::Spot { position, .. } => Some(position),
+            LightKind::Directional { .. } => None,
+        }
+    }
+
     /// Light arriving at `p`, or `None` when `p` is at the light's own position.
     pub fn incidence(&self, p: Vec3) -> Option<Incidence> {
         let emitted = self.color * self.intensity;

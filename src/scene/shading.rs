@@ -95,6 +95,45 @@ pub fn direct(surface: &SurfaceSample, n: Vec3, v: Vec3, light: &Incidence, term
     light.radiance * rad
 }
 
+/// The three parts of [`direct`], each times `S_i`: for explaining a pixel term by term (their
+/// sum is `direct`'s up to rounding).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct DirectTerms {
+    /// `ka·C`.
+    pub ambient: Vec3,
+    /// `kd·C·(n·l)`, where the light is in front.
+    pub diffuse: Vec3,
+    /// `ks·Sc·max(0, r·v)^e`, where the light is in front.
+    pub specular: Vec3,
+}
+
+/// [`direct`], part by part.
+pub fn direct_terms(surface: &SurfaceSample, n: Vec3, v: Vec3, light: &Incidence, terms: Terms) -> DirectTerms {
+    let mut parts = DirectTerms::default();
+    if terms.ambient {
+        parts.ambient = light.radiance * surface.ka * surface.color;
+    }
+    let n_dot_l = n.dot(light.l);
+    if n_dot_l > 0.0 {
+        if terms.diffuse {
+            parts.diffuse = light.radiance * surface.kd * surface.color * n_dot_l;
+        }
+        if terms.specular && surface.ks > 0.0 {
+            let r = 2.0 * n_dot_l * n - light.l;
+            parts.specular =
+                light.radiance * surface.ks * surface.specular_color * r.dot(v).max(0.0).powf(surface.shininess);
+        }
+    }
+    parts
+}
+
+/// The two parts of [`emitted_and_ambient`]: `ME`, and `AG = A ⊗ kd·C`.
+pub fn emission_and_global_ambient(surface: &SurfaceSample, ambient: Vec3, terms: Terms) -> (Vec3, Vec3) {
+    let emission = if terms.emission { surface.emission } else { Vec3::ZERO };
+    let global = if terms.ambient { ambient * surface.kd * surface.color } else { Vec3::ZERO };
+    (emission, global)
+}
+
 /// `ME + AG(p)`: the light a point gives off whatever the lights do.
 pub fn emitted_and_ambient(surface: &SurfaceSample, ambient: Vec3, terms: Terms) -> Vec3 {
     let mut rad = Vec3::ZERO;

@@ -33,7 +33,7 @@ pub mod lod;
 pub mod mipmap;
 pub mod tangents;
 
-pub use bump::{BumpParams, bump_normal, perturbed_normal};
+pub use bump::{BumpParams, bump_normal, height_gradient, perturbed_normal};
 pub use height::{HeightField, SineField, TextureHeight, ValueNoise};
 pub use lod::{RayCone, lod_from_distance, lod_from_footprint, lod_from_uv_derivatives};
 pub use mipmap::{Filter, LEVEL_PALETTE, MipChain, MipLevel};

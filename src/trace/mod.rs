@@ -18,6 +18,7 @@
 //! facing the camera, see `texture`).
 
 pub mod accel;
+pub mod explain;
 pub mod geometry;
 pub mod render;
 pub mod sampling;
@@ -83,6 +84,17 @@ impl<'s> Tracer<'s> {
         counts.primary += 1;
         let ray = self.scene.camera.ray_through(p.x, p.y);
         self.whitted.radiance(&ray, self.primary_cone, 0, counts)
+    }
+
+    /// Traces the primary ray through the centre of pixel `(x, y)`, reporting every ray and term
+    /// to `observer` (`explain`); returns the radiance, as the image has it with `center`
+    /// sampling.
+    pub fn explain_pixel(&self, (x, y): (u32, u32), observer: &mut impl explain::Observer) -> Vec3 {
+        let mut counts = RayCounts::default();
+        counts.primary += 1;
+        let ray = self.scene.camera.ray_through(x as f32 + 0.5, y as f32 + 0.5);
+        let kind = (0, explain::RayKind::Primary);
+        self.whitted.radiance_observed(&ray, self.primary_cone, kind, &mut counts, observer)
     }
 
     pub fn accelerator_stats(&self) -> accel::AccelStats {

@@ -67,7 +67,7 @@ use crate::settings::{BumpSettings, TextureFilter, TextureSettings, TracerLod};
 use crate::texture::tangents::normal_map_normal;
 use crate::texture::{
     BumpParams, Filter, HeightField, MipChain, RayCone, SineField, TextureHeight, ValueNoise, bump_normal,
-    lod_from_distance, lod_from_footprint,
+    height_gradient, lod_from_distance, lod_from_footprint,
 };
 
 /// The linear RGB value of `texture` at `uv`, bilinearly filtered with repeat wrapping: level 0
@@ -265,28 +265,12 @@ impl SceneTextures {
         if !settings.enabled {
             return hit.normal;
         }
-        let mut n = hit.normal;
-        let sine;
-        let noise;
-        let field: Option<&dyn HeightField> = match material.height_field {
-            Some(ProceduralHeight::Sine { frequency, amplitude }) => {
-                sine = SineField { amplitude, frequency };
-                Some(&sine)
-            }
-            Some(ProceduralHeight::Noise { seed, cells, octaves, amplitude }) => {
-                noise = ValueNoise { seed, cells, octaves, amplitude };
-                Some(&noise)
-            }
-            None => material.height_map.and_then(|id| self.height(id)).map(|h| h as &dyn HeightField),
-        };
-        if let Some(field) = field {
-            let params = BumpParams {
-                k: material.bump_scale * settings.scale,
-                delta: Some(settings.delta_texels * field.default_delta()),
-                analytic: settings.analytic,
-            };
-            n = bump_normal(field, &params, hit.uv, n, hit.dpdu, hit.dpdv);
-        }
+        let params = bump_params(material, settings);
+        let mut n = self
+            .with_height_field(material, |field| {
+                bump_normal(field, &params(field), hit.uv, hit.normal, hit.dpdu, hit.dpdv)
+            })
+            .unwrap_or(hit.normal);
         if let Some(chain) = material.normal_map.and_then(|id| self.chain(id)) {
             // glTF's tangent frame: t along ∂p/∂u, the bitangent's sign from ∂p/∂v's side, as
             // MikkTSpace makes it from the same texture coordinates.
@@ -297,6 +281,33 @@ impl SceneTextures {
         }
         n
     }
+
+    /// Bump mapping's slopes `(du, dv) = k·∇f_h` at the hit, where it applies.
+    pub fn bump_slopes(&self, material: &Material, hit: &SurfaceHit, settings: &BumpSettings) -> Option<Vec2> {
+        if !settings.enabled {
+            return None;
+        }
+        let params = bump_params(material, settings);
+        self.with_height_field(material, |field| height_gradient(field, hit.uv, &params(field)))
+    }
+
+    /// `f` of the material's height field (procedural, or its height map), if it has one.
+    fn with_height_field<T>(&self, material: &Material, f: impl FnOnce(&dyn HeightField) -> T) -> Option<T> {
+        match material.height_field {
+            Some(ProceduralHeight::Sine { frequency, amplitude }) => Some(f(&SineField { amplitude, frequency })),
+            Some(ProceduralHeight::Noise { seed, cells, octaves, amplitude }) => {
+                Some(f(&ValueNoise { seed, cells, octaves, amplitude }))
+            }
+            None => material.height_map.and_then(|id| self.height(id)).map(|h| f(h)),
+        }
+    }
+}
+
+/// The bump parameters of `material` under `settings`, for a given field (whose own step sets
+/// `Δ`).
+fn bump_params(material: &Material, settings: &BumpSettings) -> impl Fn(&dyn HeightField) -> BumpParams {
+    let (k, delta_texels, analytic) = (material.bump_scale * settings.scale, settings.delta_texels, settings.analytic);
+    move |field: &dyn HeightField| BumpParams { k, delta: Some(delta_texels * field.default_delta()), analytic }
 }
 
 #[cfg(test)]

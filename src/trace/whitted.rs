@@ -56,10 +56,13 @@
 use glam::Vec3;
 
 use super::accel::Accelerator;
+use super::explain::{Observer, RayKind, SurfaceState, Unobserved, VolumeState};
 use super::geometry::{Primitive, SurfaceHit};
 use super::texture::SceneTextures;
 use super::volume::{TracedVolumes, heat_colour, voxel_illumination, world_normal};
-use crate::scene::shading::{SurfaceSample, Terms, direct, emitted_and_ambient, facing_viewer};
+use crate::scene::shading::{
+    SurfaceSample, Terms, direct, direct_terms, emission_and_global_ambient, emitted_and_ambient, facing_viewer,
+};
 use crate::scene::{AlphaMode, Material, Ray, Scene};
 use crate::settings::{BumpSettings, BumpView, TextureSettings, VolumeView};
 use crate::texture::RayCone;
@@ -126,18 +129,49 @@ impl Whitted<'_> {
     /// The radiance arriving at `ray.origin` from `ray.direction` (`RayTracing(o, u, n)`); `cone`
     /// is the ray's footprint, for texture filtering.
     pub fn radiance(&self, ray: &Ray, cone: RayCone, depth: u32, counts: &mut RayCounts) -> Vec3 {
-        if !self.volumes.is_empty() {
-            return self.radiance_through_volumes(ray, cone, depth, counts);
-        }
-        match self.nearest_surface(ray, cone) {
-            Some((surface, ray, cone)) => self.shade(&ray, cone, &surface, depth, counts),
-            None => self.scene.environment_radiance(ray.direction),
-        }
+        self.radiance_observed(ray, cone, (depth, RayKind::Primary), counts, &mut Unobserved)
+    }
+
+    /// [`Self::radiance`], reporting what it does to `observer` (`super::explain`): the ray of
+    /// `kind`, its hit, the terms of its radiance, and the rays it casts.
+    pub fn radiance_observed<O: Observer>(
+        &self,
+        ray: &Ray,
+        cone: RayCone,
+        (depth, kind): (u32, RayKind),
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> Vec3 {
+        observer.begin(kind, ray, depth);
+        let radiance = if !self.volumes.is_empty() {
+            self.radiance_through_volumes(ray, cone, depth, counts, observer)
+        } else {
+            match self.nearest_surface(ray, cone) {
+                Some((surface, moved, cone)) => {
+                    observer.hit(&surface, (moved.origin - ray.origin).dot(ray.direction) + surface.t);
+                    self.shade(&moved, cone, &surface, depth, counts, observer)
+                }
+                None => {
+                    let environment = self.scene.environment_radiance(ray.direction);
+                    observer.term("environment (missed everything)".into(), environment);
+                    environment
+                }
+            }
+        };
+        observer.end(radiance);
+        radiance
     }
 
     /// `RayTracing(o, u, n)` where the scene has volumes: the nearest surface or isosurface, with
     /// the composited volumes in front of it (`super::volume`).
-    fn radiance_through_volumes(&self, ray: &Ray, cone: RayCone, depth: u32, counts: &mut RayCounts) -> Vec3 {
+    fn radiance_through_volumes<O: Observer>(
+        &self,
+        ray: &Ray,
+        cone: RayCone,
+        depth: u32,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> Vec3 {
         let nearest = self.nearest_surface(ray, cone);
         let t_surface = nearest
             .as_ref()
@@ -159,18 +193,42 @@ impl Whitted<'_> {
         });
         counts.volume_samples += u64::from(crossing.taken);
         counts.volume_samples_saved += u64::from(crossing.saved);
+        let stopped_early = self.volumes.march.termination.is_some_and(|threshold| crossing.alpha >= threshold);
+        if O::RECORDS && crossing.crossed {
+            observer.volumes(VolumeState {
+                samples: crossing.taken,
+                saved: crossing.saved,
+                alpha: crossing.alpha,
+                colour: crossing.colour,
+                stopped_early,
+            });
+            observer.term("volumes composited in front".into(), crossing.colour);
+        }
         if depth == 0 && crossing.crossed && self.volumes.view == VolumeView::Samples {
             return heat_colour(crossing.taken);
         }
-        if self.volumes.march.termination.is_some_and(|threshold| crossing.alpha >= threshold) {
+        if stopped_early {
             return crossing.colour;
         }
+        let through = Vec3::splat(1.0 - crossing.alpha);
+        observer.scale(through);
         let behind = match (isosurface, nearest) {
-            (Some(hit), _) => self.shade(ray, cone, &hit, depth, counts),
-            (None, Some((surface, moved, cone))) => self.shade(&moved, cone, &surface, depth, counts),
-            (None, None) => self.scene.environment_radiance(ray.direction),
+            (Some(hit), _) => {
+                observer.hit(&hit, hit.t);
+                self.shade(ray, cone, &hit, depth, counts, observer)
+            }
+            (None, Some((surface, moved, cone))) => {
+                observer.hit(&surface, (moved.origin - ray.origin).dot(ray.direction) + surface.t);
+                self.shade(&moved, cone, &surface, depth, counts, observer)
+            }
+            (None, None) => {
+                let environment = self.scene.environment_radiance(ray.direction);
+                observer.term("environment (missed everything)".into(), environment);
+                environment
+            }
         };
-        crossing.colour + (1.0 - crossing.alpha) * behind
+        observer.unscale();
+        crossing.colour + through * behind
     }
 
     /// The level of detail at which the nearest hit of `ray` (carrying `cone`) reads its colour
@@ -212,15 +270,27 @@ impl Whitted<'_> {
     /// The radiance leaving the hit towards the viewer. A blended surface (`AlphaMode::Blend`)
     /// covers a fraction `α` of the ray: `α·(the surface's own radiance) + (1 − α)·L(the ray
     /// continued straight through)`, the continuation one level deeper like a refracted ray.
-    pub(super) fn shade(&self, ray: &Ray, cone: RayCone, hit: &SurfaceHit, depth: u32, counts: &mut RayCounts) -> Vec3 {
+    pub(super) fn shade<O: Observer>(
+        &self,
+        ray: &Ray,
+        cone: RayCone,
+        hit: &SurfaceHit,
+        depth: u32,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> Vec3 {
         let material = &self.scene.materials[hit.material.0];
         let v = -ray.direction;
         // The teaching views show the nearest surface itself, blended or not.
         if depth == 0 {
-            match self.bump.view {
-                BumpView::Off => {}
-                BumpView::Normals => return 0.5 + 0.5 * self.shading_normal(material, hit, v),
-                BumpView::Tangents => return 0.5 + 0.5 * hit.dpdu.normalize_or_zero(),
+            let shown = match self.bump.view {
+                BumpView::Off => None,
+                BumpView::Normals => Some(0.5 + 0.5 * self.shading_normal(material, hit, v)),
+                BumpView::Tangents => Some(0.5 + 0.5 * hit.dpdu.normalize_or_zero()),
+            };
+            if let Some(shown) = shown {
+                observer.term("bump mapping's teaching view".into(), shown);
+                return shown;
             }
         }
         let alpha = match material.alpha_mode {
@@ -232,36 +302,69 @@ impl Whitted<'_> {
         };
         let mut rad = Vec3::ZERO;
         if alpha > 0.0 {
-            rad += alpha * self.shade_surface(ray, cone, hit, depth, counts);
+            observer.scale(Vec3::splat(alpha));
+            rad += alpha * self.shade_surface(ray, cone, hit, depth, counts, observer);
+            observer.unscale();
         }
         if alpha < 1.0 && depth < self.max_depth {
             counts.refracted += 1;
             let origin = hit.point - surface_offset(hit.point) * facing_viewer(hit.geometric_normal, v);
             let behind = Ray { origin, direction: ray.direction };
-            rad += (1.0 - alpha) * self.radiance(&behind, cone.continued(hit.t), depth + 1, counts);
+            let kind = (depth + 1, RayKind::Continued);
+            let through = self.radiance_observed(&behind, cone.continued(hit.t), kind, counts, observer);
+            observer.term(format!("behind the blended surface × (1 − α), α = {alpha:.3}"), (1.0 - alpha) * through);
+            rad += (1.0 - alpha) * through;
         }
         rad
     }
 
     /// `EvaluaMILRec`: the local model at the hit plus the mirror and transmission terms.
-    fn shade_surface(&self, ray: &Ray, cone: RayCone, hit: &SurfaceHit, depth: u32, counts: &mut RayCounts) -> Vec3 {
+    fn shade_surface<O: Observer>(
+        &self,
+        ray: &Ray,
+        cone: RayCone,
+        hit: &SurfaceHit,
+        depth: u32,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> Vec3 {
         let material = &self.scene.materials[hit.material.0];
         let v = -ray.direction;
         let n = self.shading_normal(material, hit, v);
         let color = self.textures.colour(material, hit, ray.direction, &cone, &self.texture_settings);
         let sample = SurfaceSample::new(material, color);
+        if O::RECORDS {
+            observer.surface(SurfaceState {
+                uv: hit.uv,
+                lod: self.textures.lod(material, hit, ray.direction, &cone, &self.texture_settings),
+                footprint: cone.width_at(hit.t),
+                colour: color,
+                alpha: material.alpha,
+                geometric_normal: hit.geometric_normal,
+                normal: n,
+                bump: self.textures.bump_slopes(material, hit, &self.bump),
+            });
+            let (emission, global) = emission_and_global_ambient(&sample, self.scene.ambient, self.terms);
+            observer.term("emission ME".into(), emission);
+            observer.term("global ambient AG = A·kd·C".into(), global);
+        }
         // The geometric normal on the viewer's side: secondary rays leave along it or against it.
         let outside = facing_viewer(hit.geometric_normal, v);
         let offset = surface_offset(hit.point);
 
         let mut rad = emitted_and_ambient(&sample, self.scene.ambient, self.terms);
-        for light in &self.scene.lights {
+        for (index, light) in self.scene.lights.iter().enumerate() {
             let Some(incidence) = light.incidence(hit.point) else { continue };
             let unlit = incidence.l.dot(n) <= 0.0 && (sample.ka == 0.0 || !self.terms.ambient);
             if unlit {
                 continue;
             }
-            let visibility = self.visibility(hit.point + offset * outside, incidence.l, incidence.distance, counts);
+            let origin = hit.point + offset * outside;
+            let towards = (incidence.l, incidence.distance);
+            let visibility = self.visibility_observed((index, depth), origin, towards, counts, observer);
+            if O::RECORDS {
+                observer.light(index, visibility, direct_terms(&sample, n, v, &incidence, self.terms));
+            }
             if visibility != Vec3::ZERO {
                 rad += visibility * direct(&sample, n, v, &incidence, self.terms);
             }
@@ -272,21 +375,31 @@ impl Whitted<'_> {
         let reflected = 2.0 * n.dot(v) * n - v;
         let cone = cone.continued(hit.t);
         let mut reflect_weight = material.mirror * material.mirror_color;
+        let mut reflected_name = "mirror kps·MPS·L(r)";
         if material.transmission > 0.0 {
             let weight = material.transmission * material.transmission_color;
             match refract(v, hit.geometric_normal, n, material.ior) {
                 Some(t) => {
                     counts.refracted += 1;
                     let origin = hit.point - offset * outside;
-                    rad += weight * self.radiance(&Ray { origin, direction: t }, cone, depth + 1, counts);
+                    let kind = (depth + 1, RayKind::Refracted);
+                    let through = self.radiance_observed(&Ray { origin, direction: t }, cone, kind, counts, observer);
+                    observer.term("transmitted kt·MT·L(t)".into(), weight * through);
+                    rad += weight * through;
                 }
-                None => reflect_weight += weight,
+                None => {
+                    reflect_weight += weight;
+                    reflected_name = "mirror kps·MPS·L(r), and kt·MT·L(r) by total internal reflection";
+                }
             }
         }
         if reflect_weight != Vec3::ZERO {
             counts.reflected += 1;
             let origin = hit.point + offset * outside;
-            rad += reflect_weight * self.radiance(&Ray { origin, direction: reflected }, cone, depth + 1, counts);
+            let kind = (depth + 1, RayKind::Reflected);
+            let mirrored = self.radiance_observed(&Ray { origin, direction: reflected }, cone, kind, counts, observer);
+            observer.term(reflected_name.into(), reflect_weight * mirrored);
+            rad += reflect_weight * mirrored;
         }
         rad
     }
@@ -303,18 +416,31 @@ impl Whitted<'_> {
     /// opaque occluder, `kt·MT` for glass (seed 003), 1 where a mask leaves no surface, and
     /// `1 − α` more through a blended one. Coverage is read at level 0: shadow rays carry no cone.
     pub fn visibility(&self, origin: Vec3, l: Vec3, distance: f32, counts: &mut RayCounts) -> Vec3 {
+        self.visibility_observed((0, 0), origin, (l, distance), counts, &mut Unobserved)
+    }
+
+    /// [`Self::visibility`] of light `light` from a surface hit at `depth`, reporting the shadow
+    /// ray and its occluders.
+    fn visibility_observed<O: Observer>(
+        &self,
+        (light, depth): (usize, u32),
+        origin: Vec3,
+        (l, distance): (Vec3, f32),
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> Vec3 {
         if !self.shadows {
             return Vec3::ONE;
         }
-        let mut transmitted = Vec3::ONE;
         let mut ray = Ray { origin, direction: l };
+        observer.begin(RayKind::Shadow, &ray, depth);
+        observer.towards(light);
+        let mut transmitted = Vec3::ONE;
         let mut remaining = distance;
         // Each surface passed restarts the ray beyond it.
         for _ in 0..MAX_LAYERS {
             counts.shadow += 1;
-            let Some(hit) = self.accelerator.closest(&self.primitives, &ray, 0.0, remaining) else {
-                return transmitted;
-            };
+            let Some(hit) = self.accelerator.closest(&self.primitives, &ray, 0.0, remaining) else { break };
             let primitive = &self.primitives[hit.primitive as usize];
             let material = &self.scene.materials[primitive.material().0];
             let coverage = || {
@@ -326,18 +452,25 @@ impl Whitted<'_> {
                 AlphaMode::Opaque | AlphaMode::Mask { .. } => 1.0,
                 AlphaMode::Blend => coverage().clamp(0.0, 1.0),
             };
-            transmitted *= alpha * material.transmission * material.transmission_color + Vec3::splat(1.0 - alpha);
+            let through = alpha * material.transmission * material.transmission_color + Vec3::splat(1.0 - alpha);
+            if O::RECORDS {
+                let mut surface = primitive.surface(&ray, hit.t);
+                surface.t = (ray.origin - origin).dot(l) + hit.t;
+                observer.occluder(&surface, through);
+            }
+            transmitted *= through;
             if transmitted == Vec3::ZERO {
-                return transmitted;
+                break;
             }
             let p = ray.at(hit.t);
             let step = hit.t + surface_offset(p);
             ray.origin = ray.at(step);
             remaining -= step;
             if remaining <= 0.0 {
-                return transmitted;
+                break;
             }
         }
+        observer.end(transmitted);
         transmitted
     }
 }

@@ -20,6 +20,7 @@ use glam::Vec3;
 
 use super::context::{Figure, FrameContext, FrameEncoder, FrameReport};
 use super::environment::pass::EnvironmentPass;
+use super::inspect::{Inspector, RasterPixel};
 use super::mirror::pass::{MirrorPass, volumes as mirror_volumes};
 use super::overlays::{FRUSTUM_COLOUR, Overlays, WIREFRAME_COLOUR, box_edges};
 use super::present::PresentPass;
@@ -56,6 +57,8 @@ pub struct Renderer {
     present: PresentPass,
     /// The lighting inputs (group 2), kept while the images it reads are the same ones.
     lighting: Option<([wgpu::TextureView; 7], wgpu::BindGroup)>,
+    /// Where an inspecting renderer records what its shaders computed at one pixel.
+    inspector: Option<Inspector>,
     /// Submit and time each pass on its own (`render --stats`): slower, but it says where the
     /// frame's time goes.
     pub profile: bool,
@@ -73,8 +76,19 @@ struct Phases<'p> {
 impl Renderer {
     /// The passes, with `scene` loaded.
     pub fn new(gpu: &Gpu, scene: &Scene, output_format: wgpu::TextureFormat) -> Renderer {
+        Renderer::build(gpu, scene, output_format, false)
+    }
+
+    /// A renderer that can inspect a pixel ([`Self::inspect`]): its lighting group carries the
+    /// inspection buffer, which needs storage buffers written by fragment shaders (every Vulkan
+    /// device; not WebGL).
+    pub fn inspecting(gpu: &Gpu, scene: &Scene, output_format: wgpu::TextureFormat) -> Renderer {
+        Renderer::build(gpu, scene, output_format, true)
+    }
+
+    fn build(gpu: &Gpu, scene: &Scene, output_format: wgpu::TextureFormat, inspect: bool) -> Renderer {
         let device = &gpu.device;
-        let layouts = SceneLayouts::new(device);
+        let layouts = SceneLayouts::new(device, inspect);
         let shader = SceneShader::new(device, &layouts);
         let mipmaps = MipmapGenerator::new(device);
         let mut mirrors = MirrorPass::default();
@@ -96,8 +110,23 @@ impl Renderer {
             shader,
             layouts,
             lighting: None,
+            inspector: inspect.then(|| Inspector::new(device)),
             profile: false,
         }
+    }
+
+    /// Inspects `pixel` (of the drawn image) in the next frames, or nothing. Only a renderer made
+    /// by [`Self::inspecting`] can.
+    pub fn inspect(&mut self, pixel: Option<(u32, u32)>) {
+        if let Some(inspector) = &mut self.inspector {
+            inspector.pixel = pixel;
+        }
+    }
+
+    /// What the last frame computed at the inspected pixel, read back from the GPU; `targets` are
+    /// the frame's.
+    pub fn inspection(&self, gpu: &Gpu, targets: &FrameTargets) -> Option<RasterPixel> {
+        self.inspector.as_ref()?.read(gpu, &targets.hdr.texture)
     }
 
     /// Loads `scene` in place of the last one: uploads it, and every pass forgets what it kept of
@@ -140,11 +169,17 @@ impl Renderer {
         }
         let targets = &*targets;
         let mut frame = FrameEncoder::new(gpu, self.profile);
-        let plan = self.plan(gpu, scene, settings, size, &mut frame);
+        let mut plan = self.plan(gpu, scene, settings, size, &mut frame);
+        if let Some((inspector, pixel)) = self.inspector.as_ref().and_then(|i| Some((i, i.pixel?))) {
+            inspector.begin(&gpu.queue, pixel);
+            plan.main.key.inspect = true;
+        }
         let layers = (&plan.maps, plan.first_shadow_slot);
         self.shadow.record(gpu, &mut frame, &self.scene_gpu, layers, &settings.shadows);
         let maps = self.shadow.maps();
-        let lighting = lighting_group(&mut self.lighting, gpu, &self.layouts, (&maps, targets), &self.environment);
+        let inspection = self.inspector.as_ref().map(|i| &i.buffer);
+        let lighting =
+            lighting_group(&mut self.lighting, gpu, &self.layouts, (&maps, targets, inspection), &self.environment);
         let lighting = &lighting.clone();
         let ctx = FrameContext { gpu, scene, scene_gpu: &self.scene_gpu, settings, shader: &self.shader, lighting };
         let (mirrors, environment) = (&self.mirrors, &self.environment);
@@ -302,7 +337,7 @@ fn lighting_group<'c>(
     cache: &'c mut Option<([wgpu::TextureView; 7], wgpu::BindGroup)>,
     gpu: &Gpu,
     layouts: &SceneLayouts,
-    (maps, targets): (&ShadowMaps, &FrameTargets),
+    (maps, targets, inspection): (&ShadowMaps, &FrameTargets, Option<&wgpu::Buffer>),
     environment: &EnvironmentPass,
 ) -> &'c wgpu::BindGroup {
     let env = environment.maps();
@@ -318,25 +353,29 @@ fn lighting_group<'c>(
     if cache.as_ref().is_none_or(|(kept, _)| kept.iter().zip(images).any(|(a, b)| a != b)) {
         let texture =
             |binding, view| wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(view) };
+        let mut entries = vec![
+            wgpu::BindGroupEntry { binding: 0, resource: maps.uniform.binding() },
+            texture(1, maps.depth),
+            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(maps.sampler) },
+            texture(3, maps.transmission),
+            texture(4, &targets.shadow_mask.view),
+            wgpu::BindGroupEntry { binding: 5, resource: env.params.binding() },
+            wgpu::BindGroupEntry {
+                binding: 6,
+                resource: wgpu::BindingResource::Sampler(&environment.converter.sampler),
+            },
+            texture(7, &env.cube.view),
+            texture(8, &env.dynamic.view),
+            texture(9, &env.sphere.view),
+            texture(10, &env.latlong.view),
+        ];
+        if let Some(buffer) = inspection {
+            entries.push(wgpu::BindGroupEntry { binding: 11, resource: buffer.as_entire_binding() });
+        }
         let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("frame::lighting_group"),
             layout: &layouts.lighting,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: maps.uniform.binding() },
-                texture(1, maps.depth),
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(maps.sampler) },
-                texture(3, maps.transmission),
-                texture(4, &targets.shadow_mask.view),
-                wgpu::BindGroupEntry { binding: 5, resource: env.params.binding() },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: wgpu::BindingResource::Sampler(&environment.converter.sampler),
-                },
-                texture(7, &env.cube.view),
-                texture(8, &env.dynamic.view),
-                texture(9, &env.sphere.view),
-                texture(10, &env.latlong.view),
-            ],
+            entries: &entries,
         });
         *cache = Some((images.map(Clone::clone), group));
     }

@@ -1,0 +1,169 @@
+// Inspecting one pixel (`mirador explain`, the viewer's inspect mode; src/raster/inspect.rs):
+// composed last into the scene module. Under INSPECT the shading functions of scene.wgsl,
+// transparency.wgsl and volume.wgsl also fill `probe`, a private record of what they computed
+// (each term, each light's visibility and shadow-map lookup, the texture's level, the bumped
+// normal, the reflections); the `*_inspect` entry points, drawn only in the main view of an
+// inspected frame, append the record of every fragment that lands on the inspected pixel to a
+// storage buffer, in the order they are drawn (the order they are blended in). Normal frames
+// use the plain entry points with INSPECT off, which never touch `probe`.
+
+override INSPECT: bool = false;
+
+const MAX_INSPECTED: u32 = 32u;
+
+const INSPECT_OPAQUE: u32 = 1u;
+const INSPECT_MIRROR: u32 = 2u;
+const INSPECT_TRANSPARENT: u32 = 3u;
+const INSPECT_BACKGROUND: u32 = 4u;
+const INSPECT_ISOSURFACE: u32 = 5u;
+const INSPECT_VOLUME: u32 = 6u;
+
+struct InspectLight {
+    // Each part of S·L_dir, before the visibility.
+    ambient: vec3f,
+    // The shadow-map layer looked up, −1 for none (the light casts none, or projected shadows).
+    layer: i32,
+    diffuse: vec3f,
+    // The filter's lit fraction (projected shadows: 1 − the mask).
+    lit: f32,
+    specular: vec3f,
+    // The depth stored in the texel the lookup lands in.
+    stored_depth: f32,
+    // V: the lit fraction times the transmission maps' tint.
+    visibility: vec3f,
+    // The receiver's depth as the light sees it (after the normal offset).
+    receiver_depth: f32,
+    texel: vec2f,
+    _pad0: f32,
+    _pad1: f32,
+}
+
+struct InspectFragment {
+    kind: u32,
+    // Material index, object index (u32 max: unknown), and the fragment's depth.
+    material: u32,
+    object: u32,
+    depth: f32,
+    world: vec3f,
+    // The colour texture's mip level (−1: no texture).
+    lod: f32,
+    normal: vec3f,
+    // Coverage α (transparent and blended fragments), the march's accumulated opacity (volumes).
+    alpha: f32,
+    geometric: vec3f,
+    // Volumes: samples taken.
+    samples: f32,
+    uv: vec2f,
+    // Texels the pixel spans along x and y: the footprint the level comes from.
+    footprint: vec2f,
+    colour: vec3f,
+    // Bump mapping's k, and its slopes (du, dv); Δ in uv.
+    bump_k: f32,
+    bump: vec2f,
+    bump_delta: vec2f,
+    emission: vec3f,
+    env_layer: i32,
+    global_ambient: vec3f,
+    _pad0: f32,
+    // kps·MPS·L(r) looked up in an environment map, and r.
+    environment: vec3f,
+    _pad1: f32,
+    env_direction: vec3f,
+    _pad2: f32,
+    // kps·MPS times the mirrored camera's image.
+    mirror: vec3f,
+    _pad3: f32,
+    // What the fragment returns: the radiance it shades (premultiplied by α where it blends).
+    radiance: vec3f,
+    _pad4: f32,
+    lights: array<InspectLight, MAX_LIGHTS>,
+}
+
+struct Inspection {
+    // The pixel inspected, written by the CPU.
+    pixel: vec2u,
+    count: atomic<u32>,
+    _pad: u32,
+    fragments: array<InspectFragment, MAX_INSPECTED>,
+}
+
+@group(2) @binding(11) var<storage, read_write> inspection: Inspection;
+
+var<private> probe: InspectFragment;
+// The light `visibility` is evaluated for, so it can fill that light's record.
+var<private> probe_light: u32;
+
+// Appends the record of a fragment of `kind` at `clip` with `radiance` when it lands on the
+// inspected pixel.
+fn inspect_record(kind: u32, clip: vec4f, radiance: vec3f) {
+    if any(vec2u(clip.xy) != inspection.pixel) {
+        return;
+    }
+    let index = atomicAdd(&inspection.count, 1u);
+    if index < MAX_INSPECTED {
+        probe.kind = kind;
+        probe.depth = clip.z;
+        probe.material = material.index;
+        probe.radiance = radiance;
+        inspection.fragments[index] = probe;
+    }
+}
+
+@fragment
+fn fs_scene_inspect(in: VertexOut) -> @location(0) vec4f {
+    probe.object = in.object;
+    let out = scene_fragment(in);
+    inspect_record(INSPECT_OPAQUE, in.clip, out.rgb);
+    return out;
+}
+
+@fragment
+fn fs_mirror_inspect(in: VertexOut) -> @location(0) vec4f {
+    probe.object = in.object;
+    let out = mirror_fragment(in);
+    inspect_record(INSPECT_MIRROR, in.clip, out.rgb);
+    return out;
+}
+
+@fragment
+fn fs_transparent_inspect(in: VertexOut) -> @location(0) vec4f {
+    probe.object = in.object;
+    let out = transparent_fragment(in);
+    probe.alpha = out.a;
+    inspect_record(INSPECT_TRANSPARENT, in.clip, out.rgb);
+    return out;
+}
+
+@fragment
+fn fs_background_inspect(in: BackgroundOut) -> @location(0) vec4f {
+    let out = background_fragment(in);
+    probe.object = 0xffffffffu;
+    if all(vec2u(in.clip.xy) == inspection.pixel) {
+        let index = atomicAdd(&inspection.count, 1u);
+        if index < MAX_INSPECTED {
+            probe.kind = INSPECT_BACKGROUND;
+            probe.depth = 1.0;
+            probe.material = 0xffffffffu;
+            probe.radiance = out.rgb;
+            inspection.fragments[index] = probe;
+        }
+    }
+    return out;
+}
+
+@fragment
+fn fs_volume_composite_inspect(in: VolumeVertex) -> @location(0) vec4f {
+    probe.object = 0xffffffffu;
+    let out = composite_fragment(in);
+    probe.alpha = out.a;
+    inspect_record(INSPECT_VOLUME, in.clip, out.rgb);
+    return out;
+}
+
+@fragment
+fn fs_volume_isosurface_inspect(in: VolumeVertex) -> IsosurfaceOut {
+    probe.object = 0xffffffffu;
+    let out = isosurface_fragment(in);
+    inspect_record(INSPECT_ISOSURFACE, vec4f(in.clip.xy, out.depth, 1.0), out.colour.rgb);
+    return out;
+}

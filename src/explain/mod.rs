@@ -1,0 +1,536 @@
+//! Explaining a pixel: what each renderer computed there, term by term, and why they differ.
+//!
+//! The rasterizer's side comes from the GPU: an inspecting frame ([`crate::raster::inspect`])
+//! records every fragment its shaders drew at the pixel: the terms of the illumination model,
+//! each light's visibility and shadow-map lookup, the texture's level, the bumped normal, the
+//! reflections, the transparent layers and volumes blended over the surface. This module works out
+//! which fragments the depth test and the blend kept, in which order, and writes the pixel's
+//! radiance as a sum of terms (each weighted by what the layers in front let through). The
+//! tracer's side is its ray tree (`crate::trace::explain`): every ray the pixel cast, each with
+//! the terms of its radiance. [`diagnosis`] names the technique behind a difference.
+//!
+//! Used by `mirador explain`, the viewer's inspect mode and the tests.
+
+pub mod diagnosis;
+pub mod text;
+
+use glam::{Vec2, Vec3};
+use serde::Serialize;
+
+use crate::gpu::Gpu;
+use crate::gpu::texture::GpuTexture;
+use crate::raster::inspect::{
+    GpuInspectFragment, INSPECT_BACKGROUND, INSPECT_ISOSURFACE, INSPECT_MIRROR, INSPECT_OPAQUE, INSPECT_TRANSPARENT,
+    INSPECT_VOLUME, RasterPixel,
+};
+use crate::raster::shadow::views::shadow_layout_in;
+use crate::raster::uniforms::{UNKNOWN_OBJECT, transmittance};
+use crate::raster::{FrameTargets, OUTPUT_FORMAT, Renderer};
+use crate::scene::Scene;
+use crate::settings::{RenderSettings, ShadowMethod, TransparencySort};
+use crate::trace::Tracer;
+use crate::trace::explain::{RayNode, RayTree, Term};
+
+/// Both renderers at one pixel, and why they differ.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Explanation {
+    pub pixel: [u32; 2],
+    pub raster: RasterSide,
+    pub trace: TraceSide,
+    /// One sentence naming the technique behind the difference, where the radiances differ.
+    pub diagnosis: Option<String>,
+}
+
+/// The rasterizer at the pixel, as its shaders computed it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RasterSide {
+    /// Linear radiance, before exposure and tone mapping (the HDR target's half floats).
+    pub radiance: Vec3,
+    /// What the radiance is made of; the terms add up to it (to half-float precision).
+    pub terms: Vec<Term>,
+    /// The surface the z-buffer kept (`None`: nothing was drawn, the background colour).
+    pub surface: Option<RasterSurface>,
+    /// The surface's lights, with each one's visibility and shadow lookup.
+    pub lights: Vec<RasterLight>,
+    /// Transparent surfaces and composited volumes blended over the surface, in blend order.
+    pub layers: Vec<Layer>,
+}
+
+/// The surface the z-buffer kept at the pixel.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RasterSurface {
+    /// `opaque`, `mirror`, `isosurface` or `background`.
+    pub kind: &'static str,
+    pub object: Option<String>,
+    pub material: Option<String>,
+    pub point: Vec3,
+    /// The depth buffer's value.
+    pub depth: f32,
+    pub normal: Vec3,
+    pub geometric_normal: Vec3,
+    pub uv: Vec2,
+    /// The colour texture's mip level from the screen derivatives (`None`: no texture).
+    pub lod: Option<f32>,
+    /// Texels the pixel spans along the screen's x and y.
+    pub footprint: Vec2,
+    pub colour: Vec3,
+    pub bump: Option<Bump>,
+    /// A curved mirror's lookup: the direction `r` and the map.
+    pub environment: Option<EnvironmentLookup>,
+    /// A planar mirror's: the mirrored camera and the texel of its image.
+    pub mirror: Option<MirrorLookup>,
+}
+
+/// Bump mapping at the pixel: `k`, `Δ` and the slopes `(du, dv) = k·∇f_h`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Bump {
+    pub k: f32,
+    pub delta: Vec2,
+    pub slopes: Vec2,
+}
+
+/// A curved mirror's environment lookup.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EnvironmentLookup {
+    /// `r = 2(n·v)n − v`, the direction looked up.
+    pub direction: Vec3,
+    /// `cube (dynamic, object's centre)`, `cube (world)`, `sphere` or `latlong`.
+    pub map: String,
+    /// Where a dynamic cube was captured (its object's centre).
+    pub centre: Option<Vec3>,
+    /// The cube face and texel (for cubes), or the map's texel coordinates.
+    pub texel: String,
+    /// `kps·MPS·L(r)`.
+    pub radiance: Vec3,
+}
+
+/// A planar mirror's lookup.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MirrorLookup {
+    /// The mirrored camera's eye: the camera reflected about the mirror's plane.
+    pub mirrored_eye: Vec3,
+    /// The texel of the mirrored camera's image read: the pixel itself.
+    pub texel: [u32; 2],
+    /// `kps·MPS` times that texel.
+    pub radiance: Vec3,
+}
+
+/// A light at the raster surface.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RasterLight {
+    pub light: usize,
+    pub name: String,
+    /// `V`: the filter's lit fraction times the tint of transparent occluders.
+    pub visibility: Vec3,
+    #[serde(flatten)]
+    pub shadow: Option<ShadowLookup>,
+}
+
+/// What a shadow lookup read.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ShadowLookup {
+    /// `map` or `projected`.
+    pub method: &'static str,
+    pub layer: Option<u32>,
+    pub texel: Option<[u32; 2]>,
+    pub stored_depth: Option<f32>,
+    pub receiver_depth: Option<f32>,
+    /// The constant depth bias at the stored depth (`depth_bias` steps of the depth format's
+    /// resolution there); the slope-scaled part depends on the occluder's slope.
+    pub bias: Option<f32>,
+    /// The lookup point moved along the normal, in world units.
+    pub normal_offset: Option<f32>,
+    /// The filter's fraction of lit comparisons (1 − the mask for projected shadows).
+    pub lit: f32,
+}
+
+/// A transparent surface or a composited volume blended over what was behind it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Layer {
+    /// `transparent` or `volume`.
+    pub kind: &'static str,
+    pub object: Option<String>,
+    pub material: Option<String>,
+    pub depth: f32,
+    /// What it adds: `Im` (`α·Im` when alpha-blended), or the volume's premultiplied colour.
+    pub adds: Vec3,
+    /// What it lets through of what is behind: `kt·Mt`, `1 − α`.
+    pub lets_through: Vec3,
+    /// Volumes: samples taken.
+    pub samples: Option<u32>,
+}
+
+/// The tracer at the pixel.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TraceSide {
+    /// Linear radiance, as `trace --exr` writes it.
+    pub radiance: Vec3,
+    /// The primary ray's terms; they add up to the radiance.
+    pub terms: Vec<Term>,
+    /// The lights at the primary hit, each with its shadow ray's visibility.
+    pub lights: Vec<crate::trace::explain::LightState>,
+    /// The ray tree: the primary ray and every ray it cast, to `max_depth`.
+    pub rays: RayNode,
+}
+
+/// Why a pixel cannot be explained.
+#[derive(Debug, thiserror::Error)]
+pub enum ExplainError {
+    #[error("pixel ({0}, {1}) lies outside the {2}×{3} image")]
+    Outside(u32, u32, u32, u32),
+    #[error(
+        "this device cannot inspect pixels: it lacks storage buffers written by fragment shaders (try the Vulkan backend)"
+    )]
+    Unsupported,
+    #[error("reading the inspection back failed")]
+    Readback,
+}
+
+/// Explains pixel `(x, y)` of `scene` as drawn by both renderers with `settings`.
+pub fn explain(
+    gpu: &Gpu,
+    scene: &Scene,
+    settings: &RenderSettings,
+    (x, y): (u32, u32),
+) -> Result<Explanation, ExplainError> {
+    let (width, height) = (scene.camera.width, scene.camera.height);
+    if x >= width || y >= height {
+        return Err(ExplainError::Outside(x, y, width, height));
+    }
+    let raster = inspect(gpu, scene, settings, (x, y))?;
+    let tracer = Tracer::new(scene, settings);
+    let mut tree = RayTree::new(scene);
+    tracer.explain_pixel((x, y), &mut tree);
+    let rays = tree.root.expect("the primary ray ends");
+    let trace = TraceSide { radiance: rays.radiance, terms: rays.terms.clone(), lights: rays.lights.clone(), rays };
+    let raster = raster_side(scene, settings, &raster);
+    let diagnosis = diagnosis::diagnose(scene, settings, &raster, &trace);
+    Ok(Explanation { pixel: [x, y], raster, trace, diagnosis })
+}
+
+/// One inspected frame of the rasterizer at `pixel` (render scale 1: the pixel is the image's).
+fn inspect(
+    gpu: &Gpu,
+    scene: &Scene,
+    settings: &RenderSettings,
+    pixel: (u32, u32),
+) -> Result<RasterPixel, ExplainError> {
+    let flags = gpu.adapter.get_downlevel_capabilities().flags;
+    if !flags.contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE) {
+        return Err(ExplainError::Unsupported);
+    }
+    let mut settings = settings.clone();
+    settings.raster.render_scale = 1.0;
+    let size = (scene.camera.width, scene.camera.height);
+    let mut renderer = Renderer::inspecting(gpu, scene, OUTPUT_FORMAT);
+    let mut targets = FrameTargets::new(&gpu.device, size);
+    let output = GpuTexture::target(&gpu.device, "explain::output", size, OUTPUT_FORMAT);
+    renderer.inspect(Some(pixel));
+    renderer.render(gpu, scene, &settings, &mut targets, &output.view);
+    renderer.inspection(gpu, &targets).ok_or(ExplainError::Readback)
+}
+
+fn object_name(scene: &Scene, index: u32) -> Option<String> {
+    (index != UNKNOWN_OBJECT).then(|| scene.objects.get(index as usize).map(|o| o.name.clone())).flatten()
+}
+
+fn material_name(scene: &Scene, index: u32) -> Option<String> {
+    scene.materials.get(index as usize).map(|m| m.name.clone())
+}
+
+/// What the depth test and the blend kept of the recorded fragments, in blend order: the
+/// surface, then each blended layer with what it lets through.
+struct Kept<'r> {
+    surface: Option<&'r GpuInspectFragment>,
+    layers: Vec<(&'r GpuInspectFragment, Vec3)>,
+}
+
+/// Which recorded fragments were blended. Fragment shaders that write storage run before the
+/// depth test, so the records hold rejected fragments too; this replays the tests: opaque
+/// surfaces (and isosurfaces) keep the nearest, `Less`; the world fills the pixel only where
+/// nothing was; transparent fragments are blended where nearer than it, in draw order; with
+/// depth peeling each peel's shading pass draws every transparent fragment and keeps the one at
+/// its layer's depth (layers farthest first, `peel_layers` of them).
+fn kept<'r>(scene: &Scene, settings: &RenderSettings, pixel: &'r RasterPixel) -> Kept<'r> {
+    let records = &pixel.fragments;
+    let solid = |r: &&GpuInspectFragment| matches!(r.kind, INSPECT_OPAQUE | INSPECT_MIRROR | INSPECT_ISOSURFACE);
+    let surface = records
+        .iter()
+        .filter(solid)
+        .min_by(|a, b| a.depth.total_cmp(&b.depth))
+        .or_else(|| records.iter().find(|r| r.kind == INSPECT_BACKGROUND));
+    let depth = surface.filter(|s| s.kind != INSPECT_BACKGROUND).map_or(1.0, |s| s.depth);
+    // The blend's `kt·Mt`: the material's constant, or `1 − α` where a texture's alpha blends it
+    // per pixel (`crate::raster::transparency`); a volume lets `1 − α` through.
+    let lets_through = |r: &GpuInspectFragment| -> Vec3 {
+        if r.kind == INSPECT_VOLUME {
+            return Vec3::splat(1.0 - r.alpha);
+        }
+        let material = &scene.materials[r.material as usize];
+        if material.alpha_mode == crate::scene::AlphaMode::Blend && material.texture.is_some() {
+            Vec3::splat(1.0 - r.alpha)
+        } else {
+            transmittance(material)
+        }
+    };
+    let transparent: Vec<&GpuInspectFragment> = records.iter().filter(|r| r.kind == INSPECT_TRANSPARENT).collect();
+    let peeled = settings.transparency.enabled && settings.transparency.sort == TransparencySort::Exact;
+    let mut layers = Vec::new();
+    if peeled && !transparent.is_empty() {
+        // Each peel's shading pass recorded the same fragments; the layers are their depths
+        // nearer than the surface, farthest first.
+        let passes = settings.transparency.peel_layers as usize;
+        let group = (transparent.len() / passes).max(1);
+        let mut depths: Vec<f32> = transparent.iter().map(|r| r.depth).filter(|&d| d < depth).collect();
+        depths.sort_by(|a, b| b.total_cmp(a));
+        depths.dedup();
+        depths.truncate(passes);
+        let mut seen = 0;
+        for record in records {
+            match record.kind {
+                INSPECT_VOLUME => layers.push((record, lets_through(record))),
+                INSPECT_TRANSPARENT => {
+                    let pass = seen / group;
+                    seen += 1;
+                    if depths.get(pass) == Some(&record.depth) {
+                        layers.push((record, lets_through(record)));
+                    }
+                }
+                _ => {}
+            }
+        }
+    } else {
+        for record in records {
+            let blended = match record.kind {
+                INSPECT_VOLUME => true,
+                INSPECT_TRANSPARENT => record.depth < depth,
+                _ => false,
+            };
+            if blended {
+                layers.push((record, lets_through(record)));
+            }
+        }
+    }
+    Kept { surface, layers }
+}
+
+/// The rasterizer's side from its records.
+fn raster_side(scene: &Scene, settings: &RenderSettings, pixel: &RasterPixel) -> RasterSide {
+    let kept = kept(scene, settings, pixel);
+    // What the layers in front of each element let through, nearest last.
+    let mut front = vec![Vec3::ONE; kept.layers.len() + 1];
+    for k in (0..kept.layers.len()).rev() {
+        front[k] = front[k + 1] * kept.layers[k].1;
+    }
+    let mut terms = Vec::new();
+    let surface_through = front[0];
+    let surface = kept.surface.map(|record| raster_surface(scene, settings, record, pixel.pixel));
+    let mut lights = Vec::new();
+    match kept.surface {
+        Some(record) if record.kind == INSPECT_BACKGROUND => {
+            terms.push(Term { name: "the world (background)".into(), radiance: surface_through * record.radiance });
+        }
+        Some(record) => {
+            let name = object_name(scene, record.object).unwrap_or_else(|| "isosurface".into());
+            fragment_terms(scene, record, &name, surface_through, &mut terms);
+            lights = raster_lights(scene, settings, record);
+        }
+        None => terms.push(Term { name: "background colour".into(), radiance: surface_through * scene.background }),
+    }
+    let mut layers = Vec::new();
+    for (k, (record, through)) in kept.layers.iter().enumerate() {
+        let weight = front[k + 1];
+        let object = object_name(scene, record.object);
+        if record.kind == INSPECT_VOLUME {
+            terms.push(Term { name: "composited volume C".into(), radiance: weight * record.radiance });
+        } else {
+            let name = object.clone().or_else(|| material_name(scene, record.material)).unwrap_or_default();
+            // The fragment returned `α·Im` (α = 1 unless alpha-blended).
+            fragment_terms(scene, record, &format!("{name} (transparent)"), weight * record.alpha, &mut terms);
+        }
+        layers.push(Layer {
+            kind: if record.kind == INSPECT_VOLUME { "volume" } else { "transparent" },
+            object,
+            material: (record.kind != INSPECT_VOLUME).then(|| material_name(scene, record.material)).flatten(),
+            depth: record.depth,
+            adds: record.radiance,
+            lets_through: *through,
+            samples: (record.kind == INSPECT_VOLUME).then_some(record.samples as u32),
+        });
+    }
+    RasterSide { radiance: pixel.radiance, terms, surface, lights, layers }
+}
+
+/// The terms of one shaded fragment, times `weight` (what lies in front lets through), named
+/// after `name`.
+fn fragment_terms(scene: &Scene, record: &GpuInspectFragment, name: &str, weight: Vec3, terms: &mut Vec<Term>) {
+    let mut push = |term: String, radiance: Vec3| {
+        if radiance != Vec3::ZERO {
+            terms.push(Term { name: format!("{name}: {term}"), radiance: weight * radiance });
+        }
+    };
+    push("emission ME".into(), record.emission);
+    push("global ambient AG = A·kd·C".into(), record.global_ambient);
+    for (index, light) in scene.lights.iter().enumerate().take(record.lights.len()) {
+        let l = &record.lights[index];
+        for (part, radiance) in
+            [("ambient ka·C", l.ambient), ("diffuse kd·C·(n·l)", l.diffuse), ("specular ks·S·(r·v)^e", l.specular)]
+        {
+            push(format!("light `{}`: {part} × V", light.name), l.visibility * radiance);
+        }
+    }
+    push("environment map kps·MPS·L(r)".into(), record.environment);
+    push("planar mirror kps·MPS·L(r)".into(), record.mirror);
+}
+
+fn raster_surface(
+    scene: &Scene,
+    settings: &RenderSettings,
+    record: &GpuInspectFragment,
+    pixel: (u32, u32),
+) -> RasterSurface {
+    let kind = match record.kind {
+        INSPECT_MIRROR => "mirror",
+        INSPECT_ISOSURFACE => "isosurface",
+        INSPECT_BACKGROUND => "background",
+        _ => "opaque",
+    };
+    let background = record.kind == INSPECT_BACKGROUND;
+    let reflective = scene.materials.get(record.material as usize).is_some_and(|m| m.mirror > 0.0);
+    let looked_up = record.kind != INSPECT_MIRROR && record.env_direction != Vec3::ZERO;
+    let environment = (reflective && looked_up && !background).then(|| environment_lookup(scene, settings, record));
+    let mirror = (record.kind == INSPECT_MIRROR).then(|| {
+        let eye = scene.camera.eye;
+        let plane = crate::raster::mirror::find_mirrors(scene)
+            .0
+            .into_iter()
+            .find(|m| m.object as u32 == record.object)
+            .map(|m| m.plane);
+        let mirrored_eye = plane.map_or(eye, |p| eye - 2.0 * p.distance(eye) * p.normal);
+        MirrorLookup { mirrored_eye, texel: [pixel.0, pixel.1], radiance: record.mirror }
+    });
+    RasterSurface {
+        kind,
+        object: if background { None } else { object_name(scene, record.object) },
+        material: if background { None } else { material_name(scene, record.material) },
+        point: record.world,
+        depth: record.depth,
+        normal: record.normal,
+        geometric_normal: record.geometric,
+        uv: record.uv,
+        lod: (record.lod >= 0.0 && !background).then_some(record.lod),
+        footprint: record.footprint,
+        colour: record.colour,
+        bump: (record.bump_k != 0.0).then_some(Bump {
+            k: record.bump_k,
+            delta: record.bump_delta,
+            slopes: record.bump,
+        }),
+        environment,
+        mirror,
+    }
+}
+
+fn environment_lookup(scene: &Scene, settings: &RenderSettings, record: &GpuInspectFragment) -> EnvironmentLookup {
+    use crate::settings::EnvironmentMap;
+    let r = record.env_direction.normalize_or_zero();
+    let env = &settings.environment;
+    let dynamic = env.map == EnvironmentMap::Cube && env.dynamic && record.env_layer >= 0;
+    let centre = dynamic
+        .then(|| {
+            (record.object != UNKNOWN_OBJECT)
+                .then(|| crate::raster::environment::object_centre(scene, record.object as usize).0)
+        })
+        .flatten();
+    let (map, texel) = match env.map {
+        EnvironmentMap::Cube => {
+            let size = env.cube_size as f32;
+            let (face, uv) = crate::scene::environment::cube_face_uv(r);
+            let faces = ["+X", "−X", "+Y", "−Y", "+Z", "−Z"];
+            let name = if dynamic { "cube (dynamic, captured at the object's centre)" } else { "cube (the world's)" };
+            (
+                name.to_string(),
+                format!("face {} texel ({}, {})", faces[face], (uv.x * size) as u32, (uv.y * size) as u32),
+            )
+        }
+        EnvironmentMap::Sphere => ("sphere map".to_string(), "in view space".to_string()),
+        EnvironmentMap::Latlong => {
+            let uv = crate::scene::environment::latlong_uv(r);
+            ("lat–long map".to_string(), format!("(u, v) = ({:.3}, {:.3})", uv.x, uv.y))
+        }
+    };
+    EnvironmentLookup { direction: r, map, centre, texel, radiance: record.environment }
+}
+
+fn raster_lights(scene: &Scene, settings: &RenderSettings, record: &GpuInspectFragment) -> Vec<RasterLight> {
+    let shadows = &settings.shadows;
+    let layout = shadow_layout_in(scene, scene.bounds(), shadows);
+    scene
+        .lights
+        .iter()
+        .enumerate()
+        .take(record.lights.len())
+        .map(|(index, light)| {
+            let l = &record.lights[index];
+            let casts = shadows.enabled && layout.first_layer.get(index).copied().flatten().is_some();
+            let shadow = casts.then(|| match shadows.method {
+                ShadowMethod::Projected => ShadowLookup {
+                    method: "projected",
+                    layer: None,
+                    texel: None,
+                    stored_depth: None,
+                    receiver_depth: None,
+                    bias: None,
+                    normal_offset: None,
+                    lit: l.lit,
+                },
+                ShadowMethod::Map => {
+                    let looked = l.layer >= 0;
+                    // A map texel's world size at the point: fixed for orthographic views, growing
+                    // with the distance from the light for perspective ones (as the lookup has it).
+                    let texel_size =
+                        looked.then(|| layout.views.get(l.layer as usize)).flatten().map(|view| {
+                            match light.position() {
+                                Some(position) if view.perspective => view.texel_size * position.distance(record.world),
+                                _ => view.texel_size,
+                            }
+                        });
+                    ShadowLookup {
+                        method: "map",
+                        layer: looked.then_some(l.layer as u32),
+                        texel: looked.then_some([l.texel.x as u32, l.texel.y as u32]),
+                        stored_depth: looked.then_some(l.stored_depth),
+                        receiver_depth: looked.then_some(l.receiver_depth),
+                        bias: looked.then(|| constant_bias(l.stored_depth, shadows.depth_bias)),
+                        normal_offset: texel_size.map(|t| shadows.normal_offset * t),
+                        lit: l.lit,
+                    }
+                }
+            });
+            RasterLight { light: index, name: light.name.clone(), visibility: l.visibility, shadow }
+        })
+        .collect()
+}
+
+/// The constant part of the hardware depth bias at depth `z` for a 32-bit float depth buffer:
+/// `steps` times the spacing of floats at `z`, `2^(⌊log2 z⌋ − 23)`.
+pub fn constant_bias(z: f32, steps: i32) -> f32 {
+    if z <= 0.0 {
+        return 0.0;
+    }
+    steps as f32 * (2.0f32).powi(z.log2().floor() as i32 - 23)
+}
+
+/// The ray-traced pixel's tree, for callers with a tracer of their own.
+pub fn trace_pixel(tracer: &Tracer, pixel: (u32, u32)) -> RayNode {
+    let mut tree = RayTree::new(tracer.scene);
+    tracer.explain_pixel(pixel, &mut tree);
+    tree.root.expect("the primary ray ends")
+}
+
+impl Explanation {
+    /// The explanation as pretty-printed JSON.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("an explanation serializes")
+    }
+}
