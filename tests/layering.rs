@@ -3,7 +3,7 @@
 //!
 //! - the crate's layers, each importing only from those below it:
 //!   `settings | shaders` ← `output | compare | settings_doc` ← `scene | volume | linear_output`
-//!   ← `texture` ← `trace | gpu` ← `raster` ← `viewer` (← `main.rs`), where modules of one layer
+//!   ← `texture` ← `trace | gpu` ← `raster` ← `explain` ← `viewer` (← `main.rs`), where modules of one layer
 //!   do not import each other (except `scene` and `volume`, the two halves of the scene);
 //! - inside `raster`: data (`context`, `geometry`, `keys`, `scene_gpu`, `targets`, `uniforms`,
 //!   `view`) ← passes (every technique's module) ← frame (`frame`, and `raster` itself);
@@ -31,7 +31,8 @@ const LAYERS: &[(&str, u32)] = &[
     ("trace", 4),
     ("gpu", 4),
     ("raster", 5),
-    ("viewer", 6),
+    ("explain", 6),
+    ("viewer", 7),
 ];
 
 /// Modules of one layer that may import each other (never in a circle: that is checked too).

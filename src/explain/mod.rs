@@ -191,43 +191,58 @@ pub fn explain(
     gpu: &Gpu,
     scene: &Scene,
     settings: &RenderSettings,
-    (x, y): (u32, u32),
+    pixel: (u32, u32),
 ) -> Result<Explanation, ExplainError> {
-    let (width, height) = (scene.camera.width, scene.camera.height);
-    if x >= width || y >= height {
-        return Err(ExplainError::Outside(x, y, width, height));
-    }
-    let raster = inspect(gpu, scene, settings, (x, y))?;
-    let tracer = Tracer::new(scene, settings);
-    let mut tree = RayTree::new(scene);
-    tracer.explain_pixel((x, y), &mut tree);
-    let rays = tree.root.expect("the primary ray ends");
-    let trace = TraceSide { radiance: rays.radiance, terms: rays.terms.clone(), lights: rays.lights.clone(), rays };
-    let raster = raster_side(scene, settings, &raster);
-    let diagnosis = diagnosis::diagnose(scene, settings, &raster, &trace);
-    Ok(Explanation { pixel: [x, y], raster, trace, diagnosis })
+    Explainer::new(gpu, scene, settings)?.explain(gpu, pixel)
 }
 
-/// One inspected frame of the rasterizer at `pixel` (render scale 1: the pixel is the image's).
-fn inspect(
-    gpu: &Gpu,
-    scene: &Scene,
-    settings: &RenderSettings,
-    pixel: (u32, u32),
-) -> Result<RasterPixel, ExplainError> {
-    let flags = gpu.adapter.get_downlevel_capabilities().flags;
-    if !flags.contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE) {
-        return Err(ExplainError::Unsupported);
+/// Both renderers ready to explain pixels of one scene: an inspecting rasterizer (render scale 1:
+/// the pixel is the image's) and a tracer.
+pub struct Explainer<'s> {
+    scene: &'s Scene,
+    settings: RenderSettings,
+    renderer: Renderer,
+    targets: FrameTargets,
+    output: GpuTexture,
+    tracer: Tracer<'s>,
+}
+
+impl<'s> Explainer<'s> {
+    pub fn new(gpu: &Gpu, scene: &'s Scene, settings: &RenderSettings) -> Result<Explainer<'s>, ExplainError> {
+        let flags = gpu.adapter.get_downlevel_capabilities().flags;
+        if !flags.contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE) {
+            return Err(ExplainError::Unsupported);
+        }
+        let mut settings = settings.clone();
+        settings.raster.render_scale = 1.0;
+        let size = (scene.camera.width, scene.camera.height);
+        Ok(Explainer {
+            scene,
+            renderer: Renderer::inspecting(gpu, scene, OUTPUT_FORMAT),
+            targets: FrameTargets::new(&gpu.device, size),
+            output: GpuTexture::target(&gpu.device, "explain::output", size, OUTPUT_FORMAT),
+            tracer: Tracer::new(scene, &settings),
+            settings,
+        })
     }
-    let mut settings = settings.clone();
-    settings.raster.render_scale = 1.0;
-    let size = (scene.camera.width, scene.camera.height);
-    let mut renderer = Renderer::inspecting(gpu, scene, OUTPUT_FORMAT);
-    let mut targets = FrameTargets::new(&gpu.device, size);
-    let output = GpuTexture::target(&gpu.device, "explain::output", size, OUTPUT_FORMAT);
-    renderer.inspect(Some(pixel));
-    renderer.render(gpu, scene, &settings, &mut targets, &output.view);
-    renderer.inspection(gpu, &targets).ok_or(ExplainError::Readback)
+
+    /// Both renderers at pixel `(x, y)`: one inspected frame of the rasterizer, the tracer's ray
+    /// tree, and the diagnosis.
+    pub fn explain(&mut self, gpu: &Gpu, (x, y): (u32, u32)) -> Result<Explanation, ExplainError> {
+        let (scene, settings) = (self.scene, &self.settings);
+        let (width, height) = (scene.camera.width, scene.camera.height);
+        if x >= width || y >= height {
+            return Err(ExplainError::Outside(x, y, width, height));
+        }
+        self.renderer.inspect(Some((x, y)));
+        self.renderer.render(gpu, scene, settings, &mut self.targets, &self.output.view);
+        let pixel = self.renderer.inspection(gpu, &self.targets).ok_or(ExplainError::Readback)?;
+        let rays = trace_pixel(&self.tracer, (x, y));
+        let trace = TraceSide { radiance: rays.radiance, terms: rays.terms.clone(), lights: rays.lights.clone(), rays };
+        let raster = raster_side(scene, settings, &pixel);
+        let diagnosis = diagnosis::diagnose(scene, settings, &raster, &trace);
+        Ok(Explanation { pixel: [x, y], raster, trace, diagnosis })
+    }
 }
 
 fn object_name(scene: &Scene, index: u32) -> Option<String> {
