@@ -431,3 +431,51 @@ fn the_volume_ray_under_the_cursor_shows_its_samples() {
         shot.display()
     );
 }
+
+/// Inspect mode: the `inspect` step explains a pixel of the red ball in both renderers, the
+/// window with the two columns opens over the lower left of the view, and the tracer's rays are
+/// drawn in 3D, where they stay as the camera orbits (here: after the orbit, the ball's reflected
+/// ray in cyan and its shadow rays in yellow). The same run without the step draws none of it.
+#[test]
+fn inspect_mode_shows_both_columns_and_draws_the_ray_tree() {
+    let dir = scratch("inspect");
+    let shot = |name: &str| dir.join(name).display().to_string();
+    let run = |inspect: bool, name: &str| {
+        let mut steps = vec!["panel off", "overlay off", "wait 2"];
+        if inspect {
+            steps.push("inspect 506 286");
+        }
+        steps.extend(["wait 2", "orbit 60 0", "wait 3"]);
+        let mut args = vec!["--size", "900x560", "--frames", "16", "--screenshot"];
+        let path = shot(name);
+        args.push(&path);
+        let step_args: Vec<String> = steps.iter().flat_map(|s| ["--step".to_string(), s.to_string()]).collect();
+        args.extend(step_args.iter().map(String::as_str));
+        let output = viewer(&args, &dir);
+        succeeded(&output);
+        (output, image::open(&path).unwrap().into_rgba8())
+    };
+    let (inspected, with) = run(true, "with.png");
+    let (_, without) = run(false, "without.png");
+    let stdout = String::from_utf8_lossy(&inspected.stdout);
+    assert!(stdout.contains("inspected (506, 286)"), "{stdout}");
+    let count = |image: &image::RgbaImage, colour: [u8; 3]| {
+        image.pixels().filter(|p| (0..3).all(|c| p[c].abs_diff(colour[c]) <= 12)).count()
+    };
+    let cyan = [0, 220, 255];
+    let yellow = [255, 220, 0];
+    let (reflected, shadow) = (count(&with, cyan), count(&with, yellow));
+    eprintln!(
+        "ray pixels: reflected {reflected}, shadow {shadow}; without inspecting {} and {}",
+        count(&without, cyan),
+        count(&without, yellow)
+    );
+    assert!(reflected > 30 && shadow > 30, "reflected {reflected}, shadow {shadow}");
+    assert!(count(&without, cyan) < 5 && count(&without, yellow) < 5, "nothing drawn without the step");
+    // The explanation's window: egui's dark panel fill over the floor in the lower left.
+    let dark = |image: &image::RgbaImage| {
+        let region = crop(image, [20, 420, 500, 120]);
+        region.pixels().filter(|p| p[0] < 40 && p[1] < 40 && p[2] < 40).count() as f32 / (500.0 * 120.0)
+    };
+    assert!(dark(&with) > 0.6 && dark(&without) < 0.3, "window fill {} vs {}", dark(&with), dark(&without));
+}

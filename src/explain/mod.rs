@@ -142,6 +142,9 @@ pub struct ShadowLookup {
     pub normal_offset: Option<f32>,
     /// The filter's fraction of lit comparisons (1 − the mask for projected shadows).
     pub lit: f32,
+    /// The map texel's four corners in the world, at the stored depth: where it lies on the
+    /// occluder (or the receiver) the light saw there.
+    pub footprint: Option<[Vec3; 4]>,
 }
 
 /// A transparent surface or a composited volume blended over what was behind it.
@@ -498,6 +501,7 @@ fn raster_lights(scene: &Scene, settings: &RenderSettings, record: &GpuInspectFr
                     bias: None,
                     normal_offset: None,
                     lit: l.lit,
+                    footprint: None,
                 },
                 ShadowMethod::Map => {
                     let looked = l.layer >= 0;
@@ -519,12 +523,26 @@ fn raster_lights(scene: &Scene, settings: &RenderSettings, record: &GpuInspectFr
                         bias: looked.then(|| constant_bias(l.stored_depth, shadows.depth_bias)),
                         normal_offset: texel_size.map(|t| shadows.normal_offset * t),
                         lit: l.lit,
+                        footprint: looked.then(|| layout.views.get(l.layer as usize)).flatten().map(|view| {
+                            texel_footprint(view.clip_from_world, l.texel, l.stored_depth, shadows.map_size)
+                        }),
                     }
                 }
             });
             RasterLight { light: index, name: light.name.clone(), visibility: l.visibility, shadow }
         })
         .collect()
+}
+
+/// The world corners of texel `texel` of a `size`² shadow map whose light sees the world through
+/// `clip_from_world`, at depth `depth`.
+fn texel_footprint(clip_from_world: glam::Mat4, texel: Vec2, depth: f32, size: u32) -> [Vec3; 4] {
+    let world_from_clip = clip_from_world.inverse();
+    let corner = |dx: f32, dy: f32| {
+        let uv = (texel + Vec2::new(dx, dy)) / size as f32;
+        world_from_clip.project_point3(Vec3::new(2.0 * uv.x - 1.0, 1.0 - 2.0 * uv.y, depth))
+    };
+    [corner(0.0, 0.0), corner(1.0, 0.0), corner(1.0, 1.0), corner(0.0, 1.0)]
 }
 
 /// The constant part of the hardware depth bias at depth `z` for a 32-bit float depth buffer:

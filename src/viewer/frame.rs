@@ -12,6 +12,7 @@ use glam::Vec2;
 use super::camera_control::{self, CameraInput, Navigation};
 use super::config::ViewerConfig;
 use super::hud::{FrameStats, FrameTimes};
+use super::inspect::Inspection;
 use super::raster_view::RasterView;
 use super::scene_panel;
 use super::scene_state::SceneState;
@@ -51,6 +52,9 @@ pub struct Viewer {
     screenshot: Option<PathBuf>,
     /// Print the volume ray under the cursor after this frame's UI (the `probe` step).
     print_probe: bool,
+    /// The inspected pixel, and a pixel to inspect once the view has its size.
+    inspection: Option<Inspection>,
+    inspect_next: Option<Vec2>,
 }
 
 /// Scripted steps still to run and the wait in progress.
@@ -102,6 +106,8 @@ impl Viewer {
             view_pixels: None,
             screenshot: None,
             print_probe: false,
+            inspection: None,
+            inspect_next: None,
         }
     }
 
@@ -175,6 +181,7 @@ impl Viewer {
                 scale,
                 camera_error: &mut self.camera_error,
                 notices: &self.notices,
+                inspection: self.inspection.as_ref(),
             };
             screen.egui.run_ui(raw, |ui| output = ui::draw(ui, &mut model))
         };
@@ -183,6 +190,10 @@ impl Viewer {
             println!("{}", output.probe.as_ref().map_or("volume probe none".to_string(), |p| p.report()));
         }
         let repaint = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
+        if output.inspection_closed {
+            self.inspection = None;
+        }
+        self.inspect_next = output.inspect.or(self.inspect_next);
         self.apply(&output, input, start);
 
         // The raster image at the view's size times the render scale.
@@ -210,6 +221,9 @@ impl Viewer {
             );
             times.raster = raster_time;
             self.request_traced(full_size, scaled == full_size, screen);
+            if let Some(pixel) = self.inspect_next.take() {
+                self.inspect(screen, pixel, full_size);
+            }
         }
 
         let paint_start = Instant::now();
@@ -322,6 +336,22 @@ impl Viewer {
         }
     }
 
+    /// Explains `pixel` of the full-resolution view of `size` in both renderers.
+    fn inspect(&mut self, screen: &Screen, pixel: Vec2, size: (u32, u32)) {
+        let mut scene = self.scene.scene.clone();
+        (scene.camera.width, scene.camera.height) = size;
+        let at = (pixel.x.max(0.0) as u32, pixel.y.max(0.0) as u32);
+        match Inspection::new(&screen.gpu, &scene, &self.settings, at) {
+            Ok(inspection) => {
+                let summary = inspection.summary();
+                println!("{summary}");
+                self.notice(summary);
+                self.inspection = Some(inspection);
+            }
+            Err(e) => self.notice(format!("cannot inspect ({}, {}): {e:#}", at.0, at.1)),
+        }
+    }
+
     /// Starts (or keeps) the traced request for the current view at its full size; in the
     /// difference view, hands over the raster image once it is at full resolution.
     fn request_traced(&mut self, full_size: (u32, u32), full_resolution: bool, screen: &Screen) {
@@ -410,6 +440,7 @@ impl Viewer {
             Step::Panel(on) => self.view.panel_open = on,
             Step::Overlay(on) => self.view.overlay_open = on,
             Step::Cursor(pixel) => self.view.scripted_cursor = Some(pixel),
+            Step::Inspect(pixel) => self.inspect_next = Some(pixel),
             Step::Probe => self.print_probe = true,
             Step::Wait(frames) => self.script.wait_frames = frames,
             Step::WaitTraced => self.script.wait_traced_since = Some(Instant::now()),

@@ -9,7 +9,8 @@
 //! - [`camera_control`]: orbit, pan, zoom, fly and frame as pure functions on the camera.
 //! - [`raster_view`]: the one place the rasterizer is called; [`traced`]: the background tracer.
 //! - [`scene_state`] and [`picking`]: the scene, reloading, the picked object;
-//!   [`volume_probe`]: the samples of the volume ray under the cursor.
+//!   [`volume_probe`]: the samples of the volume ray under the cursor; [`inspect`]: a pixel
+//!   explained by both renderers, its ray tree drawn in 3D.
 //! - [`config`]: what is remembered between runs; [`script`]: scripted steps for tests.
 //!
 //! This module holds the winit `ApplicationHandler`: it opens the window when the event loop
@@ -19,6 +20,7 @@ pub mod camera_control;
 pub mod config;
 pub mod frame;
 pub mod hud;
+pub mod inspect;
 pub mod panel;
 pub mod picking;
 pub mod raster_view;

@@ -12,6 +12,7 @@
 //! navigate fly | navigate orbit
 //! walk 0 0 1                    fly by (right, up, forward) scene units
 //! pick 320 200                  click the 3D view at this pixel (selects the object)
+//! inspect 320 200               explain this pixel in both renderers (the I key, then a click)
 //! cursor 320 200                hold the mouse over this pixel (the lat–long view's marker, the
 //!                               volume ray's samples)
 //! probe                         print the volume ray under the cursor (one line on stdout)
@@ -47,6 +48,7 @@ pub enum Step {
     Navigate(Navigation),
     Walk(Vec3),
     Pick(Vec2),
+    Inspect(Vec2),
     Cursor(Vec2),
     Probe,
     Material(String),
@@ -105,13 +107,14 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
             }
             Step::Split(x)
         }
-        "orbit" | "pan" | "pick" | "cursor" => {
+        "orbit" | "pan" | "pick" | "cursor" | "inspect" => {
             let [x, y] = numbers(args).ok_or_else(|| fail("expected two numbers: x y in pixels"))?;
             let v = Vec2::new(x, y);
             match verb {
                 "orbit" => Step::Orbit(v),
                 "pan" => Step::Pan(v),
                 "cursor" => Step::Cursor(v),
+                "inspect" => Step::Inspect(v),
                 _ => Step::Pick(v),
             }
         }

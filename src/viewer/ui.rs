@@ -36,6 +36,8 @@ pub struct UiModel<'a> {
     pub camera_error: &'a mut Option<String>,
     /// Messages for the user (settings refused, screenshots written), newest last.
     pub notices: &'a [String],
+    /// The inspected pixel, its explanation drawn over the view.
+    pub inspection: Option<&'a super::inspect::Inspection>,
 }
 
 /// Requests the UI makes of the frame.
@@ -57,6 +59,10 @@ pub struct UiOutput {
     pub settings: Vec<String>,
     /// A click in the 3D view, in pixels of the full-resolution image.
     pub pick: Option<Vec2>,
+    /// A click in inspect mode: the pixel to explain.
+    pub inspect: Option<Vec2>,
+    /// The inspection's window was closed.
+    pub inspection_closed: bool,
     pub actions: Vec<Action>,
     /// The camera, a light or a material was edited in place.
     pub camera_edited: bool,
@@ -77,6 +83,11 @@ pub fn draw(ui: &mut egui::Ui, model: &mut UiModel) -> UiOutput {
     }
     egui::CentralPanel::no_frame().show(ui, |ui| view(ui, model, &mut output));
     hud::help_window(ui.ctx(), &mut model.view.help_open);
+    if let Some(inspection) = model.inspection {
+        let mut open = true;
+        super::inspect::window(ui.ctx(), inspection, &mut open);
+        output.inspection_closed |= !open;
+    }
     output
 }
 
@@ -105,6 +116,12 @@ fn keys(ctx: &egui::Context, model: &mut UiModel, output: &mut UiOutput) {
         }
         if pressed(Key::P) {
             model.view.panel_open = !model.view.panel_open;
+        }
+        if pressed(Key::I) {
+            model.view.inspecting = !model.view.inspecting;
+            if !model.view.inspecting {
+                output.inspection_closed = true;
+            }
         }
         if pressed(Key::G) {
             *model.navigation = match model.navigation {
@@ -214,6 +231,9 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     output.view_rect = Some(rect);
     let response = ui.allocate_rect(rect, Sense::click_and_drag());
     camera_input(ui, &response, rect, ppp, output);
+    if model.view.inspecting {
+        output.inspect = output.pick.take();
+    }
 
     let painter = ui.painter_at(rect);
     let full = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
@@ -255,6 +275,9 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
         && let Some(pixel) = cursor
     {
         latlong_marker(&painter, model, rect, ppp, pixel);
+    }
+    if let Some(inspection) = model.inspection {
+        super::inspect::draw(&painter, inspection, &model.scene.scene.camera, (rect, ppp));
     }
     output.probe = volume_probe::show(ui.ctx(), model.scene, model.settings, (rect, ppp), cursor);
     if model.view.overlay_open {

@@ -55,6 +55,8 @@ pub struct ViewState {
     pub overlay_open: bool,
     /// Where a script holds the mouse, in pixels of the view (over the real mouse).
     pub scripted_cursor: Option<glam::Vec2>,
+    /// Clicks inspect pixels (`super::inspect`) instead of picking objects.
+    pub inspecting: bool,
 }
 
 impl Default for ViewState {
@@ -67,6 +69,7 @@ impl Default for ViewState {
             help_open: false,
             overlay_open: true,
             scripted_cursor: None,
+            inspecting: false,
         }
     }
 }
