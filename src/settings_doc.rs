@@ -3,10 +3,12 @@
 //! Nothing here is written by hand: each setting's meaning, accepted values and unit are declared
 //! once beside its field (`src/settings/`, see [`crate::settings::field`]), and this module turns
 //! them into the panel's tooltips, choices and slider ranges ([`describe`], keyed by the dotted
-//! path `--set` uses).
+//! path `--set` uses) and into the settings table of docs/scene-format.md
+//! ([`scene_format_table`]; `tests/settings_docs.rs` fails when the file's table differs, and
+//! rewrites it with `MIRADOR_BLESS=1`).
 
 use crate::RenderSettings;
-use crate::settings::field::Kind;
+use crate::settings::field::{self, Field, Kind};
 
 pub use crate::settings::field::{Choice, choices_of};
 
@@ -44,11 +46,56 @@ fn plain(markdown: &str) -> String {
     markdown.replace('`', "")
 }
 
+/// The table of every setting in docs/scene-format.md: key, type with the accepted values, default
+/// (`RenderSettings::default()`) and meaning, each enum's choices with their help.
+pub fn scene_format_table() -> String {
+    let mut table = String::from("| Key | Type | Default | Meaning |\n|-----|------|---------|---------|\n");
+    let defaults = RenderSettings::default();
+    field::walk(RenderSettings::FIELDS, &defaults, "", &mut |key, field, value| {
+        if !matches!(field.kind, Kind::Section(_)) {
+            let row = [format!("`{key}`"), type_of(field), format!("`{}`", value.toml()), meaning_of(field)];
+            table.push_str(&format!("| {} |\n", row.map(|cell| cell.replace('|', "\\|")).join(" | ")));
+        }
+        Ok::<(), ()>(())
+    })
+    .expect("the visitor never fails");
+    table
+}
+
+/// `integer, 3 to 4096`, `number, above 0, at most 64 texels`, `string`.
+fn type_of(field: &Field) -> String {
+    let name = match field.kind {
+        Kind::Switch => "boolean",
+        Kind::Integer { signed: false } if field.values.accepts == field::Accepts::Any => "integer ≥ 0",
+        Kind::Integer { .. } => "integer",
+        Kind::Number => "number",
+        Kind::Choice(_) => "string",
+        Kind::Section(_) => "table",
+    };
+    match field.values.summary() {
+        Some(values) => format!("{name}, {values}"),
+        None => name.to_string(),
+    }
+}
+
+/// The meaning, then each choice with its help: `` `"nearest"`: the nearest texel… ``.
+fn meaning_of(field: &Field) -> String {
+    let mut meaning = field.meaning();
+    if let Kind::Choice(choices) = field.kind {
+        for choice in choices() {
+            meaning.push_str(&format!(" `\"{}\"`", choice.value));
+            if let Some(help) = choice.help {
+                meaning.push_str(&format!(": {help}."));
+            }
+        }
+    }
+    meaning
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::settings::TextureFilter;
-    use crate::settings::field;
 
     /// Every dotted key of a serialized value: sections and their settings.
     fn keys(prefix: &str, table: &toml::Table, out: &mut Vec<(String, toml::Value)>) {
@@ -148,5 +195,15 @@ mod tests {
         assert_eq!(describe("sphere_segments").unwrap().range, Some((3.0, 512.0)), "a stated slider");
         assert!(describe("shadows").unwrap().tooltip.starts_with("Cast shadows"));
         assert!(describe("shadows.nothing").is_none() && describe("exposure.x").is_none());
+    }
+
+    #[test]
+    fn the_table_has_a_row_per_setting() {
+        let table = scene_format_table();
+        assert_eq!(table.lines().count(), 2 + all_keys().iter().filter(|(_, v)| !v.is_table()).count());
+        assert!(table.contains("| `sphere_segments` | integer, 3 to 4096 | `96` | Slices around"), "{table}");
+        assert!(table.contains("| `volume.threshold` | number, above 0, at most 1 | `0.99` |"), "{table}");
+        assert!(table.contains("`\"pcf3x3\"`: 3×3 hardware taps."), "{table}");
+        assert!(table.contains("`n = ∇f/\\|∇f\\|`"), "a pipe is escaped in a cell");
     }
 }
