@@ -5,8 +5,9 @@
 //! a checkbox, a number a drag value (its range from `settings_doc`), a string a combo box of the
 //! enum's choices. A change is written back as `key=value` through `RenderSettings::set`, the
 //! mechanism behind `--set`, so the panel can set nothing the command line could not, and a new
-//! technique's section appears here with no change to the viewer. Tooltips come from the one
-//! description table, `src/settings_doc.rs`.
+//! technique's section appears here with no change to the viewer. Tooltips, choices and ranges
+//! come from each setting's one description beside its field (`src/settings/`), through
+//! `settings_doc`.
 
 use egui::collapsing_header::CollapsingState;
 
@@ -19,11 +20,7 @@ fn label(key: &str) -> String {
 }
 
 fn tooltip(key: &str) -> FieldDoc {
-    describe(key).unwrap_or(FieldDoc {
-        tooltip: "(no description: add one to src/settings_doc.rs)",
-        choices: Vec::new(),
-        range: None,
-    })
+    describe(key).unwrap_or(FieldDoc { tooltip: "(no description)".into(), choices: Vec::new(), range: None })
 }
 
 /// Draws the settings, one section per technique; returns the assignments (`key=value`) the user
@@ -59,12 +56,13 @@ fn section_ui(ui: &mut egui::Ui, key: &str, section: &toml::Table, changes: &mut
         .show_header(ui, |ui| match section.get("enabled") {
             Some(toml::Value::Boolean(enabled)) => {
                 let mut on = *enabled;
-                if ui.checkbox(&mut on, egui::RichText::new(label(key)).strong()).on_hover_text(doc.tooltip).changed() {
+                if ui.checkbox(&mut on, egui::RichText::new(label(key)).strong()).on_hover_text(&doc.tooltip).changed()
+                {
                     changes.push(format!("{key}.enabled={on}"));
                 }
             }
             _ => {
-                ui.label(egui::RichText::new(label(key)).strong()).on_hover_text(doc.tooltip);
+                ui.label(egui::RichText::new(label(key)).strong()).on_hover_text(&doc.tooltip);
             }
         })
         .body(|ui| {
@@ -88,7 +86,7 @@ fn field(ui: &mut egui::Ui, key: &str, value: &toml::Value, changes: &mut Vec<St
             toml::Value::Boolean(on) => {
                 let mut on = *on;
                 ui.checkbox(&mut on, name.as_str())
-                    .on_hover_text(doc.tooltip)
+                    .on_hover_text(&doc.tooltip)
                     .changed()
                     .then_some(toml::Value::Boolean(on))
             }
@@ -97,16 +95,16 @@ fn field(ui: &mut egui::Ui, key: &str, value: &toml::Value, changes: &mut Vec<St
                 let (low, high) = doc.range.unwrap_or((i64::MIN as f64, i64::MAX as f64));
                 let speed = ((high - low) / 400.0).clamp(0.05, 16.0);
                 let response = ui.add(egui::DragValue::new(&mut n).range(low as i64..=high as i64).speed(speed));
-                ui.label(name.as_str()).on_hover_text(doc.tooltip);
-                response.on_hover_text(doc.tooltip).changed().then_some(toml::Value::Integer(n))
+                ui.label(name.as_str()).on_hover_text(&doc.tooltip);
+                response.on_hover_text(&doc.tooltip).changed().then_some(toml::Value::Integer(n))
             }
             toml::Value::Float(x) => {
                 let mut x = *x;
                 let (low, high) = doc.range.unwrap_or((-1e6, 1e6));
                 let speed = ((high - low) / 1000.0).clamp(1e-3, 10.0);
                 let response = ui.add(egui::DragValue::new(&mut x).range(low..=high).speed(speed).max_decimals(3));
-                ui.label(name.as_str()).on_hover_text(doc.tooltip);
-                response.on_hover_text(doc.tooltip).changed().then_some(toml::Value::Float(x))
+                ui.label(name.as_str()).on_hover_text(&doc.tooltip);
+                response.on_hover_text(&doc.tooltip).changed().then_some(toml::Value::Float(x))
             }
             toml::Value::String(current) => {
                 let mut chosen = None;
@@ -125,12 +123,12 @@ fn field(ui: &mut egui::Ui, key: &str, value: &toml::Value, changes: &mut Vec<St
                         }
                     })
                     .response
-                    .on_hover_text(doc.tooltip);
-                ui.label(name.as_str()).on_hover_text(doc.tooltip);
+                    .on_hover_text(&doc.tooltip);
+                ui.label(name.as_str()).on_hover_text(&doc.tooltip);
                 chosen
             }
             other => {
-                ui.label(format!("{name}: {other}")).on_hover_text(doc.tooltip);
+                ui.label(format!("{name}: {other}")).on_hover_text(&doc.tooltip);
                 None
             }
         };

@@ -1,0 +1,56 @@
+//! Bump mapping from height fields, and normal maps (TECHNIQUES.md §3).
+
+use super::field::{choices, section};
+
+section! {
+    /// Bump mapping and normal maps, in both renderers.
+    #[derive(Copy)]
+    pub struct BumpSettings {
+        /// Bump mapping and normal maps: the shading normal perturbed by the height field's slope
+        /// (or read from the normal map); off, surfaces are shaded with the geometric normal `n`.
+        enabled: bool = true,
+        /// Where the rasterizer's tangents `t_u = ∂p/∂u`, `t_v = ∂p/∂v` come from (the tracer
+        /// uses the third source, the analytic surface).
+        tangents: TangentSource = TangentSource::Derivatives,
+        /// Multiplies every material's bump scale `k` (`bump_scale`) in
+        /// `du = k·(f(u+Δ) − f(u−Δ))/2Δ`: the relief's depth; negative inverts it.
+        #[values(slider(-8.0, 8.0))]
+        scale: f32 = 1.0,
+        /// The finite-difference step `Δ`, in texels of the height map: small follows detail,
+        /// large smooths it. For a procedural field, in units of its own step: a 64th of a sine's
+        /// period, a 16th of the finest noise cell.
+        #[values(open_closed(0.0, 64.0).unit("texels").slider(0.05, 64.0))]
+        delta_texels: f32 = 1.0,
+        /// For procedural height fields, the closed-form gradient instead of finite differences,
+        /// so the two can be compared.
+        analytic: bool = false,
+        /// Teaching view instead of the shaded colour: the perturbed normal `n'` or the tangent
+        /// `t_u` as colour.
+        view: BumpView = BumpView::Off,
+    }
+}
+
+choices! {
+    /// What the bump-mapping teaching view shows instead of the shaded colour.
+    pub enum BumpView {
+        /// The shaded image.
+        Off,
+        /// The (perturbed) shading normal as colour: `0.5 + 0.5·n`.
+        Normals,
+        /// The tangent `t_u` as colour the same way: the frame the bumps are built in.
+        Tangents,
+    }
+}
+
+choices! {
+    /// Where the rasterizer's tangents `t_u`, `t_v` come from (TECHNIQUES.md §3 names three
+    /// sources; the tracer uses the third, the analytic surface).
+    pub enum TangentSource {
+        /// Constant per triangle, from how position and texture coordinates change across it
+        /// (screen-space derivatives): true-length `∂p/∂u`, `∂p/∂v`.
+        Derivatives,
+        /// Per vertex and interpolated: the file's tangents, or MikkTSpace's; unit length, so `k`
+        /// reads as relief per unit of texture coordinate rather than per unit of surface.
+        PerVertex,
+    }
+}

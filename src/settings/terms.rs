@@ -1,0 +1,22 @@
+//! The terms of the illumination model (TECHNIQUES.md §1), each drawn or left out: teaching
+//! toggles.
+
+use super::field::section;
+
+section! {
+    /// Which terms of the illumination model are drawn.
+    #[derive(Copy, Eq)]
+    pub struct TermSettings {
+        /// The ambient terms: the global `AG = A ⊗ kd·C` and each light's `ka·C`. Off, surfaces
+        /// no light reaches go black.
+        ambient: bool = true,
+        /// Lambert's `kd·C·max(0, n·l)`: matte shading that depends on the angle to the light,
+        /// not on the viewer.
+        diffuse: bool = true,
+        /// Phong's `ks·Sc·max(0, r·v)^e`: the highlight that moves with the viewer; `e`
+        /// (shininess) sets its size.
+        specular: bool = true,
+        /// `ME`, the material's own emitted radiance, added whatever the lights.
+        emission: bool = true,
+    }
+}
