@@ -1,4 +1,4 @@
-//! Bump mapping from a height field, side by side (TECHNIQUES.md §3; seed 000 §1.2).
+//! Bump mapping from a height field, side by side (docs/course/04-bump-mapping.md).
 //!
 //! The geometry stays flat; only the normal used for shading changes. A grey-level texture
 //! gives a height f_h(u, v). Its slopes come from finite differences,

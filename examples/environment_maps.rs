@@ -1,4 +1,4 @@
-//! Environment maps, side by side (TECHNIQUES.md §6; seed 000 §1.5).
+//! Environment maps, side by side (docs/course/08-environment-maps.md).
 //!
 //! A curved mirror reflects the radiance arriving along `r = 2(n·v)n − v`, which a z-buffer
 //! cannot trace. It looks it up instead in a map of the radiance arriving from every direction,

@@ -1,4 +1,4 @@
-//! Mipmaps and trilinear sampling, side by side (TECHNIQUES.md §2; seed 000 §1.1).
+//! Mipmaps and trilinear sampling, side by side (docs/course/03-mipmaps.md).
 //!
 //! A texture seen from far away squeezes many texels into one pixel. Sampling it at one point
 //! per pixel (nearest or bilinear) picks texels almost at random: the checkered floor breaks up

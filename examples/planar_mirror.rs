@@ -1,4 +1,4 @@
-//! Planar mirrors by a mirrored camera, side by side (TECHNIQUES.md §6; seed 000 §1.5).
+//! Planar mirrors by a mirrored camera, side by side (docs/course/07-planar-mirrors.md).
 //!
 //! A z-buffer sees only what its camera sees, and a mirror shows what a camera behind it would
 //! see: the camera mirrored about the mirror's plane. So the scene is drawn once more from that

@@ -1,4 +1,4 @@
-//! Cast shadows, side by side (TECHNIQUES.md §4; seed 000 §1.3).
+//! Cast shadows, side by side (docs/course/05-shadows.md).
 //!
 //! A shadow is where a light cannot see. The shadow-map algorithm finds it in two passes: first
 //! the scene is rendered from the light, keeping only depth (the "Z-buffer A" of the notes);

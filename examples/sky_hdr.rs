@@ -1,4 +1,4 @@
-//! The project's own environment map: the default procedural [`Sky`] (TECHNIQUES.md §6) baked
+//! The project's own environment map: the default procedural [`Sky`] (docs/course/07-planar-mirrors.md) baked
 //! into a 512 × 256 latitude–longitude Radiance HDR, `assets/environments/sky.hdr`.
 //!
 //! Each texel holds the sky's radiance towards its centre (`latlong_direction`, the image centre

@@ -1,4 +1,4 @@
-//! Transparent surfaces in sorted Z order, side by side (TECHNIQUES.md §5; seed 000 §1.4).
+//! Transparent surfaces in sorted Z order, side by side (docs/course/06-transparency.md).
 //!
 //! A z-buffer keeps one surface per pixel, so transparency is drawn in two steps: every opaque
 //! surface first, then the transparent ones farthest first, each pixel updated as

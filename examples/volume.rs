@@ -1,4 +1,4 @@
-//! Direct volume rendering, step by step (TECHNIQUES.md §8; seed 004).
+//! Direct volume rendering, step by step (docs/course/11-volumes.md).
 //!
 //! A volume is a scalar field sampled on a grid of voxels. To see it, a ray is cast through each
 //! pixel and cut into `k` equally spaced samples between where it enters and leaves the grid's

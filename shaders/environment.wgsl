@@ -1,4 +1,4 @@
-// Making environment maps (TECHNIQUES.md §6): one triangle over a target texture, each texel
+// Making environment maps (docs/course/08-environment-maps.md): one triangle over a target texture, each texel
 // finding the direction it stores and asking the source for the radiance there. So any source
 // (the procedural sky, a lat–long image, six cube faces, a sphere-map image) becomes any lookup
 // form: a cube (each face a draw, the face index passed as the instance), a lat–long map, or a

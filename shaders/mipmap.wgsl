@@ -1,4 +1,4 @@
-// Mip generation (TECHNIQUES.md §2, seed 000 §1.1): one fullscreen triangle per level, each
+// Mip generation (docs/course/03-mipmaps.md): one fullscreen triangle per level, each
 // fragment the box average of its footprint in the level above. src/gpu/mipmap.rs draws it and
 // its header states the rule; the CPU twin is src/texture/mipmap.rs (box_taps). The source is
 // read with textureLoad, so an sRGB texture is decoded to linear before averaging; the result is

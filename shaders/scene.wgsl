@@ -55,7 +55,7 @@ const ENV_MAP_DYNAMIC: u32 = 4u;
 @group(1) @binding(2) var height_texture: texture_2d<f32>;
 // Tangent-space normals (glTF's normalTexture), linear.
 @group(1) @binding(3) var normal_texture: texture_2d<f32>;
-// The chosen texture filter (TECHNIQUES.md §2) with the material's wrap modes.
+// The chosen texture filter (docs/course/03-mipmaps.md) with the material's wrap modes.
 @group(1) @binding(4) var color_sampler: sampler;
 // Group 2: the shadow pass's outputs and how to read them.
 @group(2) @binding(0) var<uniform> shadows: Shadows;
@@ -75,7 +75,7 @@ const ENV_MAP_DYNAMIC: u32 = 4u;
 @group(2) @binding(10) var env_latlong: texture_2d<f32>;
 // Group 3 (mirror variants only): the reflection, drawn by the camera mirrored about this mirror's
 // plane at the same size as this view, so the mirror's own pixel is where its reflection is
-// (the projective lookup of TECHNIQUES.md §6 reduces to the fragment's pixel).
+// (the projective lookup of docs/course/07-planar-mirrors.md reduces to the fragment's pixel).
 @group(3) @binding(2) var mirror_image: texture_2d<f32>;
 
 struct VertexIn {
@@ -203,7 +203,7 @@ fn height_delta() -> vec2f {
     }
 }
 
-// The slopes (du, dv) = k·∇f_h: central differences (TECHNIQUES.md §3), or for procedural fields
+// The slopes (du, dv) = k·∇f_h: central differences (docs/course/04-bump-mapping.md), or for procedural fields
 // their closed-form gradient when asked.
 fn height_slopes(uv: vec2f, k: f32) -> vec2f {
     if BUMP_ANALYTIC && HEIGHT_KIND == HEIGHT_SINE {
@@ -233,7 +233,7 @@ fn surface_color(uv: vec2f, duv_dx: vec2f, duv_dy: vec2f) -> vec3f {
     return material.color * textureSampleBias(color_texture, color_sampler, uv, frame.lod_bias).rgb;
 }
 
-// The shading normal: the interpolated normal, perturbed by the height field (TECHNIQUES.md §3:
+// The shading normal: the interpolated normal, perturbed by the height field (docs/course/04-bump-mapping.md:
 // t'u = tu + du·n, t'v = tv + dv·n, n' = normalize(t'u × t'v)) and by a normal map.
 fn shading_normal(in: VertexOut, tangents: SurfaceTangents) -> vec3f {
     var n = normalize(in.normal);
@@ -351,7 +351,7 @@ fn shade(in: VertexOut) -> vec3f {
     return radiance;
 }
 
-// L(r) for the mirror term kps·MPS·L(r) of a curved mirror (TECHNIQUES.md §6), r = 2(n·v)n − v
+// L(r) for the mirror term kps·MPS·L(r) of a curved mirror (docs/course/08-environment-maps.md), r = 2(n·v)n − v
 // looked up in the environment map. The level of detail comes from r's change across the pixel,
 // taken here in uniform control flow, so a reflection minified on a small sphere is filtered
 // rather than aliased.
@@ -428,7 +428,7 @@ fn fs_mask(in: VertexOut) {
     }
 }
 
-// The world where nothing is drawn (TECHNIQUES.md §6): one triangle over the screen at the far
+// The world where nothing is drawn (docs/course/08-environment-maps.md): one triangle over the screen at the far
 // plane, drawn after the opaque surfaces with the depth test LessEqual, so only the pixels no
 // surface covered run it. Each pixel looks along the camera ray through its centre, the same ray
 // the tracer sends, and returns the environment's radiance there (the tracer's rays that hit

@@ -1,4 +1,4 @@
-// Pass 1 of the shadow-map algorithm (TECHNIQUES.md §4): the scene's depth as each light sees it,
+// Pass 1 of the shadow-map algorithm (docs/course/05-shadows.md): the scene's depth as each light sees it,
 // one array layer per light view; and, for transparent occluders, the product of their kt·MT
 // in front of the nearest opaque surface, with the depth of the nearest of them in alpha.
 // Each light view is a View of its own (group 0's dynamic slot), as the main camera is.

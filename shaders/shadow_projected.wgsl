@@ -1,4 +1,4 @@
-// Object-precision shadows (seed 000 §1.3, "algoritmo de fuerza bruta"): the shadow polygons
+// Object-precision shadows (docs/course/05-shadows.md#shadow-maps-image-precision, "algoritmo de fuerza bruta"): the shadow polygons
 // that casters project from each light onto planar receivers, computed on the CPU
 // (src/raster/shadow/projected.rs) and drawn here as detail polygons into a screen-sized mask:
 // channel i is 1 where the receiver is in the shadow of shadowed light i. The mask's blend is

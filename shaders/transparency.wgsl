@@ -1,4 +1,4 @@
-// Transparent surfaces (TECHNIQUES.md §5; seed 000 §1.4), composed after shaders/scene.wgsl into
+// Transparent surfaces (docs/course/06-transparency.md), composed after shaders/scene.wgsl into
 // one module. src/raster/transparency.rs draws them after the opaque surfaces, farthest first,
 // with the blend I = Im + kt·Mt·I: the fragment returns Im (times the coverage α for alpha
 // blending), and the blend state multiplies what the target holds by kt·Mt.
@@ -12,7 +12,7 @@ fn transparent_fragment(in: VertexOut) -> vec4f {
     if masked_out(in.uv) {
         discard;
     }
-    // Alpha blending is the seed's formula with Im scaled by α; for any other material α = 1.
+    // Alpha blending is the notes' formula with Im scaled by α; for any other material α = 1.
     var alpha = 1.0;
     if ALPHA_MODE == ALPHA_BLEND {
         alpha = coverage(in.uv);

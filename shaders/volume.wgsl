@@ -1,4 +1,4 @@
-// Direct volume rendering (TECHNIQUES.md §8; seed 004), composed after shaders/scene.wgsl and
+// Direct volume rendering (docs/course/11-volumes.md), composed after shaders/scene.wgsl and
 // shaders/transparency.wgsl into one module: the GPU twin of src/volume/march.rs, drawn by
 // src/raster/volume.rs over the opaque image.
 //

@@ -1,6 +1,6 @@
 //! Coverage (`Material::alpha`, `AlphaMode`): the glTF import of `alphaMode`, `alphaCutoff`,
 //! `baseColorFactor.a` and transmission, and the ray tracer's masks and blending, with radiance
-//! known by hand (TECHNIQUES.md §5 with `Im` scaled by `α` and `kt·Mt = 1 − α`).
+//! known by hand (docs/course/06-transparency.md with `Im` scaled by `α` and `kt·Mt = 1 − α`).
 //!
 //! The scenes are lit so that every radiance is a short formula: no ambient unless said, surfaces
 //! that only emit (`kd = 0`, emission `E`) or a white floor under one light at unit distance

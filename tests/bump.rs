@@ -1,4 +1,4 @@
-//! Bump mapping (TECHNIQUES.md §3): the WGSL helpers of `shaders/common/bump.wgsl` against their
+//! Bump mapping (docs/course/04-bump-mapping.md): the WGSL helpers of `shaders/common/bump.wgsl` against their
 //! Rust twins in `src/texture/` through a compute probe, the convergence of finite differences
 //! to the analytic normal, mirrored texture coordinates, and tangent frames.
 

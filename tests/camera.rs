@@ -1,4 +1,4 @@
-//! Known answers for the camera of TECHNIQUES.md §0: the rasterizer's matrices and the ray
+//! Known answers for the camera of docs/course/01-camera.md: the rasterizer's matrices and the ray
 //! tracer's primary rays describe the same camera, so a point lands on the pixel whose centre ray
 //! hits it.
 

@@ -1,4 +1,4 @@
-//! Environment maps (TECHNIQUES.md §6) against the tracer's reflected rays: a mirror ball in a
+//! Environment maps (docs/course/08-environment-maps.md) against the tracer's reflected rays: a mirror ball in a
 //! distant environment must look the same in every map (cube, dynamic cube, sphere map,
 //! lat–long map) as traced, since the environment is the radiance arriving from a direction
 //! wherever it is seen from; the background is the tracer's missed rays; the cube made from a

@@ -1,4 +1,4 @@
-//! Environment maps on the CPU (`src/scene/environment.rs`, TECHNIQUES.md §6): `[world.environment]`
+//! Environment maps on the CPU (`src/scene/environment.rs`, docs/course/08-environment-maps.md): `[world.environment]`
 //! loads each source or fails naming the file and the problem, and the ray tracer's missed rays,
 //! primary and reflected, see the environment.
 //!

@@ -79,7 +79,7 @@ fn shadow_stage_with_projected_polygons() {
     common::assert_golden("shadows-projected", &common::raster(&scene, &settings), TOLERANCE);
 }
 
-/// The showcase's floor running to the horizon, in each texture filter (TECHNIQUES.md §2).
+/// The showcase's floor running to the horizon, in each texture filter (docs/course/03-mipmaps.md).
 #[test]
 fn floor_in_every_texture_filter() {
     use mirador::settings::TextureFilter;

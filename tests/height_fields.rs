@@ -1,4 +1,4 @@
-//! Procedural height fields for bump mapping (TECHNIQUES.md §3): named from scene files, the same
+//! Procedural height fields for bump mapping (docs/course/04-bump-mapping.md): named from scene files, the same
 //! field in WGSL and Rust, raster against ray traced, and finite differences against the
 //! closed-form gradient.
 

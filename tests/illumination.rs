@@ -1,4 +1,4 @@
-//! Known answers for the illumination model (TECHNIQUES.md §1): cases computed by hand, evaluated
+//! Known answers for the illumination model (docs/course/02-illumination.md): cases computed by hand, evaluated
 //! by the Rust model (`src/scene/shading.rs`, the ray tracer's) and by the WGSL model
 //! (`shaders/common/lighting.wgsl`, the rasterizer's) through a tiny compute pass.
 

@@ -1,4 +1,4 @@
-//! Mip chains (TECHNIQUES.md §2): the CPU chain against the box formula worked by hand, the
+//! Mip chains (docs/course/03-mipmaps.md): the CPU chain against the box formula worked by hand, the
 //! non-power-of-two rule, the GPU chain against the CPU chain on every level, and the filters
 //! (CPU known answers, and the GPU sampler against the CPU sampler).
 

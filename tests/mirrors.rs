@@ -1,4 +1,4 @@
-//! Planar mirrors by a mirrored camera (TECHNIQUES.md §6): the rasterizer's mirrors against the
+//! Planar mirrors by a mirrored camera (docs/course/07-planar-mirrors.md): the rasterizer's mirrors against the
 //! tracer's reflected rays, which they must match where the lighting, objects and depth are the
 //! same; what lies behind a mirror stays out of its reflection; winding flips in mirrored views;
 //! and the degenerate cases. The matrices themselves are tested by hand in

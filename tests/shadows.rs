@@ -1,4 +1,4 @@
-//! Cast shadows (TECHNIQUES.md §4): the light-space matrices by hand, no acne at default
+//! Cast shadows (docs/course/05-shadows.md): the light-space matrices by hand, no acne at default
 //! settings, and agreement with the ray tracer's shadow rays, which are the exact answer the
 //! shadow map approximates: for both the shadow-map and the projected-polygon methods, for a
 //! point light's six cube faces, and for transparent occluders.

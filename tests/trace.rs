@@ -329,7 +329,8 @@ fn raster_and_ray_traced_seed_simple_agree_without_shadows() {
     assert!(difference.psnr_db > 45.0, "PSNR {} dB", difference.psnr_db);
 }
 
-/// The orthographic camera of seed 003: parallel rays along −ze in both renderers.
+/// The orthographic camera of the course (docs/course/01-camera.md): parallel rays along −ze in both
+/// renderers.
 #[test]
 fn raster_and_ray_traced_agree_through_an_orthographic_camera() {
     let mut scene = common::load("scenes/shadows.toml");

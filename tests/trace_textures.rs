@@ -1,4 +1,4 @@
-//! The ray tracer's textures (TECHNIQUES.md §2, §3): mip-mapped lookups at the level a ray cone
+//! The ray tracer's textures (docs/course/03-mipmaps.md, docs/course/04-bump-mapping.md): mip-mapped lookups at the level a ray cone
 //! picks, the level-colour view, and bump mapping with its teaching views. Every scene here is
 //! lit so that a pixel's radiance is a known function of the texture: `ambient = 1`, `kd = 1`,
 //! no lights gives `L = C` exactly.

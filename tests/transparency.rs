@@ -1,4 +1,4 @@
-//! Transparent surfaces in sorted Z order (TECHNIQUES.md §5): the seed's formula
+//! Transparent surfaces in sorted Z order (docs/course/06-transparency.md): the seed's formula
 //! `I = Im + kt·Mt·I` checked by hand for every drawing order, the order-dependence the unsorted
 //! mode must show, two-sided objects, coplanar panes, and agreement with the ray tracer, whose
 //! rays go straight through when `ior = 1`.

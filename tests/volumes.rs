@@ -1,4 +1,4 @@
-//! Direct volume rendering (TECHNIQUES.md §8): the rasterizer's GPU ray marching against the
+//! Direct volume rendering (docs/course/11-volumes.md): the rasterizer's GPU ray marching against the
 //! tracer's, which march the same samples of the same field by construction, so they must agree
 //! up to the GPU's 16-bit field and hardware filtering; opacity correction against the step;
 //! early termination against marching to the end; the reconstruction against the analytic

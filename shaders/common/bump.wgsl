@@ -1,4 +1,4 @@
-// Bump mapping (TECHNIQUES.md §3, seed 000 §1.2) and mip-level helpers (§2, seed 000 §1.1): the
+// Bump mapping (docs/course/04-bump-mapping.md) and mip-level helpers (docs/course/03-mipmaps.md): the
 // WGSL twin of src/texture/{bump,height,tangents,lod,mipmap}.rs. Keep the two in step;
 // tests/bump.rs runs both on the same inputs. Pure functions only: the pass supplies texture
 // samples and screen derivatives (dpdx/dpdy are fragment-only, so they are taken by the caller).

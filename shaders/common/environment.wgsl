@@ -1,4 +1,4 @@
-// Environment maps (TECHNIQUES.md §6, seed 000 §1.5): the radiance arriving from a direction,
+// Environment maps (docs/course/08-environment-maps.md): the radiance arriving from a direction,
 // stored three ways. Each mapping here has its Rust twin in src/scene/environment.rs, with the
 // tests that pin the conventions; the passes that bind the maps are scene.wgsl (lookups and the
 // background) and environment.wgsl (making one form from another).

@@ -1,4 +1,4 @@
-// The local illumination model (TECHNIQUES.md §1, seed 000 §2.1): the WGSL twin of
+// The local illumination model (docs/course/02-illumination.md): the WGSL twin of
 // src/scene/shading.rs and src/scene/light.rs. Keep the two in step; tests/illumination.rs runs
 // both on the same inputs.
 //

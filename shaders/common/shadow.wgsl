@@ -1,4 +1,4 @@
-// Shadow-map lookups (TECHNIQUES.md §4, pass 2): project the shaded point into the light's view
+// Shadow-map lookups (docs/course/05-shadows.md, pass 2): project the shaded point into the light's view
 // and compare its depth with the stored one. Textures and samplers come in as parameters so this
 // shared file names no pass's bindings. The Rust twins of the layout logic live in
 // src/raster/shadow/views.rs (cube_face, project).

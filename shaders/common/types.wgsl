@@ -82,7 +82,7 @@ struct Material {
     // 1 when kt > 0: drawn into the transmission maps instead of the depth maps.
     transparent: u32,
     specular_color: vec3f,
-    // k of TECHNIQUES.md §3.
+    // k of docs/course/04-bump-mapping.md.
     bump_scale: f32,
     emission: vec3f,
     normal_scale: f32,
@@ -103,7 +103,7 @@ struct Material {
     index: u32,
 }
 
-// What a transparent surface lets through, the factor of I = Im + kt·Mt·I (TECHNIQUES.md §5):
+// What a transparent surface lets through, the factor of I = Im + kt·Mt·I (docs/course/06-transparency.md):
 // kt·Mt, and for alpha blending α·kt·Mt + (1 − α), with α the coverage at the fragment.
 fn material_transmittance(m: Material, alpha: f32) -> vec3f {
     if m.alpha_mode == ALPHA_BLEND {

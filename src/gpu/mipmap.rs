@@ -1,4 +1,4 @@
-//! Mip chains on the GPU (TECHNIQUES.md §2, seed 000 §1.1).
+//! Mip chains on the GPU (docs/course/03-mipmaps.md).
 //!
 //! Mipmapping stores a texture at every power-of-two reduction, level `i + 1` the box average of
 //! level `i`, `M_{i+1}[j, k] = ¼ (M_i[2j, 2k] + M_i[2j+1, 2k] + M_i[2j, 2k+1] + M_i[2j+1, 2k+1])`,

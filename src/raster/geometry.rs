@@ -134,7 +134,7 @@ pub struct GpuMesh {
 
 impl GpuMesh {
     fn upload(device: &wgpu::Device, label: &str, mesh: &Mesh) -> GpuMesh {
-        // The file's tangents where it has them, MikkTSpace's otherwise (TECHNIQUES.md §3's
+        // The file's tangents where it has them, MikkTSpace's otherwise (docs/course/04-bump-mapping.md's
         // per-vertex source).
         let existing = (!mesh.tangents.is_empty()).then_some(mesh.tangents.as_slice());
         let tangents = tangents_or_generate(mesh, existing);

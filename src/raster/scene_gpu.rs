@@ -200,7 +200,7 @@ impl SceneGpu {
             &GpuFrame::new(scene.ambient, &scene.lights, &[], &scene.settings),
         );
         let views = ViewBuffer::new(device);
-        // Every texture gets its whole mip chain, averaged in linear space (TECHNIQUES.md §2).
+        // Every texture gets its whole mip chain, averaged in linear space (docs/course/03-mipmaps.md).
         let textures: Vec<GpuTexture> = scene
             .textures
             .iter()

@@ -1,4 +1,4 @@
-//! Transparent surfaces in sorted Z order (TECHNIQUES.md §5; seed 000 §1.4). A z-buffer cannot
+//! Transparent surfaces in sorted Z order (docs/course/06-transparency.md). A z-buffer cannot
 //! bend rays, so the rasterizer takes `n_i = n_t` (the ray goes straight through) and draws:
 //!
 //! 1. every opaque surface, depth written (the scene pass);

@@ -1,4 +1,4 @@
-//! Volumes in the rasterizer (TECHNIQUES.md §8): a GPU ray-marching pass over the opaque image,
+//! Volumes in the rasterizer (docs/course/11-volumes.md): a GPU ray-marching pass over the opaque image,
 //! the twin of `crate::volume::march` (`shaders/volume.wgsl`).
 //!
 //! Per scene, each volume's normalized field becomes a 3D texture (`R16Float`, filterable, so the

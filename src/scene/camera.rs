@@ -1,4 +1,4 @@
-//! The camera of seed 004 ("Calculo do sistema do olho"), shared by both renderers.
+//! The camera of the course notes (docs/course/01-camera.md#the-eye-frame), shared by both renderers.
 //!
 //! Given `eye`, `center`, `up`, the vertical field of view `fovy`, the clip distances `near` and
 //! `far` and an image of `width × height` pixels, the eye frame is
@@ -16,13 +16,13 @@
 //! q(x, y) = eye − near·ze + w·((x + ½)/width − ½)·xe + h·(½ − (y + ½)/height)·ye
 //! ```
 //!
-//! **Pixel-centre convention.** The ray tracer shoots its primary ray through `q(x, y)` (seed 003:
+//! **Pixel-centre convention.** The ray tracer shoots its primary ray through `q(x, y)` (docs/course/01-camera.md#pixel-centres:
 //! `u = l + (r − l)(i + 0.5)/Nx`), and the rasterizer's `clip_from_world` maps `q(x, y)` to the
 //! centre of framebuffer pixel `(x, y)`, where the GPU samples coverage and interpolates
 //! attributes. So the same surface point lands on the same pixel in both images: they are
 //! pixel-aligned, which is what makes `compare` meaningful. `tests/camera.rs` checks it.
 //!
-//! Orthographic cameras (seed 003) shoot parallel rays along `−ze` from the points of a window of
+//! Orthographic cameras shoot parallel rays along `−ze` from the points of a window of
 //! height `ortho_height` centred on the eye; the window's width follows the aspect ratio.
 
 use glam::{Mat4, Vec3, Vec4};
@@ -36,7 +36,7 @@ pub enum Projection {
     Orthographic,
 }
 
-/// A pinhole (or orthographic) camera in seed 004's terms.
+/// A pinhole (or orthographic) camera in the course's terms.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
     pub eye: Vec3,
@@ -53,7 +53,7 @@ pub struct Camera {
     pub ortho_height: f32,
 }
 
-/// The orthonormal eye frame `xe, ye, ze` of seed 004.
+/// The orthonormal eye frame `xe, ye, ze` of the course.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EyeFrame {
     pub xe: Vec3,

@@ -1,4 +1,4 @@
-//! Environment maps (seed 000 §1.5, TECHNIQUES.md §6): the world beyond the scene as a radiance
+//! Environment maps (docs/course/08-environment-maps.md): the world beyond the scene as a radiance
 //! that depends only on direction, `L_env(d)`, infinitely far away. A ray that hits nothing sees
 //! `intensity · L_env(d)`; a mirror shows `kps·MPS·L_env(r)` for its reflected direction `r`.
 //!
@@ -13,7 +13,7 @@
 //!   seen orthographically along −Z; the pixel at the ball's normal `n` holds the radiance of the
 //!   direction `n` reflects −Z into. It covers every direction, but the one straight behind the
 //!   ball (`(0, 0, −1)`) is smeared over the whole rim.
-//! - **Latitude–longitude** ([`latlong_uv`], the seed's `α = a·u, β = b·v`): longitude
+//! - **Latitude–longitude** ([`latlong_uv`], the notes' `α = a·u, β = b·v`): longitude
 //!   `α = 2π·u`, angle from +Y `β = π·v`, the equirectangular layout of photographed HDRs. Texels
 //!   crowd together near the poles.
 //!

@@ -1,8 +1,8 @@
-//! Light sources of the course notes (seed 004: "Onidirecional", "Direcional", "Farolete").
+//! Light sources of the course notes (docs/course/02-illumination.md#what-it-computes): point, directional and spot.
 //!
 //! Each light gives, at a surface point `p`, the unit vector `l` towards it, the distance to it and
 //! the radiance `S_i` it delivers there: `colour · intensity · fat · spot`. `fat` is the
-//! attenuation factor of seed 003 (1 as in the course notes, or the physical `1/d²`); `spot` is a
+//! attenuation factor of the notes (1 as in the course notes, or the physical `1/d²`); `spot` is a
 //! smooth cone falloff. The WGSL twin is `light_incidence` in `shaders/common/lighting.wgsl`.
 
 use glam::Vec3;

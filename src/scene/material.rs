@@ -1,4 +1,4 @@
-//! Materials: the whole illumination model of TECHNIQUES.md §1 and §7, even where a later issue
+//! Materials: the whole illumination model of docs/course/02-illumination.md and docs/course/09-ray-tracing.md, even where a later issue
 //! is the one that draws a term (mirrors, transparency, bump maps).
 
 use std::path::PathBuf;
@@ -58,7 +58,7 @@ impl Wrap {
     }
 }
 
-/// A height field given by a formula rather than an image (TECHNIQUES.md §3), with closed-form
+/// A height field given by a formula rather than an image (docs/course/04-bump-mapping.md), with closed-form
 /// derivatives so finite differences can be compared with them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ProceduralHeight {
@@ -79,8 +79,8 @@ pub enum AlphaMode {
     /// The surface exists only where `α ≥ cutoff` (leaves, fences), for the camera and for the
     /// lights alike.
     Mask { cutoff: f32 },
-    /// A fraction `α` of the surface covers what lies behind it: `I = α·Im + (1 − α)·I`, the seed's
-    /// transparency (TECHNIQUES.md §5) with `Im` scaled by `α` and `kt·Mt = 1 − α`, grey.
+    /// A fraction `α` of the surface covers what lies behind it: `I = α·Im + (1 − α)·I`, the notes'
+    /// transparency (docs/course/06-transparency.md) with `Im` scaled by `α` and `kt·Mt = 1 − α`, grey.
     Blend,
 }
 
@@ -99,7 +99,7 @@ pub struct Material {
     pub texture: Option<TextureId>,
     /// How the material's textures wrap along u and v.
     pub wrap: [Wrap; 2],
-    /// Per-light ambient coefficient (seed 000's `Directa`: `ka·C`, counted only where the light
+    /// Per-light ambient coefficient (the notes' `Directa`: `ka·C`, counted only where the light
     /// is visible).
     pub ka: f32,
     pub kd: f32,
@@ -117,7 +117,7 @@ pub struct Material {
     pub transmission: f32,
     pub transmission_color: Vec3,
     pub ior: f32,
-    /// Grey-level height field and its scale `k` for bump mapping (TECHNIQUES.md §3).
+    /// Grey-level height field and its scale `k` for bump mapping (docs/course/04-bump-mapping.md).
     pub height_map: Option<TextureId>,
     /// Or a procedural height field (a material has one or the other).
     pub height_field: Option<ProceduralHeight>,

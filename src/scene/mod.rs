@@ -55,7 +55,7 @@ pub enum Shape {
     },
     /// Index into [`Scene::meshes`].
     Mesh(usize),
-    /// Signed-distance-field shapes, which the ray tracer finds by sphere tracing (seed 000 §2.2).
+    /// Signed-distance-field shapes, which the ray tracer finds by sphere tracing (docs/course/09-ray-tracing.md#intersections).
     /// A torus around the local y axis: `major` radius to the tube's centre, `minor` the tube's.
     Torus {
         major: f32,

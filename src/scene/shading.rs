@@ -1,4 +1,4 @@
-//! The local illumination model ("MIL", TECHNIQUES.md §1; seed 000 §2.1, `EvaluaMILRec` and
+//! The local illumination model ("MIL", docs/course/02-illumination.md, `EvaluaMILRec` and
 //! `Directa`), evaluated once here for the ray tracer and once in `shaders/common/lighting.wgsl`
 //! for the rasterizer. `tests/illumination.rs` runs both on the same inputs.
 //!
@@ -10,7 +10,7 @@
 //! `S_i` is what light `i` delivers (colour, intensity, attenuation; see `light.rs`), `V_i` its
 //! visibility (1 without shadows), `A` the scene's global ambient radiance. Two choices the notes
 //! leave open, made once for both renderers:
-//! - `AG(p)`: the notes call it "radiancia ambiente global"; seed 004 writes it `Ia ⊗ kd`. We
+//! - `AG(p)`: the notes call it "radiancia ambiente global"; the Portuguese notes write it `Ia ⊗ kd`. We
 //!   reflect `A` by the diffuse colour, so a perfect mirror (kd = 0) shows no ambient haze.
 //! - A light behind the surface (n·l ≤ 0) adds no diffuse or specular term. The notes' own shadow
 //!   test gives the same for closed objects; for open ones (a quad seen from its back) it stops
@@ -75,7 +75,7 @@ pub fn facing_viewer(n: Vec3, v: Vec3) -> Vec3 {
     if n.dot(v) < 0.0 { -n } else { n }
 }
 
-/// `L_dir(p, v, l)` of seed 000, times the light's radiance `S_i`: the contribution of one
+/// `L_dir(p, v, l)` of the notes, times the light's radiance `S_i`: the contribution of one
 /// visible light. `n` and `v` are unit vectors; `n` already faces the viewer.
 pub fn direct(surface: &SurfaceSample, n: Vec3, v: Vec3, light: &Incidence, terms: Terms) -> Vec3 {
     let mut rad = Vec3::ZERO;
@@ -147,7 +147,7 @@ pub fn emitted_and_ambient(surface: &SurfaceSample, ambient: Vec3, terms: Terms)
 }
 
 /// The whole local model at one point: `ME + AG + Σ V_i·S_i·L_dir`, with each light given as its
-/// incidence and its visibility `V_i`, an RGB fraction (0 or 1 behind opaque occluders, seed 003's
+/// incidence and its visibility `V_i`, an RGB fraction (0 or 1 behind opaque occluders, the notes'
 /// 0 < s < 1 through transparent ones). The recursive mirror and transmission terms are the tracer's.
 pub fn local_illumination<'a>(
     surface: &SurfaceSample,

@@ -1,4 +1,4 @@
-//! Bump mapping from height fields, and normal maps (TECHNIQUES.md §3).
+//! Bump mapping from height fields, and normal maps (docs/course/04-bump-mapping.md).
 
 use super::field::{choices, section};
 
@@ -43,7 +43,7 @@ choices! {
 }
 
 choices! {
-    /// Where the rasterizer's tangents `t_u`, `t_v` come from (TECHNIQUES.md §3 names three
+    /// Where the rasterizer's tangents `t_u`, `t_v` come from (docs/course/04-bump-mapping.md names three
     /// sources; the tracer uses the third, the analytic surface).
     pub enum TangentSource {
         /// Constant per triangle, from how position and texture coordinates change across it

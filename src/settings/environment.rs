@@ -1,4 +1,4 @@
-//! Environment maps for curved mirrors, and the world drawn as the background (TECHNIQUES.md §6).
+//! Environment maps for curved mirrors, and the world drawn as the background (docs/course/08-environment-maps.md).
 
 use super::field::{choices, section};
 

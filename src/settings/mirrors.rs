@@ -1,4 +1,4 @@
-//! Planar mirrors by a mirrored camera, in the rasterizer (TECHNIQUES.md §6).
+//! Planar mirrors by a mirrored camera, in the rasterizer (docs/course/07-planar-mirrors.md).
 
 use super::field::{choices, section};
 

@@ -46,7 +46,7 @@ section! {
     pub struct RenderSettings {
         /// Which terms of the illumination model
         /// `L = ME + AG + Σ V_i·S_i ⊗ (ka·C + kd·C·max(0, n·l) + ks·Sc·max(0, r·v)^e)` are drawn:
-        /// teaching toggles (TECHNIQUES.md §1).
+        /// teaching toggles (docs/course/02-illumination.md).
         terms: TermSettings = TermSettings::default(),
         /// Multiplies linear radiance before the tone curve and the sRGB encoding (the output
         /// transform both renderers share). For a model with physical lights, 1 is Blender's
@@ -63,25 +63,25 @@ section! {
         /// polygonal silhouettes in the difference view.
         #[values(closed(3.0, 4096.0).slider(3.0, 512.0))]
         sphere_segments: u32 = 96,
-        /// Texture filtering (TECHNIQUES.md §2): the mip level from the footprint on the surface
-        /// (the seed's `log(distance)`), trilinear blending between the two nearest levels.
+        /// Texture filtering (docs/course/03-mipmaps.md): the mip level from the footprint on the surface
+        /// (the notes' `log(distance)`), trilinear blending between the two nearest levels.
         textures: TextureSettings = TextureSettings::default(),
-        /// Bump mapping (TECHNIQUES.md §3): `n' = normalize((t_u + du·n) × (t_v + dv·n))` from a
+        /// Bump mapping (docs/course/04-bump-mapping.md): `n' = normalize((t_u + du·n) × (t_v + dv·n))` from a
         /// height field's differences, and normal maps.
         bump: BumpSettings = BumpSettings::default(),
-        /// Cast shadows (TECHNIQUES.md §4): the visibility `V_i` of each light, by shadow maps or
+        /// Cast shadows (docs/course/05-shadows.md): the visibility `V_i` of each light, by shadow maps or
         /// projected polygons in the rasterizer, by shadow rays in the tracer.
         shadows: ShadowSettings = ShadowSettings::default(),
-        /// Transparent surfaces in the rasterizer (TECHNIQUES.md §5): drawn after the opaque
+        /// Transparent surfaces in the rasterizer (docs/course/06-transparency.md): drawn after the opaque
         /// ones, farthest first, each pixel updated as `I = Im + kt·Mt·I`.
         transparency: TransparencySettings = TransparencySettings::default(),
-        /// Planar mirrors (TECHNIQUES.md §6): the scene rendered by the camera mirrored about each
+        /// Planar mirrors (docs/course/07-planar-mirrors.md): the scene rendered by the camera mirrored about each
         /// mirror's plane, shown in the mirror as `kps·MPS·L(r)`.
         mirrors: MirrorSettings = MirrorSettings::default(),
-        /// Environment maps (TECHNIQUES.md §6): curved mirrors look `kps·MPS·L(r)` up in a cube,
+        /// Environment maps (docs/course/08-environment-maps.md): curved mirrors look `kps·MPS·L(r)` up in a cube,
         /// sphere or latitude–longitude map; the world's environment is the background.
         environment: EnvironmentSettings = EnvironmentSettings::default(),
-        /// Direct volume rendering of voxel grids (TECHNIQUES.md §8): rays march the grid,
+        /// Direct volume rendering of voxel grids (docs/course/11-volumes.md): rays march the grid,
         /// classify each sample by the transfer function, shade it
         /// `C = C_amb + C_luz·k_dif·(n·L)` and composite front to back; or find the isosurface
         /// `f = iso`.
@@ -90,7 +90,7 @@ section! {
         /// changes what a technique computes; each trades time for a measured difference
         /// (docs/performance.md).
         raster: RasterSettings = RasterSettings::default(),
-        /// The Whitted ray tracer's own settings (TECHNIQUES.md §7): recursion, anti-aliasing,
+        /// The Whitted ray tracer's own settings (docs/course/09-ray-tracing.md): recursion, anti-aliasing,
         /// acceleration.
         trace: TraceSettings = TraceSettings::default(),
     }

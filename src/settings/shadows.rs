@@ -1,4 +1,4 @@
-//! Cast shadows (TECHNIQUES.md §4): shadow maps or projected polygons in the rasterizer, shadow
+//! Cast shadows (docs/course/05-shadows.md): shadow maps or projected polygons in the rasterizer, shadow
 //! rays in the tracer.
 
 use super::field::{choices, section};
@@ -59,12 +59,12 @@ section! {
 }
 
 choices! {
-    /// How the rasterizer finds cast shadows (TECHNIQUES.md §4).
+    /// How the rasterizer finds cast shadows (docs/course/05-shadows.md).
     pub enum ShadowMethod {
         /// Image precision: the two-pass z-buffer algorithm (shadow maps).
         Map,
         /// Object precision: casters projected from the light onto planar receivers (`plane`
-        /// objects) and clipped to them (seed 000's brute force), drawn as detail polygons.
+        /// objects) and clipped to them (the notes' brute force), drawn as detail polygons.
         Projected,
     }
 }

@@ -1,4 +1,4 @@
-//! The terms of the illumination model (TECHNIQUES.md §1), each drawn or left out: teaching
+//! The terms of the illumination model (docs/course/02-illumination.md), each drawn or left out: teaching
 //! toggles.
 
 use super::field::section;

@@ -1,4 +1,4 @@
-//! Texture filtering: mipmaps and the sampling modes (TECHNIQUES.md §2).
+//! Texture filtering: mipmaps and the sampling modes (docs/course/03-mipmaps.md).
 
 use super::field::{choices, section};
 
@@ -10,7 +10,7 @@ section! {
         /// (trilinear), anisotropic, or each level in its own colour.
         filter: TextureFilter = TextureFilter::Trilinear,
         /// How the ray tracer picks a texture's mip level at a hit: the ray cone's footprint, or
-        /// the seed's `log(distance)` rule.
+        /// the notes' `log(distance)` rule.
         tracer_lod: TracerLod = TracerLod::RayCone,
         /// Most samples along the footprint's long axis for the `anisotropic` filter (1 is
         /// isotropic), where the device allows.
@@ -48,7 +48,7 @@ choices! {
         /// The footprint of the pixel's ray cone on the surface, stretched by the angle of
         /// incidence.
         RayCone,
-        /// The seed's simple rule: the level grows with the logarithm of the distance travelled,
+        /// The notes' simple rule: the level grows with the logarithm of the distance travelled,
         /// whatever the angle (orthographic cameras, whose rays do not spread, use the cone).
         Distance,
     }

@@ -1,5 +1,5 @@
-//! The ray tracer's own settings (TECHNIQUES.md §7): recursion, anti-aliasing (seeds 003 and
-//! 004), acceleration.
+//! The ray tracer's own settings (docs/course/09-ray-tracing.md): recursion, anti-aliasing
+//! (docs/course/10-anti-aliasing.md), acceleration.
 
 use super::field::{choices, section};
 
@@ -34,7 +34,7 @@ section! {
 }
 
 choices! {
-    /// How the ray tracer samples pixels (seeds 003 and 004).
+    /// How the ray tracer samples pixels (docs/course/10-anti-aliasing.md#sampling-patterns).
     pub enum AntiAliasing {
         /// One ray through each pixel centre: pixel-aligned with the rasterizer.
         Center,

@@ -1,4 +1,4 @@
-//! Transparent surfaces in sorted Z order, in the rasterizer (TECHNIQUES.md §5).
+//! Transparent surfaces in sorted Z order, in the rasterizer (docs/course/06-transparency.md).
 
 use super::field::{choices, section};
 

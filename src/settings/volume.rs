@@ -1,4 +1,4 @@
-//! Direct volume rendering of voxel grids: compositing and isosurfaces (TECHNIQUES.md §8).
+//! Direct volume rendering of voxel grids: compositing and isosurfaces (docs/course/11-volumes.md).
 
 use super::field::{choices, section};
 
@@ -81,7 +81,7 @@ choices! {
         Off,
         /// Gradient normals by forward differences (first order).
         Forward,
-        /// Gradient normals by central differences (second order, the seed's).
+        /// Gradient normals by central differences (second order, the notes').
         Central,
     }
 }

@@ -1,4 +1,4 @@
-//! Bump mapping: perturbing the shading normal with a height field (TECHNIQUES.md §3, seed 000
+//! Bump mapping: perturbing the shading normal with a height field (docs/course/04-bump-mapping.md
 //! §1.2; Blinn 1978).
 //!
 //! The surface is `p = f_p(u, v)` with tangents `t_u = ∂p/∂u`, `t_v = ∂p/∂v` and unit normal `n`;

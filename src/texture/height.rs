@@ -1,4 +1,4 @@
-//! Height fields `f_h(u, v)` for bump mapping (TECHNIQUES.md §3, seed 000 §1.2): "a grey-level
+//! Height fields `f_h(u, v)` for bump mapping (docs/course/04-bump-mapping.md): "a grey-level
 //! texture, or a procedural function with known derivatives".
 //!
 //! - [`TextureHeight`]: a grey-level texture, read as the **red channel** of its level 0 (a grey

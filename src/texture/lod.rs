@@ -1,9 +1,9 @@
-//! Level of detail: which mip level a lookup reads (TECHNIQUES.md §2, seed 000 §1.1).
+//! Level of detail: which mip level a lookup reads (docs/course/03-mipmaps.md).
 //!
 //! The level is `λ = log2 ρ + bias`, `ρ` the number of level-0 texels one pixel covers along its
 //! longer side. Three ways to estimate `ρ`, from the simplest to the GPU's own:
 //!
-//! - **Distance** (the seed's rule, [`lod_from_distance`]): "the level grows linearly with
+//! - **Distance** (the notes' rule, [`lod_from_distance`]): "the level grows linearly with
 //!   log(d)": `λ = log2(d / d₀)`, `d₀` the distance at which one texel fills one pixel. Exact only
 //!   for a surface facing the camera with a uniform texture scale; it knows nothing of slanted
 //!   surfaces or of how the texture is stretched.
@@ -29,7 +29,7 @@ use glam::Vec2;
 /// large but finite level (the sampler clamps it to the smallest level anyway).
 pub const MIN_COS_INCIDENCE: f32 = 1e-4;
 
-/// The seed's rule: `λ = log2(distance / texel_distance) + bias`, where `texel_distance` is the
+/// The notes' rule: `λ = log2(distance / texel_distance) + bias`, where `texel_distance` is the
 /// distance at which one level-0 texel covers one pixel (for a frontal surface,
 /// `(|∂p/∂u| / width) / γ` with `γ` the pixel's angle, see [`pixel_spread_angle`]). Negative
 /// values (magnification) are returned as they are; the sampler clamps them to level 0.

@@ -1,4 +1,4 @@
-//! Mip chains and the filters that read them (TECHNIQUES.md §2, seed 000 §1.1), on the CPU.
+//! Mip chains and the filters that read them (docs/course/03-mipmaps.md), on the CPU.
 //!
 //! A mipmap ("multum in parvo") of a `2^n × 2^n` texture is `n + 1` images; level `i + 1` halves
 //! level `i` by the box filter
@@ -23,7 +23,7 @@
 //!
 //! 2D weights are products of the two axes' (up to 3×3 taps). The footprints tile the source
 //! exactly, so every level has the same mean as level 0 (up to rounding) for every size, and
-//! power-of-two sizes reduce to the seed's formula bit for bit. `shaders/mipmap.wgsl` computes
+//! power-of-two sizes reduce to the notes' formula bit for bit. `shaders/mipmap.wgsl` computes
 //! the same weights on the GPU.
 //!
 //! **Sampling** ([`MipChain::sample`]) follows the GPU sampler (Vulkan's rules) so that the ray
@@ -33,7 +33,7 @@
 //! `λ − ⌊λ⌋`. Anisotropic filtering exists only on the GPU (its footprint shape is left to the
 //! implementation); the CPU has no twin for it.
 //!
-//! Limits: the box filter is the seed's, not the best downsampler (it blurs less evenly than a
+//! Limits: the box filter is the notes', not the best downsampler (it blurs less evenly than a
 //! wider kernel and aliases a little); levels are not renormalized for alpha coverage.
 
 use glam::{Vec2, Vec3, Vec4};
@@ -254,7 +254,7 @@ impl MipLevel {
             for (j, out) in row.iter_mut().enumerate() {
                 let tx = box_taps(j as u32, self.width);
                 // y outer, x inner: for power-of-two sizes the sum is
-                // ((¼a + ¼b) + ¼c) + ¼d = (a + b + c + d)/4 in the seed's order, bit for bit.
+                // ((¼a + ¼b) + ¼c) + ¼d = (a + b + c + d)/4 in the notes' order, bit for bit.
                 let mut sum = Vec4::ZERO;
                 for b in 0..ty.count {
                     let row_start = (ty.first + b) as usize * self.width as usize;

@@ -1,10 +1,10 @@
-//! Textures beyond plain lookups: mip chains and level of detail (TECHNIQUES.md §2, seed 000
-//! §1.1) and bump mapping (§3, seed 000 §1.2), on the CPU for the ray tracer, with WGSL twins in
+//! Textures beyond plain lookups: mip chains and level of detail (docs/course/03-mipmaps.md
+//! §1.1) and bump mapping (docs/course/04-bump-mapping.md), on the CPU for the ray tracer, with WGSL twins in
 //! `shaders/common/bump.wgsl` and GPU mip generation in `crate::gpu::mipmap`.
 //!
 //! - [`mipmap`]: [`MipChain`] (linear f32 levels, box filter, NPOT rule) and its [`Filter`]s,
 //!   the level-colour palette.
-//! - [`lod`]: which level to read: the seed's distance rule, ray cones for the tracer, and the
+//! - [`lod`]: which level to read: the notes' distance rule, ray cones for the tracer, and the
 //!   GPU's screen-derivative rule.
 //! - [`height`]: height fields `f_h(u, v)`: grey textures, a sine field, value noise.
 //! - [`bump`]: finite differences and the perturbed normal `n' = normalize(t'_u × t'_v)`.

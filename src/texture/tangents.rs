@@ -1,4 +1,4 @@
-//! Tangent frames for bump and normal mapping (TECHNIQUES.md §3, seed 000 §1.2): the vectors
+//! Tangent frames for bump and normal mapping (docs/course/04-bump-mapping.md): the vectors
 //! `t_u = ∂p/∂u`, `t_v = ∂p/∂v` of the surface as a function of its texture coordinates.
 //! The seed lists three ways to get them, all here:
 //!

@@ -6,7 +6,7 @@
 //! ("intersecciones rayo-objeto"): the hit is the smallest root `t > 0` of `F(o + t·v) = 0` that
 //! meets the object's extra conditions `C`, found by a direct formula or iteratively.
 //!
-//! - **Slabs** (seed 003, Kay–Kajiya): a box is the intersection of three slabs; per axis
+//! - **Slabs** (Kay–Kajiya; docs/course/09-ray-tracing.md#intersections): a box is the intersection of three slabs; per axis
 //!   `t₁ = (min − o)/d`, `t₂ = (max − o)/d`, and the ray is inside the box for
 //!   `max(t_near) ≤ t ≤ min(t_far)`. With a precomputed inverse direction a zero component gives
 //!   `±∞`, which is exactly right, except for `0·∞ = NaN` when the origin lies on the slab's
@@ -39,7 +39,7 @@
 //! Hit records ([`SurfaceHit`]) are computed once, for the nearest hit only. Their texture
 //! coordinates follow the rasterizer's tessellation in `src/scene/mesh.rs` exactly, so textures
 //! and bump maps land on the same places in both renderers; `dpdu`, `dpdv` are `∂p/∂u`, `∂p/∂v`
-//! of that same parametrization (TECHNIQUES.md §3).
+//! of that same parametrization (docs/course/04-bump-mapping.md).
 
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
 
@@ -500,7 +500,7 @@ impl Analytic {
         }
     }
 
-    /// Sphere tracing (seed 000 §2.2) in local space with `t` in world units.
+    /// Sphere tracing (docs/course/09-ray-tracing.md#intersections) in local space with `t` in world units.
     fn sphere_trace(&self, o: Vec3, d: Vec3, t_min: f32, t_max: f32) -> Option<f32> {
         let d_len = d.length();
         let (enter, exit) = self.shape.local_bounds().intersect_inv(o, d.recip(), t_min, t_max)?;
@@ -752,7 +752,7 @@ pub struct SurfaceHit {
     pub uv: Vec2,
     /// `∂p/∂u`, `∂p/∂v` in world space. For the rasterizer's image-like texture coordinates (v
     /// down the image) `dpdu × dpdv` points along −n on spheres, boxes and planes and along +n on
-    /// tori; bump mapping orients the perturbed normal like `n` (TECHNIQUES.md §3).
+    /// tori; bump mapping orients the perturbed normal like `n` (docs/course/04-bump-mapping.md).
     pub dpdu: Vec3,
     pub dpdv: Vec3,
     pub material: MaterialId,

@@ -5,7 +5,7 @@
 //!
 //! - [`geometry`]: world-space primitives, exact intersections, hit records.
 //! - [`accel`]: BVH, uniform grid, octree and brute force, which agree on every hit.
-//! - [`whitted`]: the recursion of TECHNIQUES.md §7.
+//! - [`whitted`]: the recursion of docs/course/09-ray-tracing.md.
 //! - [`texture`]: mip-mapped texture lookups with ray cones, and bump mapping (§2, §3).
 //! - [`sampling`]: anti-aliasing (centre, regular, jittered, corner rays, adaptive).
 //! - [`render`]: tiles over threads, progress, cancellation, statistics, progressive refinement.

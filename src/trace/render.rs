@@ -1,5 +1,5 @@
 //! The image loop: pixels in tiles over rayon's threads, with a progress bar, cancellation and
-//! ray statistics; and progressive refinement (seed 004), which shows a coarse image first.
+//! ray statistics; and progressive refinement (docs/course/10-anti-aliasing.md#progressive-refinement), which shows a coarse image first.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -211,7 +211,7 @@ fn progress_bar(show: bool, length: u64, message: &'static str) -> indicatif::Pr
     bar
 }
 
-/// Progressive refinement (seed 004): the image is first traced one ray per `start × start`
+/// Progressive refinement (docs/course/10-anti-aliasing.md#progressive-refinement): the image is first traced one ray per `start × start`
 /// block and each block filled with it, then each level halves the blocks, tracing only the
 /// pixels not traced before, until every pixel has its own centre ray. The final image equals a
 /// `center` render exactly; the viewer polls [`Progressive::refine`] between frames.

@@ -1,6 +1,6 @@
 //! Anti-aliasing: where in each pixel the rays go, and how their radiance becomes the pixel's
-//! (seed 003: four corner rays shared between neighbours and Whitted's adaptive subdivision;
-//! seed 004: jittered supersampling).
+//! (docs/course/10-anti-aliasing.md#sampling-patterns: four corner rays shared between
+//! neighbours, Whitted's adaptive subdivision, jittered supersampling).
 //!
 //! Positions are image coordinates: pixel `(i, j)` covers `[i, i+1] × [j, j+1]`, centre at
 //! `(i + ½, j + ½)`.

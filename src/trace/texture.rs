@@ -1,4 +1,4 @@
-//! Texture lookups and bump mapping for the ray tracer (TECHNIQUES.md §2 and §3), matching the
+//! Texture lookups and bump mapping for the ray tracer (docs/course/03-mipmaps.md and docs/course/04-bump-mapping.md), matching the
 //! rasterizer's sampler so the two images agree: repeat wrapping, texel centres at
 //! `(i + ½)/width`, sRGB colour textures decoded to linear before any filtering or averaging.
 //!
@@ -15,7 +15,7 @@
 //! `1/|cos θ|` (`θ` between the ray and the geometric normal: the footprint lies on the actual
 //! surface, which for a smoothed mesh is the flat triangle), gives
 //! `λ = log2 max(w·footprint/|∂p/∂u|, h·footprint/|∂p/∂v|) + lod_bias`
-//! (`crate::texture::lod::lod_from_footprint`). The seed's simpler rule, `λ = log2(d/d₀)` with
+//! (`crate::texture::lod::lod_from_footprint`). The notes' simpler rule, `λ = log2(d/d₀)` with
 //! `d₀` the distance at which a texel fills a pixel (`lod_from_distance`), is not used: it is
 //! exact only for a surface facing the camera and knows nothing of slant, texture stretch or
 //! bounces. The cone is always one pixel wide, whatever the anti-aliasing: supersampling averages
@@ -122,7 +122,7 @@ pub fn hit_lod(cone: &RayCone, direction: Vec3, hit: &SurfaceHit, size: (u32, u3
     lod_from_footprint(footprint, hit.dpdu.length(), hit.dpdv.length(), size, bias)
 }
 
-/// The level by the seed's simple rule, `log2(distance / texel_distance)`: the distance is the
+/// The level by the notes' simple rule, `log2(distance / texel_distance)`: the distance is the
 /// whole path the cone has travelled (its width over its spread), and `texel_distance` the one at
 /// which a level-0 texel, seen head-on, covers a pixel. The angle of incidence plays no part, so
 /// a floor seen at a grazing angle keeps too fine a level (aliasing): what ray cones cure.

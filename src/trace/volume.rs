@@ -1,4 +1,4 @@
-//! Volumes in the ray tracer (TECHNIQUES.md §8): every ray, primary or secondary, marches the
+//! Volumes in the ray tracer (docs/course/11-volumes.md): every ray, primary or secondary, marches the
 //! volumes it crosses in front of the nearest surface.
 //!
 //! - **Composite**: each volume's box is clipped to `[0, t_surface]` and composited front to back
@@ -7,7 +7,7 @@
 //!   `C + (1 − α)·L_behind`. Each volume ends its own march at the termination threshold, and
 //!   when the accumulated opacity is past it the ray goes no further: the surface behind is not
 //!   shaded (what the rasterizer's blend still adds, at most `1 − threshold` of it).
-//! - **Samples are shaded** with the seed's voxel illumination `C = C_amb + C_luz·k_dif·(n·L)`:
+//! - **Samples are shaded** with the notes' voxel illumination `C = C_amb + C_luz·k_dif·(n·L)`:
 //!   the illumination model of `scene/shading.rs` for a material with `kd = 1`, `ka = ks = 0` and
 //!   the classified colour as `C`, so `C_amb = A ⊗ C` and `C_luz·k_dif = S_i ⊗ C`. The normal is
 //!   the gradient carried to world space by the inverse transpose, normalized and turned to the
@@ -170,7 +170,7 @@ pub fn world_normal(normal_from_local: Mat3, gradient: Vec3) -> Option<Vec3> {
     (n.length_squared() > 1e-20).then(|| n.normalize())
 }
 
-/// One composited sample's colour, the seed's voxel illumination `C_amb + Σ V·C_luz·k_dif·(n·L)`
+/// One composited sample's colour, the notes' voxel illumination `C_amb + Σ V·C_luz·k_dif·(n·L)`
 /// with the classified colour `colour`, at `p` seen from direction `v` (unit, towards the viewer):
 /// `normal` is turned to the viewer, `None` gives the ambient term alone; `visibility` is each
 /// light's `V`.

@@ -1,4 +1,4 @@
-//! Whitted ray tracing (TECHNIQUES.md §7; seed 000 §2, `RayTracing` and `EvaluaMILRec`; seeds
+//! Whitted ray tracing (docs/course/09-ray-tracing.md, `RayTracing` and `EvaluaMILRec`; seeds
 //! 003 and 004):
 //!
 //! ```text
@@ -12,13 +12,13 @@
 //!   have depth `n + 1` and are traced only while `n < max_depth`, so two facing mirrors end.
 //! - **Visibility `V_i`** is a shadow ray towards the light. Opaque occluders block it;
 //!   transparent ones (kt > 0) let `kt·MT` through, so shadows behind glass are partial and
-//!   coloured (seed 003: 0 < s < 1). Occluders are not refracted: a shadow ray goes straight.
+//!   coloured (0 < s < 1, docs/course/05-shadows.md#through-glass). Occluders are not refracted: a shadow ray goes straight.
 //! - **Alpha (coverage)**, `material.alpha_mode`: `α = alpha ×` the colour texture's alpha at the
 //!   hit (linear, filtered like the colour; `super::texture`). *Opaque* ignores `α`. *Mask*: the
 //!   surface exists only where `α ≥ cutoff`; camera, mirror, refracted and shadow rays alike go on
 //!   from `ε` beyond a hit where `α < cutoff`, along their own direction, as if nothing were there
-//!   (the same ray, not counted again; its cone continued). *Blend* is the seed's
-//!   transparency (TECHNIQUES.md §5) with `Im` scaled by `α` and `kt·Mt = 1 − α`:
+//!   (the same ray, not counted again; its cone continued). *Blend* is the notes'
+//!   transparency (docs/course/06-transparency.md) with `Im` scaled by `α` and `kt·Mt = 1 − α`:
 //!
 //!   ```text
 //!   L = α·(ME + AG + Σ V·L_dir + kps·MPS·L(r) + kt·MT·L(t)) + (1 − α)·L(p, u, n + 1)
@@ -37,7 +37,7 @@
 //!   the side they leave towards, along the geometric normal: `ε = 1e-4·max(1, |p|∞)`, which
 //!   scales with the scene's coordinates (a fixed ε is too small far from the origin, where
 //!   `f32` spacing grows). Rays then accept hits from `t > 0`.
-//! - **Textures and bumps** (TECHNIQUES.md §2, §3; `super::texture`). Every ray that can see a
+//! - **Textures and bumps** (docs/course/03-mipmaps.md, docs/course/04-bump-mapping.md; `super::texture`). Every ray that can see a
 //!   texture carries a [`RayCone`]: the primary ray the camera's, the mirror and refracted rays
 //!   that cone continued from the hit, so a texture seen in a mirror is filtered for its whole
 //!   path length; shadow rays carry none. The bump-mapped normal `n'` replaces the shading normal
@@ -179,7 +179,7 @@ impl Whitted<'_> {
         let isosurface = self.volumes.nearest_isosurface(ray, t_surface);
         let t_end = isosurface.as_ref().map_or(t_surface, |hit| hit.t);
         let crossing = self.volumes.composite(ray, t_end, &mut |prepared, t, gradient, colour| {
-            // One composited sample: the seed's voxel illumination, with shadow rays when
+            // One composited sample: the notes' voxel illumination, with shadow rays when
             // `volume.shadows` is on.
             let p = ray.at(t);
             let normal = world_normal(prepared.normal_from_local, gradient);
@@ -413,7 +413,7 @@ impl Whitted<'_> {
     /// `V_i`: the fraction of a light's radiance that reaches `origin` along `l` over `distance`:
     /// the product, over the surfaces the shadow ray crosses, of what each lets through. A
     /// surface covering a fraction `α` of the ray lets `α·kt·MT + (1 − α)` through: 0 for an
-    /// opaque occluder, `kt·MT` for glass (seed 003), 1 where a mask leaves no surface, and
+    /// opaque occluder, `kt·MT` for glass, 1 where a mask leaves no surface, and
     /// `1 − α` more through a blended one. Coverage is read at level 0: shadow rays carry no cone.
     pub fn visibility(&self, origin: Vec3, l: Vec3, distance: f32, counts: &mut RayCounts) -> Vec3 {
         self.visibility_observed((0, 0), origin, (l, distance), counts, &mut Unobserved)

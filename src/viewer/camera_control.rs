@@ -1,4 +1,4 @@
-//! Camera controls as pure functions on the seed's camera (`eye`, `center`, `up`, `fovy`, `near`,
+//! Camera controls as pure functions on the notes' camera (`eye`, `center`, `up`, `fovy`, `near`,
 //! `far`, see `scene/camera.rs`): each takes a camera and returns the moved one, so they are
 //! tested without a window.
 //!

@@ -2,7 +2,7 @@
 //!
 //! One worker thread owns a rayon pool of all cores but one (the other keeps the rasterizer and
 //! the UI responsive). For each request — a scene, its settings and the camera at the view's full
-//! size — it shows progressive refinement (seed 004, [`Progressive`]): one ray per 16×16 block,
+//! size — it shows progressive refinement ([`Progressive`], docs/course/10-anti-aliasing.md#progressive-refinement): one ray per 16×16 block,
 //! then 8×8, then 4×4; then it traces the whole image with the configured anti-aliasing through
 //! [`Tracer::render`], whose [`RenderControl`] cancellation flag stops it within a tile when the
 //! camera, the scene or a setting changes. With `center` sampling the final image is exactly the

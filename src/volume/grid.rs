@@ -1,4 +1,4 @@
-//! The scalar field on a Cartesian grid (seed 004, "Volume de dados", "Interpolação"): voxel
+//! The scalar field on a Cartesian grid (docs/course/11-volumes.md#reconstruction): voxel
 //! values at grid points, reconstructed between them by nearest-neighbour or trilinear
 //! interpolation, and the gradient by first- or second-order differences ("Estimativa do vetor
 //! normal").
@@ -25,7 +25,7 @@ pub struct Grid {
 pub enum Reconstruction {
     /// The value of the nearest grid point (`floor(g + 0.5)`, as a texture's nearest filter).
     Nearest,
-    /// The seed's `v(x, y, z)`: the eight surrounding grid points weighted by `(1 − x)`, `x`, …
+    /// The notes' `v(x, y, z)`: the eight surrounding grid points weighted by `(1 − x)`, `x`, …
     Trilinear,
 }
 
@@ -34,7 +34,7 @@ pub enum Reconstruction {
 pub enum Differences {
     /// First order: `(f(g + e) − f(g)) / Δ`, error O(Δ).
     Forward,
-    /// Second order, the seed's formula: `(f(g + e) − f(g − e)) / 2Δ`, error O(Δ²).
+    /// Second order, the notes' formula: `(f(g + e) − f(g − e)) / 2Δ`, error O(Δ²).
     Central,
 }
 

@@ -1,4 +1,4 @@
-//! Casting one ray through a volume (seed 004, "Lançamento dos Raios" to "Etapa de Composição"):
+//! Casting one ray through a volume (docs/course/11-volumes.md#compositing):
 //! `k` equally spaced samples between where the ray enters the volume's box and where it leaves
 //! it (or meets an opaque surface first), each reconstructed, classified, shaded and composited
 //! front to back:

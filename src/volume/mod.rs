@@ -1,9 +1,9 @@
-//! Direct volume rendering (TECHNIQUES.md §8; seed 004, "Volume de dados" to "Partição na
+//! Direct volume rendering (docs/course/11-volumes.md, "Volume de dados" to "Partição na
 //! grade"): the CPU half both renderers share.
 //!
 //! A [`Volume`] is a scalar field sampled on a Cartesian grid, placed in the scene by a transform
 //! like any object, and shown either by **compositing** (every sample classified into colour and
-//! opacity by a transfer function, shaded with the seed's voxel illumination
+//! opacity by a transfer function, shaded with the notes' voxel illumination
 //! `C = C_amb + C_luz·k_dif·(n·L)`, `n` the normalized gradient, and composited front to back) or
 //! as an **isosurface** `f = iso` shaded like any surface.
 //!

@@ -1,4 +1,4 @@
-//! Classification (seed 004, "Classificação do Voxel"): a transfer function from a voxel's value
+//! Classification (docs/course/11-volumes.md#classification): a transfer function from a voxel's value
 //! to a colour and an opacity, and the opacity's correction for the sample step.
 //!
 //! The function is piecewise linear between control points over the normalized value `x ∈ [0, 1]`

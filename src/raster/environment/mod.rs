@@ -1,4 +1,4 @@
-//! Environment maps (TECHNIQUES.md §6, seed 000 §1.5): the rasterizer cannot trace the mirror term
+//! Environment maps (docs/course/08-environment-maps.md): the rasterizer cannot trace the mirror term
 //! `kps·MPS·L(r)` of a curved mirror, so it looks `L(r)` up in a map of the radiance arriving from
 //! every direction, made beforehand:
 //!

@@ -1,4 +1,4 @@
-//! Planar mirrors, the geometry (TECHNIQUES.md §6, seed 000 §1.5): "render the scene with the
+//! Planar mirrors, the geometry (docs/course/07-planar-mirrors.md): "render the scene with the
 //! camera mirrored about the mirror's plane (only what is in front of the plane), and show that
 //! image in the mirror". No wgpu here: the mirror pass draws the views this module makes.
 //!

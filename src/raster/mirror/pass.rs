@@ -1,4 +1,4 @@
-//! The planar-mirror pass (TECHNIQUES.md §6): before the main view is shaded, every mirror it
+//! The planar-mirror pass (docs/course/07-planar-mirrors.md): before the main view is shaded, every mirror it
 //! sees is drawn from its mirrored camera into an image of the frame's size; the mirror's own
 //! fragments then add `kps·MPS` times that image at their pixel (`MIRROR` in
 //! `shaders/scene.wgsl`), as the tracer adds `kps·MPS·L(r)`.

@@ -1,4 +1,4 @@
-//! Cast shadows (TECHNIQUES.md §4; seed 000 §1.3), two ways:
+//! Cast shadows (docs/course/05-shadows.md), two ways:
 //!
 //! - **Image precision, the two-pass z-buffer algorithm.** Pass 1 ([`ShadowPass::record`])
 //!   renders the scene's depth as each light sees it ([`views`]) into one layer of a depth-texture
@@ -14,7 +14,7 @@
 //! larger than a pixel alias; map size and percentage-closer filtering (PCF: several hardware
 //! comparisons averaged) trade that for blur.
 //!
-//! **Transparent occluders** (seed 003: 0 < s < 1) are drawn after the opaque depth of each
+//! **Transparent occluders** (0 < s < 1, docs/course/05-shadows.md#through-glass) are drawn after the opaque depth of each
 //! layer into a colour map that multiplies their `kt·MT` and keeps the nearest one's depth in
 //! alpha. A receiver behind that depth is tinted by the product. The approximation: every
 //! transparent surface in front of the nearest opaque one counts, even those behind the

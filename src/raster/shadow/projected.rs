@@ -1,4 +1,4 @@
-//! Cast shadows at object precision (seed 000 §1.3, "algoritmo de fuerza bruta"): for every pair
+//! Cast shadows at object precision (docs/course/05-shadows.md#shadow-maps-image-precision, "algoritmo de fuerza bruta"): for every pair
 //! of a caster polygon `P` and a planar receiver `Q`, the shadow polygon `S` that `P` casts on
 //! `Q`'s plane from the light, clipped by `Q` (Sutherland–Hodgman). The results are detail
 //! polygons in which the light is not visible (drawn by `shaders/shadow_projected.wgsl`).

@@ -1,4 +1,4 @@
-//! The light's point of view for pass 1 of the shadow-map algorithm (seed 000 §1.3: "el papel
+//! The light's point of view for pass 1 of the shadow-map algorithm (docs/course/05-shadows.md#shadow-maps-image-precision: "el papel
 //! del observador lo juega la fuente de luz"): one view per map layer.
 //!
 //! - **Directional light**: an orthographic view along the light (the observer is infinitely
