@@ -231,15 +231,21 @@ const MAX_SHININESS: f32 = 2048.0;
 
 /// Loads a `.gltf` or `.glb` file; see the module documentation for what is read and how.
 pub fn import(path: &Path) -> Result<GltfImport, SceneError> {
-    let gltf_error = |message: String| SceneError::Gltf { path: path.to_path_buf(), message };
     if path.as_os_str().is_empty() {
-        return Err(gltf_error("no file given (the path is empty)".into()));
+        return Err(SceneError::Gltf { path: path.to_path_buf(), message: "no file given (the path is empty)".into() });
     }
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
-    super::without_panics(|| import_bytes(path, &bytes)).map_err(gltf_error)
+    let bytes = super::read_file(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    import_bytes(path, &bytes)
 }
 
-fn import_bytes(path: &Path, bytes: &[u8]) -> Result<GltfImport, String> {
+/// Reads a `.gltf` or `.glb` file already in memory; `path` names it in messages, and relative
+/// URIs are resolved against its folder.
+pub fn import_bytes(path: &Path, bytes: &[u8]) -> Result<GltfImport, SceneError> {
+    super::without_panics(|| read(path, bytes))
+        .map_err(|message| SceneError::Gltf { path: path.to_path_buf(), message })
+}
+
+fn read(path: &Path, bytes: &[u8]) -> Result<GltfImport, String> {
     check_glb_header(bytes)?;
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(describe_gltf_error)?;
@@ -378,7 +384,7 @@ fn read_uri(uri: &str, base: &Path) -> Result<Vec<u8>, String> {
     }
     let relative = percent_decode(uri).ok_or_else(|| format!("URI `{}` has an invalid %-escape", shorten(uri)))?;
     let file = base.join(relative);
-    std::fs::read(&file).map_err(|e| format!("cannot read `{uri}` ({}): {e}", file.display()))
+    super::read_file(&file).map_err(|e| format!("cannot read `{uri}` ({}): {e}", file.display()))
 }
 
 /// `scheme:` as RFC 3986 spells it; a single letter is taken for a Windows drive, not a scheme.

@@ -95,16 +95,22 @@ pub const DEFAULT_MATERIAL: &str = "obj-default";
 
 /// Loads an `.obj` file and the MTL libraries it names; see the module documentation.
 pub fn import(path: &Path) -> Result<ModelImport, SceneError> {
-    let error = |message: String| SceneError::Obj { path: path.to_path_buf(), message };
     if path.as_os_str().is_empty() {
-        return Err(error("no file given (the path is empty)".into()));
+        return Err(SceneError::Obj { path: path.to_path_buf(), message: "no file given (the path is empty)".into() });
     }
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    let bytes = super::read_file(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    import_bytes(path, &bytes)
+}
+
+/// Reads an OBJ file already in memory; `path` names it in messages, and the MTL libraries it
+/// names are read relative to its folder.
+pub fn import_bytes(path: &Path, bytes: &[u8]) -> Result<ModelImport, SceneError> {
+    let error = |message: String| SceneError::Obj { path: path.to_path_buf(), message };
     if bytes.is_empty() {
         return Err(error("the file is empty".into()));
     }
     // OBJ is ASCII; old exporters write names and comments in Latin-1, which must not stop it.
-    let text = String::from_utf8_lossy(&bytes);
+    let text = String::from_utf8_lossy(bytes);
     super::without_panics(|| import_text(path, &text)).map_err(error)
 }
 
@@ -263,7 +269,7 @@ fn read_library(dir: &Path, name: &Path, libraries: &RefCell<Vec<Library>>) -> t
 }
 
 fn read_mtl(file: &Path) -> Result<(Vec<tobj::Material>, HashMap<String, usize>), String> {
-    let bytes = std::fs::read(file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
+    let bytes = super::read_file(file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
     let text = expand_grey_colours(&String::from_utf8_lossy(&bytes))?;
     let mut cursor = Cursor::new(text.as_bytes());
     tobj::load_mtl_buf(&mut cursor).map_err(|e| {

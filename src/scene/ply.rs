@@ -55,15 +55,20 @@ const INDEX_NAMES: [&str; 2] = ["vertex_indices", "vertex_index"];
 
 /// Loads a `.ply` file; see the module documentation.
 pub fn import(path: &Path) -> Result<ModelImport, SceneError> {
-    let error = |message: String| SceneError::Ply { path: path.to_path_buf(), message };
     if path.as_os_str().is_empty() {
-        return Err(error("no file given (the path is empty)".into()));
+        return Err(SceneError::Ply { path: path.to_path_buf(), message: "no file given (the path is empty)".into() });
     }
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    let bytes = super::read_file(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    import_bytes(path, &bytes)
+}
+
+/// Reads a PLY file already in memory; `path` names it in messages and names its mesh.
+pub fn import_bytes(path: &Path, bytes: &[u8]) -> Result<ModelImport, SceneError> {
+    let error = |message: String| SceneError::Ply { path: path.to_path_buf(), message };
     if bytes.is_empty() {
         return Err(error("the file is empty".into()));
     }
-    super::without_panics(|| import_bytes(path, &bytes)).map_err(error)
+    super::without_panics(|| read(path, bytes)).map_err(error)
 }
 
 /// One vertex as the file gives it; what the file lacks stays zero.
@@ -135,7 +140,7 @@ impl PropertyAccess for Skipped {
     }
 }
 
-fn import_bytes(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
+fn read(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
     let mut reader = Reader::new(Cursor::new(bytes));
     let header = Parser::<Skipped>::new().read_header(&mut reader).map_err(|e| format!("header: {e}"))?;
     let layout = Layout::of(&header)?;
