@@ -106,7 +106,7 @@ impl Builder<'_> {
             Some([Finite(lo), Finite(hi)]) => return Err(fail(format!("range needs low < high, got [{lo}, {hi}]"))),
             None => grid.range(),
         };
-        let normalize = |v: f32| if hi > lo { (v - lo) / (hi - lo) } else { 0.0 };
+        let normalize = |v: f32| crate::volume::grid::normalize(v, (lo, hi));
         let transfer = match (d.preset, d.transfer) {
             (Some(_), Some(_)) => return Err(fail("give a volume either a `preset` or a `transfer`, not both".into())),
             (Some(preset), None) => Preset::by_name(preset.get_ref())
