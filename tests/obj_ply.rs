@@ -569,20 +569,22 @@ fn ply_counts_the_file_cannot_hold_are_refused_before_reading() {
 #[test]
 fn obj_face_indices_near_the_integer_limit_are_errors_at_their_line() {
     // Found by fuzzing (the 2 660 inputs; fuzz/regressions/obj/): tobj computes
-    // `2·vt + 1` and `3·vn + 2` from a face's indices unchecked, which overflowed (a panic inside
-    // tobj where overflow checks are on, caught by the importer's last net; a wrapped offset
-    // where they are off). Mirador checks each index before tobj sees it.
+    // `2·vt + 1` and `3·vn + 2` from a face's indices unchecked, which overflowed for a huge `vn`
+    // or a relative `vt` before the first (turned into an index near 2⁶⁴): a panic inside tobj
+    // where overflow checks are on, caught by the importer's last net; a wrapped offset where
+    // they are off. Mirador checks each index before tobj sees it.
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions/obj");
     for (file, words) in [
-        (
-            "tobj-overflow-vt-index-2e63.obj",
-            &["line 6", "texture coordinates 9223372036854775807", "past the last `vt`"][..],
-        ),
-        ("tobj-overflow-vn-index-2e63.obj", &["line 6", "normal 9223372036854775807", "past the last `vn`"]),
+        ("tobj-overflow-vn-index-2e63.obj", &["line 6", "normal 9223372036854775807", "past the last `vn`"][..]),
         ("tobj-overflow-vt-relative-before-first.obj", &["line 6", "relative index -5", "only 1 come before it"]),
         // 3·(6148914691236517207 − 1) wraps to 2: a release build read the second normal's y,
         // z and the next x as this vertex's normal, without an error.
         ("tobj-overflow-vn-wraps-to-offset-2.obj", &["line 6", "normal 6148914691236517207", "past the last `vn`"]),
+        // 2·(2⁶³ − 2) + 1 still fits: tobj refused this one itself, but without its line.
+        (
+            "vt-index-2e63-past-the-last.obj",
+            &["line 6", "texture coordinates 9223372036854775807", "past the last `vt`"],
+        ),
     ] {
         let path = dir.join(file);
         let message = assert_error(obj::import(&path), &path, "OBJ", words);
