@@ -535,6 +535,63 @@ fn a_ply_header_that_lies_is_an_error() {
     ply_error("negative", format!("{HEADER}0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n").as_bytes(), &["vertex -1"]);
 }
 
+/// Runs `read` on another thread and fails if it has not finished within `limit`.
+fn within<T: Send + 'static>(limit: std::time::Duration, read: impl FnOnce() -> T + Send + 'static) -> T {
+    let (done, finished) = std::sync::mpsc::channel();
+    std::thread::spawn(move || done.send(read()));
+    finished.recv_timeout(limit).unwrap_or_else(|_| panic!("not finished within {limit:?}"))
+}
+
+#[test]
+fn a_ply_element_without_properties_is_not_read_however_many_it_claims() {
+    // Found by fuzzing (fuzz/regressions/ply/): a binary element with no properties takes no
+    // bytes, so the parser's loop over its count of 10^15 read nothing, never ended, and kept
+    // `mirador render` busy past 60 s.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions/ply/hang-empty-element-1e15.ply");
+    let import = within(std::time::Duration::from_secs(20), move || ply::import(&path));
+    let import = import.unwrap_or_else(|e| panic!("the triangle after the empty element loads: {e}"));
+    assert_eq!(import.meshes[0].indices, [0, 1, 2]);
+}
+
+#[test]
+fn ply_counts_the_file_cannot_hold_are_refused_before_reading() {
+    // 10^15 vertices of 12 bytes in a file of a few dozen: refused by the header alone.
+    let header = "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000000\nproperty float x\n\
+                  property float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+    let bytes = [header.as_bytes(), &[0; 40]].concat();
+    let message = ply_error("counts", &bytes, &["1000000000000000 `vertex`", "12 byte(s)", "40 bytes"]);
+    assert!(message.contains("the header lies"), "{message}");
+    // In ASCII a property takes at least one character: 3 vertices of 3 need 9 bytes, 1 face 1.
+    let ascii = format!("{HEADER}0 0 0\n");
+    ply_error("ascii-counts", ascii.as_bytes(), &["`vertex`", "cannot hold them"]);
+}
+
+#[test]
+fn obj_face_indices_near_the_integer_limit_are_errors_at_their_line() {
+    // Found by fuzzing (the issue's 2 660 inputs; fuzz/regressions/obj/): tobj computes
+    // `2·vt + 1` and `3·vn + 2` from a face's indices unchecked, which overflowed for a huge `vn`
+    // or a relative `vt` before the first (turned into an index near 2⁶⁴): a panic inside tobj
+    // where overflow checks are on, caught by the importer's last net; a wrapped offset where
+    // they are off. Mirador checks each index before tobj sees it.
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions/obj");
+    for (file, words) in [
+        ("tobj-overflow-vn-index-2e63.obj", &["line 6", "normal 9223372036854775807", "past the last `vn`"][..]),
+        ("tobj-overflow-vt-relative-before-first.obj", &["line 6", "relative index -5", "only 1 come before it"]),
+        // 3·(6148914691236517207 − 1) wraps to 2: a release build read the second normal's y,
+        // z and the next x as this vertex's normal, without an error.
+        ("tobj-overflow-vn-wraps-to-offset-2.obj", &["line 6", "normal 6148914691236517207", "past the last `vn`"]),
+        // 2·(2⁶³ − 2) + 1 still fits: tobj refused this one itself, but without its line.
+        (
+            "vt-index-2e63-past-the-last.obj",
+            &["line 6", "texture coordinates 9223372036854775807", "past the last `vt`"],
+        ),
+    ] {
+        let path = dir.join(file);
+        let message = assert_error(obj::import(&path), &path, "OBJ", words);
+        assert!(!message.contains(mirador::scene::PANIC_CAUGHT), "{message}");
+    }
+}
+
 #[test]
 fn nan_ply_coordinates_empty_plys_and_point_clouds_are_errors() {
     // The ASCII reader refuses `nan` itself; binary files can hold any bit pattern.

@@ -97,6 +97,42 @@ fn a_directory_is_not_a_scene_file() {
 }
 
 #[test]
+fn a_pipe_or_device_named_by_a_file_is_refused_without_reading_it() {
+    // Opening a FIFO for reading waits for a writer, and `/dev/zero` never ends: a file naming one
+    // as a model, a glTF buffer, an MTL library, a texture or a volume would hang or fill memory.
+    let dir = temp_path("pipes");
+    std::fs::create_dir_all(&dir).unwrap();
+    let fifo = dir.join("fifo");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().expect("mkfifo runs");
+    assert!(made.success(), "mkfifo {}", fifo.display());
+    let fifo_name = fifo.display().to_string();
+    let gltf = format!(r#"{{"asset":{{"version":"2.0"}},"buffers":[{{"byteLength":4,"uri":"{fifo_name}"}}]}}"#);
+    std::fs::write(dir.join("model.gltf"), gltf).unwrap();
+    std::fs::write(dir.join("model.obj"), format!("mtllib {fifo_name}\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")).unwrap();
+    let scenes = [
+        "[[objects]]\ntype = \"gltf\"\npath = \"model.gltf\"\n".to_string(),
+        "[[objects]]\ntype = \"obj\"\npath = \"model.obj\"\n".to_string(),
+        format!("[[objects]]\ntype = \"ply\"\npath = \"{fifo_name}\"\n"),
+        format!("[materials.a]\ntexture = \"{fifo_name}\"\n"),
+        format!("[world.environment]\nlatlong = \"{fifo_name}\"\n"),
+        format!("[[volumes]]\npath = \"{fifo_name}\"\n"),
+        format!("[[volumes]]\nraw = {{ path = \"{fifo_name}\", dims = [2, 2, 2], type = \"uint8\" }}\n"),
+    ];
+    for text in scenes {
+        let scene = dir.join("scene.toml");
+        let (done, finished) = std::sync::mpsc::channel();
+        let shown = text.clone();
+        std::thread::spawn(move || done.send(parse(&text, &scene).map(|_| ()).map_err(|e| e.to_string())));
+        let result = finished
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .unwrap_or_else(|_| panic!("still reading the pipe after 20 s:\n{shown}"));
+        let message = result.expect_err("a pipe is not a file to read");
+        assert!(message.contains("not a regular file"), "{shown}\n{message}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn a_missing_gltf_file_is_an_io_error_naming_it() {
     let path = temp_path("does-not-exist.glb");
     let error = Scene::load(&path).expect_err("a missing model cannot load");

@@ -365,6 +365,7 @@ pub fn fold_cross(image: &EnvImage) -> Result<Box<[EnvImage; 6]>, String> {
 /// warning. Non-finite and negative texels are repaired to 0 with a warning ([`from_image`]).
 pub fn load_image(path: &Path) -> Result<EnvImage, SceneError> {
     let error = |message: String| SceneError::Texture { path: path.to_path_buf(), message };
+    super::check_regular_file(path).map_err(|e| error(format!("cannot open: {e}")))?;
     let reader = image::ImageReader::open(path)
         .map_err(|e| error(format!("cannot open: {e}")))?
         .with_guessed_format()

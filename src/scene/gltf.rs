@@ -143,8 +143,11 @@
 //! the file itself cannot be read); it never panics. Buffers, buffer views and accessors are
 //! checked against each other before any byte is read (accessors are read here, not through the
 //! `gltf` crate's reader, which panics or truncates silently on such files), node transforms and
-//! attribute values must be finite, and indices must be in range. As a last net, a panic inside
-//! the `gltf` crate on a malformed file the checks missed is turned into an error too.
+//! attribute values must be finite, and indices must be in range. Since any number of primitives
+//! may read one accessor, and any number of nodes draw one mesh, what the import builds is held to
+//! a budget of 32 times the bytes of the file's buffers plus 16 MiB ([`MESH_BUDGET_FACTOR`]). As a
+//! last net, a panic inside the `gltf` crate on a malformed file the checks missed is turned into
+//! an error too.
 
 use std::collections::HashMap;
 use std::ffi::OsString;
@@ -231,15 +234,21 @@ const MAX_SHININESS: f32 = 2048.0;
 
 /// Loads a `.gltf` or `.glb` file; see the module documentation for what is read and how.
 pub fn import(path: &Path) -> Result<GltfImport, SceneError> {
-    let gltf_error = |message: String| SceneError::Gltf { path: path.to_path_buf(), message };
     if path.as_os_str().is_empty() {
-        return Err(gltf_error("no file given (the path is empty)".into()));
+        return Err(SceneError::Gltf { path: path.to_path_buf(), message: "no file given (the path is empty)".into() });
     }
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
-    super::without_panics(|| import_bytes(path, &bytes)).map_err(gltf_error)
+    let bytes = super::read_file(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    import_bytes(path, &bytes)
 }
 
-fn import_bytes(path: &Path, bytes: &[u8]) -> Result<GltfImport, String> {
+/// Reads a `.gltf` or `.glb` file already in memory; `path` names it in messages, and relative
+/// URIs are resolved against its folder.
+pub fn import_bytes(path: &Path, bytes: &[u8]) -> Result<GltfImport, SceneError> {
+    super::without_panics(|| read(path, bytes))
+        .map_err(|message| SceneError::Gltf { path: path.to_path_buf(), message })
+}
+
+fn read(path: &Path, bytes: &[u8]) -> Result<GltfImport, String> {
     check_glb_header(bytes)?;
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(describe_gltf_error)?;
@@ -269,6 +278,7 @@ fn import_bytes(path: &Path, bytes: &[u8]) -> Result<GltfImport, String> {
         materials: HashMap::new(),
         uv_mappings: HashMap::new(),
         textures: HashMap::new(),
+        budget: MESH_BUDGET_FACTOR * buffers.iter().map(|b| b.len() as u64).sum::<u64>() + MESH_BUDGET_ALLOWANCE,
     };
     let ignored: Vec<&str> = document.extensions_used().filter(|e| !HANDLED_EXTENSIONS.contains(e)).collect();
     if !ignored.is_empty() {
@@ -378,7 +388,7 @@ fn read_uri(uri: &str, base: &Path) -> Result<Vec<u8>, String> {
     }
     let relative = percent_decode(uri).ok_or_else(|| format!("URI `{}` has an invalid %-escape", shorten(uri)))?;
     let file = base.join(relative);
-    std::fs::read(&file).map_err(|e| format!("cannot read `{uri}` ({}): {e}", file.display()))
+    super::read_file(&file).map_err(|e| format!("cannot read `{uri}` ({}): {e}", file.display()))
 }
 
 /// `scheme:` as RFC 3986 spells it; a single letter is taken for a Windows drive, not a scheme.
@@ -465,7 +475,26 @@ struct Importer<'d> {
     uv_mappings: HashMap<Option<usize>, UvMapping>,
     /// glTF image → index into `out.textures`.
     textures: HashMap<(usize, ColorSpace), TextureId>,
+    /// The bytes of meshes and objects still allowed ([`MESH_BUDGET_FACTOR`]).
+    budget: u64,
 }
+
+/// The meshes and objects one file builds may hold at most this many times the bytes of its
+/// buffers, plus [`MESH_BUDGET_ALLOWANCE`]. Every accessor is checked against its buffer, but any
+/// number of primitives may read the same accessor, each into a mesh of its own, and any number of
+/// nodes may draw a mesh of many primitives: without a budget, a file of a few megabytes listing
+/// thousands of primitives over one buffer, or thousands of nodes over one mesh of thousands of
+/// primitives, would ask for terabytes. An object counts [`OBJECT_BYTES`].
+/// A file that reads each byte once builds at most about 12 bytes per byte (8-bit positions
+/// widened to floats, with the normals and texture coordinates filled in, or 8-bit strip indices
+/// unrolled into 32-bit triangles); 32 leaves room for primitives that share their vertices.
+const MESH_BUDGET_FACTOR: u64 = 32;
+
+/// See [`MESH_BUDGET_FACTOR`]: 16 MiB, so that small files sharing data freely still load.
+const MESH_BUDGET_ALLOWANCE: u64 = 16 << 20;
+
+/// What one object costs the budget: its name, indices and transform, with room to spare.
+const OBJECT_BYTES: u64 = 128;
 
 /// Where the depth-first walk is in each node, to tell a cycle (an error: the walk would never
 /// end) from a node listed twice (drawn once, with a warning).
@@ -544,9 +573,23 @@ impl<'d> Importer<'d> {
         Ok(())
     }
 
+    /// Takes `bytes` from the budget of what the import builds ([`MESH_BUDGET_FACTOR`]).
+    fn spend(&mut self, bytes: u64, what: &str) -> Result<(), String> {
+        self.budget = self.budget.checked_sub(bytes).ok_or_else(|| {
+            format!(
+                "{what}: the file's meshes and objects come to more than {MESH_BUDGET_FACTOR} times the bytes of its \
+                 buffers (plus {} MiB); its primitives or nodes read the same data over and over",
+                MESH_BUDGET_ALLOWANCE >> 20
+            )
+        })?;
+        Ok(())
+    }
+
     fn node(&mut self, node: &gltf::Node<'d>, label: &str, world: Mat4) -> Result<(), String> {
         if let Some(mesh) = node.mesh() {
             for primitive in mesh.primitives() {
+                // Every node drawing a mesh adds an object per primitive, however many nodes share it.
+                self.spend(OBJECT_BYTES, &format!("node `{label}`"))?;
                 let Some(mesh_index) = self.mesh(&mesh, &primitive)? else { continue };
                 let material = self.material(primitive.material())?;
                 self.out.objects.push(GltfObject {
@@ -654,6 +697,9 @@ impl<'d> Importer<'d> {
             _ => vertices,
         };
         let has_normals = normals.is_some();
+        // Normals and texture coordinates are filled in for every position when missing.
+        let bytes = positions.len() as u64 * (12 + 12 + 8) + tangents.len() as u64 * 16 + indices.len() as u64 * 4;
+        self.spend(bytes, &format!("mesh `{name}`"))?;
         let mut built = Mesh {
             name,
             positions,

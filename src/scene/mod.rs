@@ -227,6 +227,11 @@ impl Scene {
     }
 }
 
+/// The words of the message [`without_panics`] gives for a caught panic. A file that gets this
+/// message found a check the readers miss: the fuzz harness (`fuzz/src/lib.rs`) counts it as a
+/// crash, as libFuzzer does the panic itself.
+pub const PANIC_CAUGHT: &str = "the reader stopped on an internal check";
+
 /// Runs a model reader, turning a panic inside a third-party parser into an error message. The
 /// readers check what they can before handing bytes to a parser; this is only the last net that
 /// keeps a malformed file the parser trips over from taking the whole program down.
@@ -239,9 +244,28 @@ fn without_panics<T>(read: impl FnOnce() -> Result<T, String>) -> Result<T, Stri
                 .map(|s| s.to_string())
                 .or_else(|| payload.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "no details".into());
-            Err(format!("malformed file (the reader stopped on an internal check: {what})"))
+            Err(format!("malformed file ({PANIC_CAUGHT}: {what})"))
         }
     }
+}
+
+/// Reads a whole file that a scene or model names (a model, a glTF buffer or image, an MTL
+/// library). Only regular files are read: a device or a pipe (`/dev/zero`, a FIFO) has no end a
+/// reader could wait for, so a file naming one would never load, or fill memory while trying.
+fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
+    check_regular_file(path)?;
+    std::fs::read(path)
+}
+
+/// An error unless `path` is a regular file (or a link to one); see [`read_file`].
+pub(crate) fn check_regular_file(path: &Path) -> std::io::Result<()> {
+    if std::fs::metadata(path)?.is_file() {
+        return Ok(());
+    }
+    Err(std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        "not a regular file (a folder, a device or a pipe); Mirador reads files",
+    ))
 }
 
 /// Where the built-in scenes live: `assets/scenes/` of the source tree this binary was built from.

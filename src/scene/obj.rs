@@ -73,7 +73,10 @@
 //!
 //! Bad input gives [`SceneError::Obj`] naming the file and the problem, with the line where there
 //! is one ([`SceneError::Io`] when the OBJ file itself cannot be read); it never panics. A number
-//! that is not finite in a `v`, `vn` or `vt` statement is refused before parsing, with its line.
+//! that is not finite in a `v`, `vn` or `vt` statement is refused before parsing, with its line, and
+//! so is a face index that no statement backs (0, a relative index before the first statement, or
+//! one past the last): `tobj` computes offsets from the indices unchecked, and an index near 2⁶³
+//! overflowed inside it (found by fuzzing, `fuzz/`).
 //! An `mtllib` that cannot be read, a malformed MTL statement, and a texture that cannot be read or
 //! decoded are errors, as a missing buffer or image is for glTF: a model whose files are missing
 //! is broken, and saying so names the file to fix. A face referring to a vertex the file does not
@@ -95,16 +98,22 @@ pub const DEFAULT_MATERIAL: &str = "obj-default";
 
 /// Loads an `.obj` file and the MTL libraries it names; see the module documentation.
 pub fn import(path: &Path) -> Result<ModelImport, SceneError> {
-    let error = |message: String| SceneError::Obj { path: path.to_path_buf(), message };
     if path.as_os_str().is_empty() {
-        return Err(error("no file given (the path is empty)".into()));
+        return Err(SceneError::Obj { path: path.to_path_buf(), message: "no file given (the path is empty)".into() });
     }
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    let bytes = super::read_file(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    import_bytes(path, &bytes)
+}
+
+/// Reads an OBJ file already in memory; `path` names it in messages, and the MTL libraries it
+/// names are read relative to its folder.
+pub fn import_bytes(path: &Path, bytes: &[u8]) -> Result<ModelImport, SceneError> {
+    let error = |message: String| SceneError::Obj { path: path.to_path_buf(), message };
     if bytes.is_empty() {
         return Err(error("the file is empty".into()));
     }
     // OBJ is ASCII; old exporters write names and comments in Latin-1, which must not stop it.
-    let text = String::from_utf8_lossy(&bytes);
+    let text = String::from_utf8_lossy(bytes);
     super::without_panics(|| import_text(path, &text)).map_err(error)
 }
 
@@ -169,6 +178,10 @@ struct Scan {
 
 fn scan(text: &str) -> Result<Scan, String> {
     let mut scan = Scan { usemtl: Vec::new(), skipped: 0 };
+    // Statements of each kind `v`, `vt`, `vn` so far, and the largest index a face gives for
+    // each, with its line.
+    let mut counts = [0usize; 3];
+    let mut largest: [Option<(usize, usize)>; 3] = [None; 3];
     for (index, line) in text.lines().enumerate() {
         let number = index + 1;
         let mut words = line.split_whitespace();
@@ -180,18 +193,79 @@ fn scan(text: &str) -> Result<Scan, String> {
                          ±3.4e38, which overflows 32-bit floats)"
                     ));
                 }
+                counts[match keyword {
+                    "v" => 0,
+                    "vt" => 1,
+                    _ => 2,
+                }] += 1;
             }
-            Some("f") => match words.count() {
-                0 => return Err(format!("line {number}: a face (`f`) with no vertices")),
-                1 | 2 => scan.skipped += 1,
-                _ => {}
-            },
-            Some("p" | "l") => scan.skipped += 1,
+            Some(keyword @ ("f" | "l")) => {
+                let vertices: Vec<&str> = words.collect();
+                for vertex in &vertices {
+                    check_face_vertex(vertex, number, &counts, &mut largest)
+                        .map_err(|e| format!("line {number}: {e}"))?;
+                }
+                match (keyword, vertices.len()) {
+                    ("f", 0) => return Err(format!("line {number}: a face (`f`) with no vertices")),
+                    ("f", 1 | 2) | ("l", _) => scan.skipped += 1,
+                    _ => {}
+                }
+            }
+            Some("p") => scan.skipped += 1,
             Some("usemtl") => scan.usemtl.push((number, words.collect::<Vec<_>>().join(" "))),
             _ => {}
         }
     }
+    for ((largest, count), (keyword, what)) in largest.iter().zip(counts).zip(INDEXED) {
+        if let Some((index, line)) = *largest
+            && index > count
+        {
+            return Err(format!(
+                "line {line}: a face refers to {what} {index}, past the last `{keyword}` (the file has {count})"
+            ));
+        }
+    }
     Ok(scan)
+}
+
+/// The statements a face vertex `v/vt/vn` indexes, in that order, and what they give.
+const INDEXED: [(&str, &str); 3] = [("v", "vertex position"), ("vt", "texture coordinates"), ("vn", "normal")];
+
+/// Checks one face vertex's indices before `tobj` sees them: `tobj` turns an index into an offset
+/// (`2·vt + 1`) unchecked, which overflows for an index near 2⁶³ (a panic in a debug build, a
+/// wrapped offset in a release one), and reads an index of 0 as "none". An index counts from 1,
+/// a negative one back from the last statement so far; `counts` are the statements so far, and
+/// `largest` keeps the largest positive index of each kind (checked against the whole file's
+/// count at its end, since a face may refer to vertices given after it). Words `tobj` cannot
+/// parse are left for its error.
+fn check_face_vertex(
+    vertex: &str,
+    line: usize,
+    counts: &[usize; 3],
+    largest: &mut [Option<(usize, usize)>; 3],
+) -> Result<(), String> {
+    for (kind, word) in vertex.split('/').enumerate().take(3) {
+        let Ok(index) = word.parse::<i64>() else { continue };
+        let (keyword, what) = INDEXED[kind];
+        if index == 0 {
+            return Err(format!("face vertex `{vertex}` gives its {what} an index of 0 (OBJ indices count from 1)"));
+        }
+        if index < 0 {
+            if index.unsigned_abs() > counts[kind] as u64 {
+                return Err(format!(
+                    "face vertex `{vertex}` gives its {what} the relative index {index}, before the first `{keyword}` \
+                     (only {} come before it)",
+                    counts[kind]
+                ));
+            }
+            continue;
+        }
+        let index = usize::try_from(index).unwrap_or(usize::MAX);
+        if largest[kind].is_none_or(|(known, _)| index > known) {
+            largest[kind] = Some((index, line));
+        }
+    }
+    Ok(())
 }
 
 /// `tobj`'s error, with the line it stopped at when the error belongs to one line. `consumed` is
@@ -263,7 +337,7 @@ fn read_library(dir: &Path, name: &Path, libraries: &RefCell<Vec<Library>>) -> t
 }
 
 fn read_mtl(file: &Path) -> Result<(Vec<tobj::Material>, HashMap<String, usize>), String> {
-    let bytes = std::fs::read(file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
+    let bytes = super::read_file(file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
     let text = expand_grey_colours(&String::from_utf8_lossy(&bytes))?;
     let mut cursor = Cursor::new(text.as_bytes());
     tobj::load_mtl_buf(&mut cursor).map_err(|e| {
@@ -706,8 +780,26 @@ mod tests {
         assert!(scan("v 1e39 0 0").is_err(), "beyond f32");
         let found = scan("v 0 0 0\nl 1 2\nf 1 2\np 1\nusemtl glass\nf\n");
         assert!(found.err().expect("an empty face").contains("line 6"));
-        let found = scan("l 1 2\nf 1 2\np 1\nusemtl glass\n").unwrap();
+        let found = scan("v 0 0 0\nv 1 0 0\nl 1 2\nf 1 2\np 1\nusemtl glass\n").unwrap();
         assert_eq!(found.skipped, 3);
-        assert_eq!(found.usemtl, [(4, "glass".to_string())]);
+        assert_eq!(found.usemtl, [(6, "glass".to_string())]);
+    }
+
+    #[test]
+    fn the_scan_refuses_face_indices_tobj_would_overflow_on_or_read_as_none() {
+        let triangle = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n";
+        assert!(scan(&format!("{triangle}f 1/1/1 2/1/1 3/1/-1\n")).is_ok());
+        // A face may name a vertex given after it.
+        assert!(scan(&format!("f 1 2 4\n{triangle}v 1 1 0\n")).is_ok());
+        let error = scan(&format!("{triangle}f 1/9223372036854775807 2/1 3/1\n")).err().expect("a huge vt index");
+        assert!(error.contains("line 6") && error.contains("texture coordinates 9223372036854775807"), "{error}");
+        let error = scan(&format!("{triangle}f 1//3 2//1 3//1\n")).err().expect("past the last vn");
+        assert!(error.contains("normal 3, past the last `vn` (the file has 1)"), "{error}");
+        let error = scan(&format!("{triangle}f 1/0 2/1 3/1\n")).err().expect("a vt index of 0");
+        assert!(error.contains("line 6") && error.contains("an index of 0"), "{error}");
+        let error = scan(&format!("{triangle}f 1 2 -4\n")).err().expect("before the first v");
+        assert!(error.contains("relative index -4") && error.contains("only 3"), "{error}");
+        let error = scan(&format!("{triangle}f 1/-9223372036854775808 2/1 3/1\n")).err().expect("the least i64");
+        assert!(error.contains("relative index"), "{error}");
     }
 }

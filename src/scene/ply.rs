@@ -4,10 +4,14 @@
 //! [`ModelImport`] as a glTF file, with one object and no lights or cameras; the scene loader
 //! places it.
 //!
-//! Parsing is the `ply-rs-bw` crate's, the maintained continuation of `ply-rs`. It reads a header
-//! that lies without trusting it: it never reserves more than 65 536 elements up front, so a header
-//! declaring a billion vertices costs nothing until they are actually read, and a file that ends
-//! before its declared counts is an error, not a panic.
+//! Parsing is the `ply-rs-bw` crate's, the maintained continuation of `ply-rs`. A header may lie,
+//! so before any element is read its counts are checked against the bytes that follow it: every
+//! element takes at least its scalars and one count per list in binary, at least a character per
+//! property in ASCII, and a file too short for its counts is refused by the header alone. The
+//! parser never reserves more than 65 536 elements up front either, so memory grows with what is
+//! actually read. A binary element without properties takes no bytes and is not read at all: the
+//! parser's loop over its count would read nothing, as long as the count says (a count of 10¹⁵
+//! kept `mirador render` busy for good before this check; found by fuzzing, `fuzz/`).
 //!
 //! # What is read
 //!
@@ -29,17 +33,19 @@
 //!
 //! Bad input gives [`SceneError::Ply`] naming the file and the problem ([`SceneError::Io`] when the
 //! file cannot be read); it never panics: an empty file, a header the parser rejects, a file that
-//! ends before the counts its header declares, a file without `vertex` or `face` elements (a point
-//! cloud, which Mirador cannot draw), `x`, `y` or `z` missing, face indices that are not integers,
-//! a coordinate that is not finite (with its vertex number), and a face index below 0 or past the
-//! last vertex (with its face number).
+//! ends before the counts its header declares or is too short to hold them, a file without `vertex`
+//! or `face` elements (a point cloud, which Mirador cannot draw), `x`, `y` or `z` missing, face
+//! indices that are not integers, a coordinate that is not finite (with its vertex number), and a
+//! face index below 0 or past the last vertex (with its face number).
 
 use std::io::Cursor;
 use std::path::Path;
 
 use glam::{Mat4, Vec2, Vec3};
 use ply_rs_bw::parser::{Parser, Reader};
-use ply_rs_bw::ply::{ElementDef, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType};
+use ply_rs_bw::ply::{
+    ElementDef, Encoding, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType,
+};
 
 use super::gltf::GltfObject;
 use super::{Material, Mesh, ModelImport, SceneError};
@@ -55,15 +61,20 @@ const INDEX_NAMES: [&str; 2] = ["vertex_indices", "vertex_index"];
 
 /// Loads a `.ply` file; see the module documentation.
 pub fn import(path: &Path) -> Result<ModelImport, SceneError> {
-    let error = |message: String| SceneError::Ply { path: path.to_path_buf(), message };
     if path.as_os_str().is_empty() {
-        return Err(error("no file given (the path is empty)".into()));
+        return Err(SceneError::Ply { path: path.to_path_buf(), message: "no file given (the path is empty)".into() });
     }
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    let bytes = super::read_file(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    import_bytes(path, &bytes)
+}
+
+/// Reads a PLY file already in memory; `path` names it in messages and names its mesh.
+pub fn import_bytes(path: &Path, bytes: &[u8]) -> Result<ModelImport, SceneError> {
+    let error = |message: String| SceneError::Ply { path: path.to_path_buf(), message };
     if bytes.is_empty() {
         return Err(error("the file is empty".into()));
     }
-    super::without_panics(|| import_bytes(path, &bytes)).map_err(error)
+    super::without_panics(|| read(path, bytes)).map_err(error)
 }
 
 /// One vertex as the file gives it; what the file lacks stays zero.
@@ -135,10 +146,12 @@ impl PropertyAccess for Skipped {
     }
 }
 
-fn import_bytes(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
+fn read(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
     let mut reader = Reader::new(Cursor::new(bytes));
     let header = Parser::<Skipped>::new().read_header(&mut reader).map_err(|e| format!("header: {e}"))?;
     let layout = Layout::of(&header)?;
+    let payload = bytes.len() as u64 - reader.get_ref().position();
+    check_counts(&header, payload)?;
     let mut out = ModelImport::default();
     let mut warn = |message: String| {
         let message = format!("{}: PLY: {message}", path.display());
@@ -155,6 +168,10 @@ fn import_bytes(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
     let (mut vertices, mut faces) = (Vec::new(), Vec::new());
     for (name, element) in &header.elements {
         let failed = |e: ply_rs_bw::parser::ParseError| describe_payload_error(element, e);
+        if element.properties.is_empty() && header.encoding != Encoding::Ascii {
+            // Nothing to read, however many there are; the parser would loop over the count.
+            continue;
+        }
         match name.as_str() {
             "vertex" => vertices = read_element::<Vertex>(&mut reader, element, &header).map_err(failed)?,
             "face" => faces = read_element::<Face>(&mut reader, element, &header).map_err(failed)?,
@@ -240,6 +257,51 @@ fn read_element<E: PropertyAccess>(
     header: &Header,
 ) -> Result<Vec<E>, ply_rs_bw::parser::ParseError> {
     Parser::<E>::new().read_payload_for_element(reader, element, header)
+}
+
+/// The fewest bytes one element can take in the file: in binary, its scalars plus each list's
+/// count (a list may be empty); in ASCII, one character per property, or one line break for an
+/// element without properties. Binary elements without properties take none.
+fn smallest_element(element: &ElementDef, encoding: Encoding) -> u64 {
+    if encoding == Encoding::Ascii {
+        return (element.properties.len() as u64).max(1);
+    }
+    element
+        .properties
+        .values()
+        .map(|p| match &p.data_type {
+            PropertyType::Scalar(scalar) | PropertyType::List(scalar, _) => scalar_size(scalar),
+        })
+        .sum()
+}
+
+fn scalar_size(scalar: &ScalarType) -> u64 {
+    match scalar {
+        ScalarType::Char | ScalarType::UChar => 1,
+        ScalarType::Short | ScalarType::UShort => 2,
+        ScalarType::Int | ScalarType::UInt | ScalarType::Float => 4,
+        ScalarType::Double => 8,
+    }
+}
+
+/// Refuses a header whose counts the file cannot hold, before any element is read: each
+/// declared element needs at least [`smallest_element`] bytes of the `payload` bytes that follow
+/// the header. This bounds both the reading loops and what they allocate by the file's size.
+fn check_counts(header: &Header, payload: u64) -> Result<(), String> {
+    let mut needed: u64 = 0;
+    for element in header.elements.values() {
+        let smallest = smallest_element(element, header.encoding);
+        let total = (element.count as u64).saturating_mul(smallest);
+        needed = needed.saturating_add(total);
+        if needed > payload {
+            return Err(format!(
+                "the header declares {} `{}` element(s) of at least {smallest} byte(s) each, and the {payload} bytes \
+                 after the header cannot hold them (truncated, or the header lies)",
+                element.count, element.name
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn describe_payload_error(element: &ElementDef, error: ply_rs_bw::parser::ParseError) -> String {

@@ -33,6 +33,7 @@ use crate::scene::camera::Camera;
 /// Decodes an image file.
 pub fn load(path: &Path, color_space: ColorSpace) -> Result<Texture, SceneError> {
     let error = |message: String| SceneError::Texture { path: path.to_path_buf(), message };
+    super::check_regular_file(path).map_err(|e| error(format!("cannot open: {e}")))?;
     let reader = ImageReader::open(path)
         .map_err(|e| error(format!("cannot open: {e}")))?
         .with_guessed_format()

@@ -85,8 +85,7 @@ impl Grid {
 
     /// The values mapped by `(v − lo)/(hi − lo)` and clamped to `[0, 1]` (all 0 when `hi == lo`).
     pub fn normalized(&self, (lo, hi): (f32, f32)) -> Grid {
-        let scale = if hi > lo { 1.0 / (hi - lo) } else { 0.0 };
-        let values = self.values.iter().map(|v| ((v - lo) * scale).clamp(0.0, 1.0)).collect();
+        let values = self.values.iter().map(|&v| normalize(v, (lo, hi))).collect();
         Grid { values, ..self.clone() }
     }
 
@@ -163,6 +162,23 @@ fn check_dims(dims: UVec3) -> Result<(), String> {
     Ok(())
 }
 
+/// `(v − lo)/(hi − lo)` clamped to `[0, 1]`, 0 when `hi ≤ lo`: a data value as the transfer
+/// function reads it. In `f32`, except for a range whose width overflows `f32` (data near
+/// ±3.4e38): there `hi − lo` is infinite and `f32` would give ∞/∞ = NaN at `hi`, so the
+/// quotient is taken in `f64`, where the width of any two `f32` values is finite.
+pub fn normalize(v: f32, (lo, hi): (f32, f32)) -> f32 {
+    if !(hi > lo) {
+        return 0.0;
+    }
+    let width = hi - lo;
+    let t = if width.is_finite() {
+        (v - lo) / width
+    } else {
+        ((f64::from(v) - f64::from(lo)) / (f64::from(hi) - f64::from(lo))) as f32
+    };
+    t.clamp(0.0, 1.0)
+}
+
 /// The number of points of a grid of `dims`.
 pub fn voxel_count(dims: UVec3) -> u64 {
     u64::from(dims.x) * u64::from(dims.y) * u64::from(dims.z)
@@ -176,6 +192,29 @@ fn unflatten(dims: UVec3, index: usize) -> (usize, usize, usize) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn normalizing_stays_finite_over_ranges_wider_than_f32_holds() {
+        assert_eq!(normalize(2.5, (0.0, 10.0)), 0.25);
+        assert_eq!(normalize(-4.0, (0.0, 10.0)), 0.0, "clamped below");
+        assert_eq!(normalize(3.0, (1.0, 1.0)), 0.0, "an empty range");
+        // hi − lo overflows f32: in f32, ∞/∞ at hi would be NaN.
+        let (lo, hi) = (-3.0e38, 3.0e38);
+        assert_eq!(normalize(hi, (lo, hi)), 1.0);
+        assert_eq!(normalize(0.0, (lo, hi)), 0.5);
+        let grid = Grid::new(UVec3::splat(2), Vec3::ONE, vec![lo, hi, 0.0, 1.0, lo, hi, hi, lo]).unwrap();
+        let normalized = grid.normalized(grid.range());
+        assert!(normalized.values.iter().all(|v| (0.0..=1.0).contains(v)), "{:?}", normalized.values);
+        // A range one subnormal wide: its reciprocal overflows, the quotient does not.
+        let tiny = f32::from_bits(1);
+        assert_eq!(
+            Grid::new(UVec3::splat(2), Vec3::ONE, vec![0.0, tiny, 0.0, 0.0, 0.0, 0.0, 0.0, tiny])
+                .unwrap()
+                .normalized((0.0, tiny))
+                .values[..2],
+            [0.0, 1.0]
+        );
+    }
 
     fn linear_grid() -> Grid {
         // f = 2x − y + 0.5z + 1 at the points of a 5 × 4 × 3 grid with uneven spacing.

@@ -262,7 +262,7 @@ impl FromStr for Endian {
 
 /// Reads a NRRD file (attached, or a detached header and its data file) into a grid.
 pub fn read_nrrd(path: &Path) -> Result<Grid, String> {
-    let file = File::open(path).map_err(|e| format!("cannot open the file: {e}"))?;
+    let file = open_regular(path).map_err(|e| format!("cannot open the file: {e}"))?;
     let mut reader = BufReader::new(file);
     let mut warnings = Vec::new();
     let header = read_header(&mut reader, &mut warnings)?;
@@ -271,7 +271,7 @@ pub fn read_nrrd(path: &Path) -> Result<Grid, String> {
         Some(name) => {
             let data_path = path.parent().unwrap_or(Path::new("")).join(name);
             let in_data_file = |e: String| format!("data file {}: {e}", data_path.display());
-            File::open(&data_path)
+            open_regular(&data_path)
                 .map_err(|e| in_data_file(format!("cannot open it: {e}")))
                 .and_then(|file| read_samples(BufReader::new(file), &header, &mut warnings).map_err(in_data_file))
         }
@@ -280,6 +280,13 @@ pub fn read_nrrd(path: &Path) -> Result<Grid, String> {
         log::warn!("{}: {warning}", path.display());
     }
     Grid::new(header.dims, header.spacing, samples?)
+}
+
+/// Opens a volume file, which must be a regular file: a pipe or a device has no size to check the
+/// header's against, and might never end.
+fn open_regular(path: &Path) -> io::Result<File> {
+    crate::scene::check_regular_file(path)?;
+    File::open(path)
 }
 
 /// What the header says about the samples.
@@ -948,7 +955,7 @@ pub fn read_raw(path: &Path, desc: &RawDesc) -> Result<Grid, String> {
     let dims = checked_dims(desc.dims.to_array().map(u64::from))?;
     let count = voxel_count(dims);
     let needed = count * desc.scalar.size() as u64;
-    let file = File::open(path).map_err(|e| format!("cannot open the file: {e}"))?;
+    let file = open_regular(path).map_err(|e| format!("cannot open the file: {e}"))?;
     let held = file.metadata().map_err(|e| format!("cannot read the file: {e}"))?.len();
     let total = desc.header_bytes.saturating_add(needed);
     if held != total {

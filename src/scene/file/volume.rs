@@ -10,6 +10,7 @@ use toml::Spanned;
 
 use super::{Builder, Finite, Scale, V3, transform};
 use crate::scene::SceneError;
+use crate::volume::grid::{MAX_VOXELS, voxel_count};
 use crate::volume::nrrd::{Endian, RawDesc, ScalarType, read_nrrd, read_raw};
 use crate::volume::{ControlPoint, Grid, Preset, Rendering, TransferFunction, Volume, fields};
 
@@ -106,7 +107,7 @@ impl Builder<'_> {
             Some([Finite(lo), Finite(hi)]) => return Err(fail(format!("range needs low < high, got [{lo}, {hi}]"))),
             None => grid.range(),
         };
-        let normalize = |v: f32| if hi > lo { (v - lo) / (hi - lo) } else { 0.0 };
+        let normalize = |v: f32| crate::volume::grid::normalize(v, (lo, hi));
         let transfer = match (d.preset, d.transfer) {
             (Some(_), Some(_)) => return Err(fail("give a volume either a `preset` or a `transfer`, not both".into())),
             (Some(preset), None) => Preset::by_name(preset.get_ref())
@@ -147,10 +148,22 @@ impl Builder<'_> {
 
     /// The grid in data units, and the iso value its kind suggests (0 for distance fields).
     fn volume_grid(&self, d: &VolumeDesc, span: Range<usize>) -> Result<(Grid, Option<f32>), SceneError> {
+        // The scene's volumes together stay within one grid's limit, checked before a grid whose
+        // size the scene alone sets is made: a few lines asking for many 1024³ fields must not
+        // take 4 GiB each.
+        let held: u64 = self.scene.volumes.iter().map(|v| v.grid.values.len() as u64).sum();
+        let room = MAX_VOXELS.saturating_sub(held);
+        let too_many = |voxels: u64| {
+            format!(
+                "the scene's volumes would hold {} points in all, more than the {MAX_VOXELS} Mirador reads \
+                 ({held} before this one)",
+                held + voxels
+            )
+        };
         if let Some(field) = &d.field {
             let span = field.span();
             let fail = |message: String| self.error(message, span.clone());
-            return procedural(field.get_ref()).map_err(fail);
+            return procedural(field.get_ref(), room, too_many).map_err(fail);
         }
         if let Some(raw) = &d.raw {
             let span = raw.span();
@@ -168,13 +181,20 @@ impl Builder<'_> {
                 endian: r.endian.as_deref().unwrap_or("little").parse::<Endian>().map_err(&fail)?,
                 header_bytes: r.header_bytes.unwrap_or(0),
             };
+            if voxel_count(dims) <= MAX_VOXELS && voxel_count(dims) > room {
+                return Err(fail(too_many(voxel_count(dims))));
+            }
             let file = self.dir.join(&r.path);
             let grid = read_raw(&file, &desc).map_err(|e| fail(format!("{}: {e}", file.display())))?;
             return Ok((grid, None));
         }
         let relative = d.path.as_ref().expect("one source is present");
         let file = self.dir.join(relative);
-        let grid = read_nrrd(&file).map_err(|e| self.error(format!("{}: NRRD: {e}", file.display()), span))?;
+        let grid = read_nrrd(&file).map_err(|e| self.error(format!("{}: NRRD: {e}", file.display()), span.clone()))?;
+        // A NRRD file's size bounds what reading it took; the sum is checked after.
+        if grid.values.len() as u64 > room {
+            return Err(self.error(too_many(grid.values.len() as u64), span));
+        }
         Ok((grid, None))
     }
 
@@ -208,8 +228,9 @@ impl Builder<'_> {
 }
 
 /// A procedural field sampled onto its grid over `[−1, 1]³`. Distance fields are negated
-/// (positive inside), so that in every field the values rise inwards.
-fn procedural(d: &FieldDesc) -> Result<(Grid, Option<f32>), String> {
+/// (positive inside), so that in every field the values rise inwards. `too_many` is the message
+/// for a grid of more points than the scene has `room` for, which is refused before sampling.
+fn procedural(d: &FieldDesc, room: u64, too_many: impl Fn(u64) -> String) -> Result<(Grid, Option<f32>), String> {
     let default = match d.kind {
         // 41 points: Marschner and Lobb's 40 intervals over [−1, 1].
         FieldType::MarschnerLobb => 41,
@@ -220,6 +241,11 @@ fn procedural(d: &FieldDesc) -> Result<(Grid, Option<f32>), String> {
         Some(Resolution::Cube(n)) => UVec3::splat(checked_dim(n)?),
         Some(Resolution::Axes([x, y, z])) => UVec3::new(checked_dim(x)?, checked_dim(y)?, checked_dim(z)?),
     };
+    // A grid over the limit on its own is refused by `Grid::from_function`, with the limits.
+    let points = voxel_count(dims);
+    if points <= MAX_VOXELS && points > room {
+        return Err(too_many(points));
+    }
     let applies = |field: &str, present: bool, allowed: &[FieldType]| {
         if present && !allowed.contains(&d.kind) {
             Err(format!("`{field}` does not apply to this field"))
@@ -259,4 +285,23 @@ fn procedural(d: &FieldDesc) -> Result<(Grid, Option<f32>), String> {
 
 fn checked_dim(n: i64) -> Result<u32, String> {
     u32::try_from(n).ok().filter(|&n| n >= 2).ok_or_else(|| format!("resolution must be at least 2, got {n}"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_field_larger_than_the_scene_has_room_for_is_refused_before_sampling() {
+        let field = FieldDesc {
+            kind: FieldType::Sphere,
+            resolution: Some(Resolution::Cube(16)),
+            radius: None,
+            major_radius: None,
+            minor_radius: None,
+        };
+        let message = procedural(&field, 4095, |points| format!("{points} points")).expect_err("4096 > 4095");
+        assert_eq!(message, "4096 points");
+        assert!(procedural(&field, 4096, |_| unreachable!()).is_ok());
+    }
 }
