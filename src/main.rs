@@ -133,8 +133,9 @@ struct ViewArgs {
     screenshot: Option<PathBuf>,
     /// A scripted step, one per frame, in order: `set KEY=VALUE`, `view raster|traced|split|difference`,
     /// `split X`, `orbit DX DY`, `pan DX DY`, `zoom N`, `frame`, `reset`, `navigate orbit|fly`,
-    /// `walk X Y Z`, `pick X Y`, `cursor X Y`, `probe`, `material KEY=VALUE`, `load FILE`, `scale S`, `help on|off`,
-    /// `panel on|off`, `overlay on|off`, `wait N`, `wait traced`, `screenshot FILE.png`.
+    /// `walk X Y Z`, `pick X Y`, `cursor X Y`, `probe`, `material KEY=VALUE`, `load FILE`, `scale S`,
+    /// `fps N|off`, `help on|off`, `panel on|off`, `overlay on|off`, `wait N`, `wait traced`, `measure`,
+    /// `screenshot FILE.png`.
     #[arg(long = "step", value_name = "STEP", requires = "frames")]
     steps: Vec<String>,
     /// A file of steps, one a line (`#` comments); run before any --step.

@@ -28,6 +28,8 @@ pub const SHADOW: &str = include_str!("../shaders/shadow.wgsl");
 pub const SHADOW_PROJECTED: &str = include_str!("../shaders/shadow_projected.wgsl");
 pub const OVERLAYS: &str = include_str!("../shaders/overlays.wgsl");
 pub const ENVIRONMENT: &str = include_str!("../shaders/environment.wgsl");
+/// The viewer's: its 3D view's image stretched over the view while the camera moves.
+pub const UPSCALE: &str = include_str!("../shaders/upscale.wgsl");
 
 /// Every pass's own file, by name, for tests that validate them all.
 pub const PASSES: &[(&str, &str)] = &[
@@ -38,6 +40,7 @@ pub const PASSES: &[(&str, &str)] = &[
     ("shadow_projected", SHADOW_PROJECTED),
     ("overlays", OVERLAYS),
     ("environment", ENVIRONMENT),
+    ("upscale", UPSCALE),
 ];
 
 /// The full source of a pass: the common files, then the pass's own.

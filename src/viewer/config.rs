@@ -1,6 +1,11 @@
-//! What the viewer remembers between runs: the window's size, the view mode and divider, and the
-//! render settings the user changed. Kept as TOML in the user's configuration directory
-//! (`$XDG_CONFIG_HOME/mirador/viewer.toml`, else `~/.config/mirador/viewer.toml`).
+//! What the viewer remembers between runs: the window's size, the view mode and divider, the
+//! frame budget while moving, and the render settings the user changed. Kept as TOML in the
+//! user's configuration directory (`$XDG_CONFIG_HOME/mirador/viewer.toml`, else
+//! `~/.config/mirador/viewer.toml`).
+//!
+//! The frame budget (a target frame rate and the lowest render scale) is the viewer's alone:
+//! `render` and `trace` never move a camera, so it is kept here and in the panel's view section,
+//! not in `RenderSettings`, whose every key the headless commands and the scene files share.
 //!
 //! Settings are remembered as the leaves that differ from the scene's own defaults and are put
 //! back one by one through `RenderSettings::set` (the mechanism behind `--set`), so a setting
@@ -14,6 +19,18 @@ use serde::{Deserialize, Serialize};
 use super::view_mode::ViewMode;
 use crate::RenderSettings;
 
+/// The frame rate held while the camera moves, by default. A software GPU (lavapipe on two
+/// cores) draws the showcase's flat-colour floor at about 26 frames a second at 1280×720; 30
+/// keeps orbiting at or under the cost of that floor (docs/performance.md); a GPU holds it at
+/// full scale.
+pub const DEFAULT_MOTION_FPS: f32 = 30.0;
+/// The frame rates the panel offers (0, outside it, turns the target off).
+pub const MOTION_FPS: std::ops::RangeInclusive<f32> = 5.0..=120.0;
+/// The lowest render scale while moving, by default: a quarter of the pixels in each direction.
+pub const DEFAULT_MOTION_SCALE: f32 = 0.25;
+/// The lowest render scales the panel offers.
+pub const MOTION_SCALES: std::ops::RangeInclusive<f32> = 0.1..=1.0;
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct ViewerConfig {
@@ -22,7 +39,10 @@ pub struct ViewerConfig {
     pub mode: ViewMode,
     /// Where the split view's divider sits, as a fraction of the view's width.
     pub split: f32,
-    /// The render scale while the camera moves (1 = always full resolution).
+    /// The frame rate the render scale holds while the camera moves (0: no target, the scale
+    /// is `motion_scale`).
+    pub motion_fps: f32,
+    /// The lowest render scale while the camera moves (1 = always full resolution).
     pub motion_scale: f32,
     /// Render settings that differ from the scene's defaults, as dotted keys.
     pub settings: toml::Table,
@@ -34,7 +54,8 @@ impl Default for ViewerConfig {
             window: [1280, 720],
             mode: ViewMode::Raster,
             split: 0.5,
-            motion_scale: 0.5,
+            motion_fps: DEFAULT_MOTION_FPS,
+            motion_scale: DEFAULT_MOTION_SCALE,
             settings: toml::Table::new(),
         }
     }
@@ -89,8 +110,11 @@ impl ViewerConfig {
         if !(self.split.is_finite() && (0.0..=1.0).contains(&self.split)) {
             self.split = 0.5;
         }
-        if !(self.motion_scale.is_finite() && (0.1..=1.0).contains(&self.motion_scale)) {
-            self.motion_scale = 0.5;
+        if !(self.motion_scale.is_finite() && MOTION_SCALES.contains(&self.motion_scale)) {
+            self.motion_scale = DEFAULT_MOTION_SCALE;
+        }
+        if !(self.motion_fps == 0.0 || MOTION_FPS.contains(&self.motion_fps)) {
+            self.motion_fps = DEFAULT_MOTION_FPS;
         }
     }
 }

@@ -1,6 +1,13 @@
 //! One frame of the viewer, top to bottom: scripted step → file watch → traced images in →
-//! UI (egui) → camera and settings changes → raster image at the view's size × render scale →
-//! traced request → paint the window (and a screenshot when asked).
+//! UI (egui) → camera and settings changes → raster image at the view's size (drawn at the
+//! render scale, unless nothing it depends on changed) → traced request → compose and present
+//! the window (and a screenshot when asked) → when the next frame is due.
+//!
+//! Frames are drawn only when something asks for one: input (egui says), a scripted step, a
+//! traced image arriving, the camera moving or settling, an egui animation. Otherwise the event
+//! loop sleeps (`super` polls the scene file without drawing). While the camera moves the image
+//! is drawn at the render scale the frame budget picks ([`FrameBudget`]); the frame after it
+//! stops ([`SETTLE`]) is drawn at full scale.
 
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
@@ -9,14 +16,15 @@ use std::time::{Duration, Instant};
 use anyhow::{Context as _, bail};
 use glam::Vec2;
 
+use super::budget::FrameBudget;
 use super::camera_control::{self, CameraInput, Navigation};
 use super::config::ViewerConfig;
 use super::hud::{FrameStats, FrameTimes};
 use super::inspect::Inspection;
-use super::raster_view::RasterView;
+use super::raster_view::{Drawn, RasterView};
 use super::scene_panel;
 use super::scene_state::SceneState;
-use super::screen::{Presented, Screen};
+use super::screen::{Composition, Presented, Screen, ViewImage};
 use super::script::Step;
 use super::traced::TracedView;
 use super::ui::{self, Action, UiModel, UiOutput};
@@ -26,6 +34,8 @@ use crate::scene::{Camera, Light};
 
 /// How long the camera counts as moving after its last change: the render scale stays low.
 const SETTLE: Duration = Duration::from_millis(250);
+/// How soon a frame the surface was not ready for is tried again.
+const RETRY: Duration = Duration::from_millis(50);
 /// The longest a `wait traced` step waits.
 const TRACE_TIMEOUT: Duration = Duration::from_secs(600);
 
@@ -37,13 +47,17 @@ pub struct Viewer {
     pub view: ViewState,
     raster: RasterView,
     traced: TracedView,
+    budget: FrameBudget,
     pub stats: FrameStats,
     script: Script,
     camera_error: Option<String>,
     pub notices: Vec<String>,
     /// When the camera last moved plus [`SETTLE`].
     moving_until: Option<Instant>,
-    last_frame: Option<Instant>,
+    /// When the last frame started, and whether it asked for the next one at once.
+    last_frame: Option<(Instant, bool)>,
+    /// A scripted run: every frame follows the last at once.
+    pub scripted: bool,
     /// What the current traced request was made from, and its key.
     request: Option<(Camera, RenderSettings, u64, Vec<Light>)>,
     key: u64,
@@ -63,11 +77,15 @@ struct Script {
     steps: VecDeque<Step>,
     wait_frames: u32,
     wait_traced_since: Option<Instant>,
+    /// A `measure` step ran: the stats start where it said, not after the last step.
+    measured: bool,
+    /// Start the stats again after this frame.
+    reset_stats: bool,
 }
 
 /// What a frame tells the event loop.
 pub struct FrameEnd {
-    /// When the window should be drawn again at the latest (`None`: only on input).
+    /// When the window should be drawn again (`None`: only when something happens).
     pub next: Option<Instant>,
 }
 
@@ -82,7 +100,7 @@ impl Viewer {
         let (settings, warnings) = super::config::apply_settings(&scene.settings, &config.settings);
         let mut scene = SceneState::new(scene);
         scene.scene.settings = settings.clone();
-        let raster = RasterView::new(&screen.gpu, &mut screen.painter, &scene.scene, scene.revision);
+        let raster = RasterView::new(screen, &scene.scene, scene.revision);
         Viewer {
             scene,
             settings,
@@ -90,17 +108,20 @@ impl Viewer {
             view: ViewState {
                 mode: config.mode,
                 split: config.split,
+                motion_fps: config.motion_fps,
                 motion_scale: config.motion_scale,
                 ..Default::default()
             },
             raster,
             traced: TracedView::new(wake),
+            budget: FrameBudget::default(),
             stats: FrameStats::default(),
             script: Script { steps: steps.into(), ..Default::default() },
             camera_error: None,
             notices: warnings,
             moving_until: None,
             last_frame: None,
+            scripted: false,
             request: None,
             key: 0,
             view_pixels: None,
@@ -116,12 +137,28 @@ impl Viewer {
         self.script.steps.is_empty() && self.script.wait_frames == 0 && self.script.wait_traced_since.is_none()
     }
 
+    /// Whether a `measure` step said where the stats start.
+    pub fn measured(&self) -> bool {
+        self.script.measured
+    }
+
+    /// Reloads the scene when its file changed on disk (polled between frames, without drawing
+    /// one); returns whether it did, so the window is drawn again.
+    pub fn poll_file(&mut self) -> bool {
+        let reloaded = self.scene.reload_if_changed(&self.settings);
+        if reloaded {
+            self.notice("scene file changed on disk: reloaded".into());
+        }
+        reloaded
+    }
+
     /// What the configuration file should remember now.
     pub fn remembered(&self, window: [u32; 2]) -> ViewerConfig {
         ViewerConfig {
             window,
             mode: self.view.mode,
             split: self.view.split,
+            motion_fps: self.view.motion_fps,
             motion_scale: self.view.motion_scale,
             settings: super::config::changed_settings(&self.settings, &self.scene.seed_settings),
         }
@@ -151,21 +188,18 @@ impl Viewer {
     /// Draws one frame.
     pub fn frame(&mut self, screen: &mut Screen) -> anyhow::Result<FrameEnd> {
         let start = Instant::now();
-        let mut times =
-            FrameTimes { frame: self.last_frame.map_or(Duration::ZERO, |t| start - t), ..Default::default() };
-        self.last_frame = Some(start);
+        let interval = self.last_frame.filter(|(_, at_once)| *at_once).map(|(t, _)| start - t);
+        let mut times = FrameTimes { interval, ..Default::default() };
+        let camera_before = self.scene.scene.camera.clone();
         let mut input = CameraInput::default();
         self.run_script(&mut input)?;
-        if self.scene.reload_if_changed(&self.settings) {
-            self.notice("scene file changed on disk: reloaded".into());
-        }
+        self.poll_file();
         self.traced.poll(&screen.egui);
 
         // The UI decides the 3D view's size and gathers input.
         let ui_start = Instant::now();
-        let raw = screen.input.take_egui_input(&screen.window);
-        let raster_id = self.raster.texture_id();
-        let scale = self.scale(start);
+        let raw = screen.take_input();
+        let raster_id = (screen.composition == Composition::Textured).then(|| self.raster.texture_id());
         let mut output = UiOutput::default();
         let full = {
             let mut model = UiModel {
@@ -178,7 +212,6 @@ impl Viewer {
                 key: self.key,
                 stats: &self.stats,
                 passes: &self.raster.report.passes,
-                scale,
                 camera_error: &mut self.camera_error,
                 notices: &self.notices,
                 inspection: self.inspection.as_ref(),
@@ -195,40 +228,49 @@ impl Viewer {
         }
         self.inspect_next = output.inspect.or(self.inspect_next);
         self.apply(&output, input, start);
+        // Compared without the image size, which the frame sets below.
+        let camera = &self.scene.scene.camera;
+        let moved = Camera { width: camera_before.width, height: camera_before.height, ..camera.clone() } != camera_before;
 
-        // The raster image at the view's size times the render scale.
+        // The raster image at the view's size, drawn at the render scale.
         let ppp = full.pixels_per_point;
-        let view_rect = output.view_rect;
-        self.view_pixels = view_rect.map(|r| {
+        self.view_pixels = output.view_rect.map(|r| {
             let px = |x: f32| (x * ppp).round().max(0.0) as u32;
             (px(r.min.x), px(r.min.y), px(r.width()).max(1), px(r.height()).max(1))
         });
-        let scale = self.scale(Instant::now());
+        let moving = self.moving(Instant::now());
+        let scale = self.scale(moving);
+        let mut drawn = Drawn::Kept;
         if let Some((_, _, width, height)) = self.view_pixels {
-            let full_size = (width, height);
-            let scaled =
-                (((width as f32) * scale).round().max(1.0) as u32, ((height as f32) * scale).round().max(1.0) as u32);
-            let filter = if scaled == full_size { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
-            self.scene.scene.camera.width = scaled.0;
-            self.scene.scene.camera.height = scaled.1;
-            let (_, raster_time) = self.raster.render(
-                &screen.gpu,
-                &mut screen.painter,
-                (&self.scene.scene, self.scene.revision),
-                &self.settings,
-                filter,
-                true,
-            );
-            times.raster = raster_time;
-            self.request_traced(full_size, scaled == full_size, screen);
+            // The camera's image size is the drawn one while the raster image is drawn, so the
+            // rasterizer's work shrinks with the scale; the view's size otherwise (picking, pans).
+            let scaled = |n: u32| ((n as f32 * scale).round() as u32).clamp(1, n);
+            let drawn_size = (scaled(width), scaled(height));
+            let filter = if drawn_size == (width, height) { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
+            (self.scene.scene.camera.width, self.scene.scene.camera.height) = drawn_size;
+            let scene = (&self.scene.scene, self.scene.revision);
+            // Each pass is timed on its own only for the overlay, which lists them.
+            drawn = self.raster.render(screen, scene, &self.settings, (self.view.overlay_open, filter));
+            (self.scene.scene.camera.width, self.scene.scene.camera.height) = (width, height);
+            if let Drawn::New(time) = drawn {
+                times.raster = Some(time);
+            }
+            self.request_traced((width, height), scale == 1.0, screen);
             if let Some(pixel) = self.inspect_next.take() {
-                self.inspect(screen, pixel, full_size);
+                self.inspect(screen, pixel, (width, height));
             }
         }
 
         let paint_start = Instant::now();
         let screenshot = self.screenshot.take();
-        let presented = screen.paint(full, screenshot.as_deref())?;
+        let view = match (self.raster.image(), self.view_pixels) {
+            (Some((texture, plain)), Some((x, y, w, h))) => Some(ViewImage { texture, plain, rect: [x, y, w, h] }),
+            _ => None,
+        };
+        let presented = screen.paint(full, view, screenshot.as_deref())?;
+        // Nothing is drawn between frames, so waiting loses nothing, and the frame's time is then
+        // the whole of it, the GPU's share included.
+        screen.gpu.wait();
         times.paint = paint_start.elapsed();
         if let Some(path) = screenshot {
             match presented {
@@ -242,23 +284,43 @@ impl Viewer {
                 Presented::Skipped => self.screenshot = Some(path),
             }
         }
+        times.frame = start.elapsed();
+        times.scale = scale;
+        if moving && self.view.motion_fps > 0.0 && matches!(drawn, Drawn::New(_)) {
+            let target = Duration::from_secs_f32(1.0 / self.view.motion_fps);
+            self.budget.update(times.frame, target, self.view.motion_scale);
+        }
         self.stats.record(times);
-        let moved = self.moving_until.is_some_and(|t| t > start + SETTLE - Duration::from_millis(1));
-        let soon = |delay: Duration| Instant::now() + delay;
-        let next = [
-            moved.then(Instant::now),
-            repaint.filter(|d| *d < Duration::from_secs(3600)).map(soon),
-            self.moving_until,
-            Some(soon(Duration::from_millis(500))),
-        ]
-        .into_iter()
-        .flatten()
-        .min();
+        if std::mem::take(&mut self.script.reset_stats) {
+            self.stats.reset();
+        }
+
+        // The next frame: at once while the camera moves; at the end of the settling time after a
+        // frame drawn below full scale (full scale again); when egui animates; soon after a
+        // frame the surface was not ready for; else only when something happens.
+        let now = Instant::now();
+        let settle = (scale < 1.0).then(|| self.moving_until.map_or(now, |t| t.max(now)));
+        let animation = repaint.filter(|d| *d < Duration::from_secs(3600)).map(|d| now + d);
+        let retry = (presented == Presented::Skipped).then(|| now + RETRY);
+        let next = [moved.then_some(now), settle, animation, retry].into_iter().flatten().min();
+        let at_once = self.scripted || next.is_some_and(|t| t <= now);
+        self.last_frame = Some((start, at_once));
         Ok(FrameEnd { next })
     }
 
-    fn scale(&self, now: Instant) -> f32 {
-        if self.moving_until.is_some_and(|t| now < t) { self.view.motion_scale } else { 1.0 }
+    /// Whether the camera moved within the last [`SETTLE`].
+    fn moving(&self, now: Instant) -> bool {
+        self.moving_until.is_some_and(|t| now < t)
+    }
+
+    /// The render scale of a frame: full when still; while moving, what the frame budget says
+    /// within `[motion_scale, 1]`, or `motion_scale` when no frame rate is asked for.
+    fn scale(&self, moving: bool) -> f32 {
+        match (moving, self.view.motion_fps > 0.0) {
+            (false, _) => 1.0,
+            (true, true) => self.budget.scale(self.view.motion_scale),
+            (true, false) => self.view.motion_scale,
+        }
     }
 
     /// Applies what the UI gathered: camera input, edits, settings, picks and actions.
@@ -436,6 +498,11 @@ impl Viewer {
             }
             Step::Load(path) => self.open(&path),
             Step::Scale(scale) => self.view.motion_scale = scale,
+            Step::Fps(fps) => self.view.motion_fps = fps,
+            Step::Measure => {
+                self.script.measured = true;
+                self.script.reset_stats = true;
+            }
             Step::Help(on) => self.view.help_open = on,
             Step::Panel(on) => self.view.panel_open = on,
             Step::Overlay(on) => self.view.overlay_open = on,

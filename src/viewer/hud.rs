@@ -40,15 +40,20 @@ pub fn help_window(ctx: &egui::Context, open: &mut bool) {
 /// Times of one frame.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FrameTimes {
-    /// From one frame's start to the next's.
+    /// From the frame's start until the GPU finished it (the viewer waits for it at the end of
+    /// every frame: nothing is drawn between frames, so nothing is lost by waiting).
     pub frame: Duration,
-    /// Building the UI and tessellating it (CPU).
+    /// Since the previous frame's start, when it asked for this one at once (scripted runs,
+    /// moving cameras): the frame rate as seen.
+    pub interval: Option<Duration>,
+    /// Building the UI (CPU).
     pub ui: Duration,
-    /// Recording egui's draw and presenting (CPU side of the UI's painting).
-    pub paint: Duration,
-    /// The rasterizer's frame, submission to completion (only measured with `--stats` or the
-    /// overlay's detailed timing, since waiting for it stalls the pipeline).
+    /// The rasterizer's frame, submission to completion; `None` when the image was kept.
     pub raster: Option<Duration>,
+    /// Tessellating egui's output, composing the window and presenting it, GPU included.
+    pub paint: Duration,
+    /// The render scale the 3D view was drawn at.
+    pub scale: f32,
 }
 
 /// Running means over the frames of a run, for the overlay and `--stats`.
@@ -57,9 +62,9 @@ pub struct FrameStats {
     pub last: FrameTimes,
     frames: u32,
     total: FrameTimes,
+    intervals: u32,
     raster_frames: u32,
-    /// A smoothed frame time for the overlay.
-    smooth_ms: f64,
+    scales: Vec<f32>,
 }
 
 fn ms(d: Duration) -> f64 {
@@ -73,50 +78,66 @@ impl FrameStats {
         self.total.frame += times.frame;
         self.total.ui += times.ui;
         self.total.paint += times.paint;
+        if let Some(interval) = times.interval {
+            self.intervals += 1;
+            *self.total.interval.get_or_insert(Duration::ZERO) += interval;
+        }
         if let Some(raster) = times.raster {
             self.raster_frames += 1;
             *self.total.raster.get_or_insert(Duration::ZERO) += raster;
+            self.scales.push(times.scale);
         }
-        let now = ms(times.frame);
-        self.smooth_ms = if self.frames == 1 { now } else { self.smooth_ms * 0.9 + now * 0.1 };
     }
 
     /// Starts the means again (after warm-up frames).
     pub fn reset(&mut self) {
-        *self = FrameStats { last: self.last, smooth_ms: self.smooth_ms, ..Default::default() };
+        *self = FrameStats { last: self.last, ..Default::default() };
     }
 
-    pub fn overlay_text(&self, scale: f32) -> String {
+    /// The last frame's times: what the overlay shows. Frames are drawn only when something
+    /// changes, so this is what the last change cost, not a rate.
+    pub fn overlay_text(&self) -> String {
         let t = &self.last;
-        let mut text = format!(
-            "{:.1} ms/frame ({:.1} fps)\nUI {:.1} ms + paint {:.1} ms",
-            self.smooth_ms,
-            1e3 / self.smooth_ms.max(1e-3),
-            ms(t.ui),
-            ms(t.paint)
-        );
-        if let Some(raster) = t.raster {
-            text += &format!("\nraster {:.1} ms", ms(raster));
+        let mut text = format!("frame {:.1} ms", ms(t.frame));
+        if let Some(interval) = t.interval {
+            text += &format!(" ({:.1} fps)", 1e3 / ms(interval).max(1e-3));
         }
-        if scale < 1.0 {
-            text += &format!("\nrender scale {scale:.2} (moving)");
+        text += &format!("\nUI {:.1} ms + paint {:.1} ms", ms(t.ui), ms(t.paint));
+        match t.raster {
+            Some(raster) => text += &format!("\nraster {:.1} ms", ms(raster)),
+            None => text += "\nraster: image kept",
+        }
+        if t.scale < 1.0 {
+            text += &format!("\nrender scale {:.2} (moving)", t.scale);
         }
         text
     }
 
-    /// The `--stats` summary: mean frame time, frames per second, and the UI's share.
+    /// The `--stats` summary: mean frame time, frames per second, where the time went, and the
+    /// render scales drawn at.
     pub fn summary(&self) -> String {
         let n = self.frames.max(1) as f64;
         let frame = ms(self.total.frame) / n;
-        let ui = (ms(self.total.ui) + ms(self.total.paint)) / n;
+        let (ui, paint) = (ms(self.total.ui) / n, ms(self.total.paint) / n);
         let mut text = format!(
-            "frames: {}\nframe: {frame:.2} ms ({:.2} fps)\nUI (build + tessellate + paint, CPU): {ui:.2} ms = {:.1} % of the frame",
-            self.frames,
-            1e3 / frame.max(1e-6),
-            100.0 * ui / frame.max(1e-6)
+            "frames: {}, the 3D view drawn in {}\nframe: {frame:.2} ms (start to GPU done)",
+            self.frames, self.raster_frames
+        );
+        if let Some(interval) = self.total.interval {
+            let apart = ms(interval) / self.intervals.max(1) as f64;
+            text += &format!("\nframes apart: {apart:.2} ms ({:.2} fps)", 1e3 / apart.max(1e-6));
+        }
+        text += &format!(
+            "\nUI build: {ui:.2} ms; paint (tessellate, compose, present, GPU included): {paint:.2} ms; together {:.1} % of the frame",
+            100.0 * (ui + paint) / frame.max(1e-6)
         );
         if let Some(raster) = self.total.raster {
             text += &format!("\nraster (submit to done): {:.2} ms", ms(raster) / self.raster_frames.max(1) as f64);
+        }
+        if !self.scales.is_empty() {
+            let mean = self.scales.iter().sum::<f32>() / self.scales.len() as f32;
+            let (low, high) = self.scales.iter().fold((f32::MAX, f32::MIN), |(l, h), &s| (l.min(s), h.max(s)));
+            text += &format!("\nrender scale: mean {mean:.2}, from {low:.2} to {high:.2}");
         }
         text
     }

@@ -3,19 +3,29 @@
 //! FLIP difference, of a scene you can orbit, fly through, pick and edit.
 //!
 //! - [`frame`]: one frame, top to bottom, and the state it works on ([`frame::Viewer`]).
-//! - [`screen`]: the window, the device and surface, egui's input and painter, screenshots.
+//! - [`screen`]: the window, the device and surface, egui's input and painter, the window's
+//!   composition (the 3D view and the panel copied in, egui over them), screenshots.
 //! - [`ui`]: the layout; [`panel`] the settings sections generated from `RenderSettings`;
 //!   [`scene_panel`] the camera, light and material editors; [`hud`] frame times and help.
 //! - [`camera_control`]: orbit, pan, zoom, fly and frame as pure functions on the camera.
-//! - [`raster_view`]: the one place the rasterizer is called; [`traced`]: the background tracer.
+//! - [`raster_view`]: the one place the rasterizer is called; [`traced`]: the background tracer;
+//!   [`budget`]: the render scale while the camera moves; [`upscale`]: a moving frame stretched
+//!   over the view.
 //! - [`scene_state`] and [`picking`]: the scene, reloading, the picked object;
 //!   [`volume_probe`]: the samples of the volume ray under the cursor; [`inspect`]: a pixel
 //!   explained by both renderers, its ray tree drawn in 3D.
 //! - [`config`]: what is remembered between runs; [`script`]: scripted steps for tests.
 //!
 //! This module holds the winit `ApplicationHandler`: it opens the window when the event loop
-//! resumes, forwards events to egui, and asks for frames.
+//! resumes, forwards events to egui, and asks for frames: on input, on the background tracer's
+//! news, when a frame asks for the next one ([`frame::FrameEnd`]), and when the scene file
+//! changed. In between it sleeps: a still window costs no CPU (the file is polled, not drawn).
+//!
+//! The window may go away in three ways, none of them a panic: closed (a close request: the
+//! settings are remembered and the viewer exits), destroyed from outside (the `Destroyed` event:
+//! the same, with a line saying so), or the display lost (Xlib prints its one line and exits).
 
+pub mod budget;
 pub mod camera_control;
 pub mod config;
 pub mod frame;
@@ -30,6 +40,7 @@ pub mod screen;
 pub mod script;
 pub mod traced;
 pub mod ui;
+pub mod upscale;
 pub mod view_mode;
 pub mod volume_probe;
 
@@ -100,7 +111,16 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
         ViewerError::NoDisplay
     })?;
     let proxy = event_loop.create_proxy();
-    let mut app = App { options, scene: Some(scene), proxy, running: None, outcome: Ok(()), frames: 0, started: None };
+    let mut app = App {
+        options,
+        scene: Some(scene),
+        proxy,
+        running: None,
+        outcome: Ok(()),
+        frames: 0,
+        next_frame: None,
+        finished: false,
+    };
     event_loop.run_app(&mut app).context("the window's event loop failed")?;
     app.outcome
 }
@@ -117,7 +137,9 @@ struct App {
     running: Option<(Screen, Viewer)>,
     outcome: anyhow::Result<()>,
     frames: u64,
-    started: Option<Instant>,
+    /// When the last frame asked for the next one.
+    next_frame: Option<Instant>,
+    finished: bool,
 }
 
 impl App {
@@ -146,17 +168,20 @@ impl App {
         };
         let mut viewer = Viewer::new(&mut screen, scene, &config, self.options.steps.clone(), wake);
         viewer.notices.extend(notices);
+        viewer.scripted = self.options.scripted();
         if self.options.stats {
             println!("adapter: {}", screen.gpu.describe());
         }
         screen.window.request_redraw();
         self.running = Some((screen, viewer));
-        self.started = Some(Instant::now());
         Ok(())
     }
 
     /// Ends the run with `result` (the first error wins).
     fn finish(&mut self, event_loop: &ActiveEventLoop, result: anyhow::Result<()>) {
+        if std::mem::replace(&mut self.finished, true) {
+            return;
+        }
         if let Err(e) = result
             && self.outcome.is_ok()
         {
@@ -195,20 +220,19 @@ impl App {
         let result = viewer.frame(screen);
         self.frames += 1;
         // Measure the state the script set up, not the steps getting there nor the first frames
-        // (the driver compiles its pipelines lazily).
-        if (!was_done && viewer.script_done()) || (self.frames == 2 && viewer.script_done()) {
+        // (the driver compiles its pipelines lazily), unless a `measure` step said where.
+        if !viewer.measured() && ((!was_done && viewer.script_done()) || (self.frames == 2 && viewer.script_done())) {
             viewer.stats.reset();
         }
+        let result = result.and_then(|end| match screen.surface_failing() {
+            Some(error) => Err(anyhow::anyhow!(error)),
+            None => Ok(end),
+        });
         match result {
             Err(e) => self.finish(event_loop, Err(e)),
             Ok(_) if last => self.finish(event_loop, Ok(())),
-            Ok(end) => {
-                if scripted.is_some() {
-                    screen.window.request_redraw();
-                } else if let Some(next) = end.next {
-                    event_loop.set_control_flow(ControlFlow::WaitUntil(next));
-                }
-            }
+            Ok(_) if scripted.is_some() => screen.window.request_redraw(),
+            Ok(end) => self.next_frame = end.next,
         }
     }
 }
@@ -233,6 +257,9 @@ impl ApplicationHandler<Wake> for App {
         // A window destroyed from outside (no close request first) can no longer be asked
         // anything: end before any handler looks at it.
         if matches!(event, WindowEvent::Destroyed) {
+            if !self.finished {
+                eprintln!("the window was destroyed (by the window system or another program); the viewer stops");
+            }
             self.finish(event_loop, Ok(()));
             self.running = None;
             return;
@@ -258,9 +285,24 @@ impl ApplicationHandler<Wake> for App {
     }
 
     fn new_events(&mut self, _: &ActiveEventLoop, cause: StartCause) {
-        // Timed wake-ups: the camera settling back to full resolution, file polling, animations.
-        if let (StartCause::ResumeTimeReached { .. }, Some((screen, _))) = (cause, &self.running) {
+        if !matches!(cause, StartCause::ResumeTimeReached { .. }) {
+            return;
+        }
+        let Some((screen, viewer)) = &mut self.running else { return };
+        let now = Instant::now();
+        if self.next_frame.is_some_and(|t| t <= now) {
+            self.next_frame = None;
             screen.window.request_redraw();
         }
+        if viewer.poll_file() {
+            screen.window.request_redraw();
+        }
+    }
+
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        // Sleep until the frame asked for or the next look at the scene file, whichever is first.
+        let Some((_, viewer)) = &self.running else { return };
+        let wake = [self.next_frame, viewer.scene.next_poll()].into_iter().flatten().min();
+        event_loop.set_control_flow(wake.map_or(ControlFlow::Wait, ControlFlow::WaitUntil));
     }
 }

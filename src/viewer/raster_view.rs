@@ -1,60 +1,99 @@
 //! The rasterizer's image in the window: the one place the viewer calls [`Renderer`].
 //!
-//! The frame is drawn offscreen, into an `Rgba8UnormSrgb` texture of the 3D view's size times the
-//! render scale (lower while the camera moves), exactly as `mirador render` draws it; then copied
-//! into an `Rgba8Unorm` twin that egui samples. egui expects sRGB-encoded values in a texture it
-//! does not decode, and a copy between formats that differ only in their sRGB-ness moves the
-//! bytes unchanged, so the window shows the very pixels a screenshot of `render` holds, on every
-//! backend (the GL backend cannot reinterpret one texture through a view of another format).
+//! The frame is drawn offscreen, into a texture of the 3D view's size times the render scale
+//! (lower while the camera moves: `frame::Viewer::scale`), exactly as `mirador render` draws it.
+//! The image has the sRGB twin of the window surface's format, so the window takes it by a copy
+//! of its bytes, or stretches it over the view ([`super::upscale`]) through a plain view of the
+//! same bytes (`screen::Composition::Copied`). Where the surface takes no copies, the image is
+//! `Rgba8UnormSrgb` and is copied into an `Rgba8Unorm` twin that egui samples: egui expects sRGB-encoded values in a texture it does not decode, and a copy
+//! between formats that differ only in their sRGB-ness moves the bytes unchanged, so the window
+//! shows the very pixels a screenshot of `render` holds, on every backend (the GL backend cannot
+//! reinterpret one texture through a view of another format).
+//!
+//! A frame whose inputs (camera, lights, settings, scene revision, size) are those of the image
+//! already drawn is not drawn again: the window shows the kept image. Hovering, the panel and the
+//! overlays then cost only the window's composition.
 
 use std::time::{Duration, Instant};
 
+use super::screen::{Composition, Screen};
+use crate::gpu::Gpu;
 use crate::gpu::texture::GpuTexture;
-use crate::gpu::{Gpu, readback};
-use crate::raster::{FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer};
+use crate::raster::{FrameReport, FrameTargets, Renderer, drawn_size};
+use crate::scene::{Camera, Light};
 use crate::{RenderSettings, Scene};
 
-/// The format egui samples the image from.
+/// The format egui samples the image from ([`Composition::Textured`]).
 const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 pub struct RasterView {
     renderer: Renderer,
+    composition: Composition,
+    format: wgpu::TextureFormat,
     /// The scene revision the renderer loaded.
     revision: u64,
     /// Everything that depends on the image size.
     frame: Option<SizedTargets>,
-    /// How egui refers to the displayed image; the same id across resizes, so the UI can lay out
-    /// a frame before its image is drawn.
+    /// What the image shows.
+    drawn: Option<Inputs>,
+    /// How egui refers to the displayed image ([`Composition::Textured`]); the same id across
+    /// resizes, so the UI can lay out a frame before its image is drawn.
     texture_id: egui::TextureId,
     /// Bound to `texture_id` until the first frame is drawn.
     _placeholder: wgpu::Texture,
     /// The image size and filter the egui texture was last bound with.
     bound: Option<((u32, u32), wgpu::FilterMode)>,
-    /// What the last frame did: its passes' times (when timed), the shadow layers it redrew.
+    /// What the last frame drawn did: its passes' times (when profiled), the shadow layers it
+    /// redrew.
     pub report: FrameReport,
+}
+
+/// Everything a raster image depends on.
+#[derive(Clone, PartialEq)]
+struct Inputs {
+    camera: Camera,
+    lights: Vec<Light>,
+    settings: RenderSettings,
+    revision: u64,
 }
 
 struct SizedTargets {
     size: (u32, u32),
     targets: FrameTargets,
-    output: GpuTexture,
-    display: wgpu::Texture,
-    display_view: wgpu::TextureView,
+    image: GpuTexture,
+    /// The image's bytes through the plain (not sRGB) twin of its format.
+    plain: wgpu::TextureView,
+    /// The twin egui samples ([`Composition::Textured`]).
+    display: Option<(wgpu::Texture, wgpu::TextureView)>,
+}
+
+/// What [`RasterView::render`] did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Drawn {
+    /// Nothing changed: the image is the last one.
+    Kept,
+    /// A new image, in this time from submission to completion.
+    New(Duration),
 }
 
 impl RasterView {
-    pub fn new(gpu: &Gpu, egui_renderer: &mut egui_wgpu::Renderer, scene: &Scene, revision: u64) -> RasterView {
-        let renderer = Renderer::new(gpu, scene, OUTPUT_FORMAT);
+    pub fn new(screen: &mut Screen, scene: &Scene, revision: u64) -> RasterView {
+        let gpu = &screen.gpu;
+        let format = screen.image_format();
+        let renderer = Renderer::new(gpu, scene, format);
         let placeholder = display_texture(&gpu.device, (1, 1));
         let view = placeholder.create_view(&wgpu::TextureViewDescriptor {
             label: Some("viewer::raster::placeholder_view"),
             ..Default::default()
         });
-        let texture_id = egui_renderer.register_native_texture(&gpu.device, &view, wgpu::FilterMode::Nearest);
+        let texture_id = screen.painter.register_native_texture(&gpu.device, &view, wgpu::FilterMode::Nearest);
         RasterView {
             renderer,
+            composition: screen.composition,
+            format,
             revision,
             frame: None,
+            drawn: None,
             texture_id,
             _placeholder: placeholder,
             bound: None,
@@ -62,76 +101,107 @@ impl RasterView {
         }
     }
 
-    /// The displayed image's egui id.
+    /// The displayed image's egui id ([`Composition::Textured`]).
     pub fn texture_id(&self) -> egui::TextureId {
         self.texture_id
     }
 
-    /// Renders `scene` (whose camera must have the image's size) into the displayed texture and
-    /// returns the texture's egui id and the time the GPU took (measured only when `timed`, as it
-    /// waits for the frame; then each pass is also timed on its own, in [`Self::report`]).
+    /// The image to copy into the window ([`Composition::Copied`]) and its plain view, once one
+    /// is drawn.
+    pub fn image(&self) -> Option<(&wgpu::Texture, &wgpu::TextureView)> {
+        let frame = self.frame.as_ref().filter(|_| self.drawn.is_some())?;
+        Some((&frame.image.texture, &frame.plain))
+    }
+
+    /// Renders `scene` (whose camera has the image's size) with `settings` unless the image
+    /// already shows it. Waits for the frame to measure it; with `profile`, each pass is also
+    /// submitted and timed on its own, in [`Self::report`]. `filter` is how egui samples the
+    /// image ([`Composition::Textured`]): linear when it is smaller than the view.
     pub fn render(
         &mut self,
-        gpu: &Gpu,
-        egui_renderer: &mut egui_wgpu::Renderer,
+        screen: &mut Screen,
         (scene, revision): (&Scene, u64),
         settings: &RenderSettings,
-        filter: wgpu::FilterMode,
-        timed: bool,
-    ) -> (egui::TextureId, Option<Duration>) {
+        (profile, filter): (bool, wgpu::FilterMode),
+    ) -> Drawn {
+        let inputs =
+            Inputs { camera: scene.camera.clone(), lights: scene.lights.clone(), settings: settings.clone(), revision };
+        if self.drawn.as_ref() == Some(&inputs) {
+            return Drawn::Kept;
+        }
+        let gpu = &screen.gpu;
         if revision != self.revision {
             self.renderer.load(gpu, scene);
             self.revision = revision;
         }
         let size = (scene.camera.width, scene.camera.height);
         if self.frame.as_ref().is_none_or(|f| f.size != size) {
-            self.frame = Some(self.sized_targets(gpu, size));
+            self.frame = Some(self.sized_targets(gpu, size, settings));
         }
         let frame = self.frame.as_mut().expect("made just above");
         let start = Instant::now();
-        self.renderer.profile = timed;
-        self.report = self.renderer.render(gpu, scene, settings, &mut frame.targets, &frame.output.view);
-        let mut encoder =
-            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer::raster::copy") });
-        encoder.copy_texture_to_texture(
-            frame.output.texture.as_image_copy(),
-            frame.display.as_image_copy(),
-            frame.output.texture.size(),
-        );
-        gpu.queue.submit([encoder.finish()]);
-        let elapsed = timed.then(|| {
-            gpu.wait();
-            start.elapsed()
-        });
-        if self.bound != Some((size, filter)) {
-            egui_renderer.update_egui_texture_from_wgpu_texture(
-                &gpu.device,
-                &frame.display_view,
-                filter,
-                self.texture_id,
+        self.renderer.profile = profile;
+        self.report = self.renderer.render(gpu, scene, settings, &mut frame.targets, &frame.image.view);
+        if let Some((display, _)) = &frame.display {
+            let mut encoder = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer::raster::copy") });
+            encoder.copy_texture_to_texture(
+                frame.image.texture.as_image_copy(),
+                display.as_image_copy(),
+                frame.image.texture.size(),
             );
+            gpu.queue.submit([encoder.finish()]);
+        }
+        gpu.wait();
+        let elapsed = start.elapsed();
+        if let Some((_, display_view)) = &frame.display
+            && self.bound != Some((size, filter))
+        {
+            screen.painter.update_egui_texture_from_wgpu_texture(&gpu.device, display_view, filter, self.texture_id);
             self.bound = Some((size, filter));
         }
-        (self.texture_id, elapsed)
+        self.drawn = Some(inputs);
+        Drawn::New(elapsed)
     }
 
-    fn sized_targets(&self, gpu: &Gpu, size: (u32, u32)) -> SizedTargets {
-        let targets = FrameTargets::new(&gpu.device, size);
-        // The renderer remakes the targets itself when `raster.render_scale` asks for less.
-        let output = GpuTexture::target(&gpu.device, "viewer::raster::output", size, OUTPUT_FORMAT);
-        let display = display_texture(&gpu.device, size);
-        let display_view = display.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("viewer::raster::display_view"),
+    fn sized_targets(&self, gpu: &Gpu, size: (u32, u32), settings: &RenderSettings) -> SizedTargets {
+        let targets = FrameTargets::new(&gpu.device, drawn_size(size, settings.raster.render_scale));
+        let plain_format = self.format.remove_srgb_suffix();
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("viewer::raster::image"),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[plain_format],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let plain = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("viewer::raster::plain_view"),
+            format: Some(plain_format),
             ..Default::default()
         });
-        SizedTargets { size, targets, output, display, display_view }
+        let image = GpuTexture { texture, view };
+        let display = (self.composition == Composition::Textured).then(|| {
+            let display = display_texture(&gpu.device, size);
+            let view = display.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("viewer::raster::display_view"),
+                ..Default::default()
+            });
+            (display, view)
+        });
+        SizedTargets { size, targets, image, plain, display }
     }
 
     /// The last rendered image, read back (sRGB RGBA8, as `mirador render` writes it).
     pub fn read_back(&self, gpu: &Gpu) -> Option<image::RgbaImage> {
         let frame = self.frame.as_ref()?;
-        let pixels = readback::read_rgba8(&gpu.device, &gpu.queue, &frame.output.texture).ok()?;
-        image::RgbaImage::from_raw(frame.size.0, frame.size.1, pixels)
+        super::screen::read_image(gpu, &frame.image.texture).ok()
     }
 }
 

@@ -113,6 +113,11 @@ impl SceneState {
         self.load(&path, settings)
     }
 
+    /// When the scene file's modification time is next due a look (`None`: no file).
+    pub fn next_poll(&self) -> Option<Instant> {
+        self.watch.as_ref().map(|watch| watch.checked + WATCH_PERIOD)
+    }
+
     /// Marks geometry or materials as changed.
     pub fn touch(&mut self) {
         self.revision += 1;

@@ -1,17 +1,34 @@
 //! The window and what draws into it: the wgpu device and the window's surface, egui's input
 //! (egui-winit) and its painter (egui-wgpu), and screenshots of the whole window.
 //!
-//! A surface can go away under the program: a minimised window has a zero size (nothing is drawn
+//! A frame of the window is composed by copies wherever it can ([`Screen::paint`]): the 3D view's
+//! image (the rasterizer's frame, already through the output transform) is copied into the view's
+//! rectangle, the side panel's pixels are copied from where egui last drew them, and egui draws
+//! only the rest (the overlays over the view) each frame. On a software GPU (lavapipe) egui costs
+//! about 27 ns a pixel it covers: drawing the image as a textured rectangle over a 950×720 view
+//! took about 20 ms a frame, the side panel 10 to 20 ms, as much as the rasterizer's frame itself,
+//! where a copy takes about a millisecond (docs/performance.md). The panel is drawn again only when
+//! its shapes change: they are the front of egui's list of shapes, up to the first that reaches
+//! into the view ([`panel_shapes`]). A surface that takes no copies (the GL backend's) falls back
+//! to egui drawing everything, the image as a texture ([`Composition::Textured`]).
+//!
+//! The window can go away under the program: a minimised window has a zero size (nothing is drawn
 //! until it comes back), a resized one is reconfigured, an outdated surface is reconfigured and a
-//! lost one recreated; each of those skips one frame instead of failing.
+//! lost one recreated; each of those skips one frame instead of failing. The window's size is
+//! followed from its `Resized` events and never asked of the window: winit's X11 backend panics
+//! when a window destroyed from outside (`xdotool windowclose`, `xkill`, a window manager) is
+//! asked its size. Errors of the surface itself (it may fail before the `Destroyed` event
+//! arrives) skip frames too and are reported only if they last ([`Screen::surface_failing`]).
 
 use std::path::Path;
 use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use anyhow::Context as _;
 use winit::event_loop::ActiveEventLoop;
 use winit::window::Window;
 
+use super::upscale::Upscale;
 use crate::gpu::{Gpu, readback};
 
 pub struct Screen {
@@ -19,18 +36,61 @@ pub struct Screen {
     pub gpu: Gpu,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
+    pub composition: Composition,
     pub egui: egui::Context,
     pub input: egui_winit::State,
     pub painter: egui_wgpu::Renderer,
+    /// The window has no pixels (its last `Resized` event said zero).
+    zero_size: bool,
+    /// egui's clock.
+    started: Instant,
+    /// Since when every frame's surface has failed, and the last error.
+    failing: Option<(Instant, String)>,
+    /// The side panel as egui last drew it ([`Composition::Copied`]).
+    panel: Option<PanelCache>,
+    upscale: Option<Upscale>,
+}
+
+/// The side panel's pixels and the shapes they were drawn from.
+struct PanelCache {
+    /// The window's size, in the surface's format; the panel is its left `width` pixels.
+    texture: wgpu::Texture,
+    width: u32,
+    pixels_per_point: f32,
+    shapes: Vec<egui::epaint::ClippedShape>,
+}
+
+/// How the 3D view's image reaches the window.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Composition {
+    /// Copied into the surface, under egui's drawing.
+    Copied,
+    /// Drawn by egui as a texture (a surface that takes no copies).
+    Textured,
+}
+
+/// The 3D view's image and where it goes in the window, in pixels: copied when it has the view's
+/// size, stretched over it when it was drawn at a lower render scale.
+#[derive(Clone, Copy)]
+pub struct ViewImage<'a> {
+    pub texture: &'a wgpu::Texture,
+    /// The image's bytes as a plain (not sRGB) 8-bit view, for stretching.
+    pub plain: &'a wgpu::TextureView,
+    /// The view's rectangle: `x, y, width, height`.
+    pub rect: [u32; 4],
 }
 
 /// What became of one frame's presentation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Presented {
     Shown,
-    /// The surface was not ready (minimised, outdated, lost): nothing was drawn this time.
+    /// The surface was not ready (minimised, outdated, lost, failing): nothing was drawn.
     Skipped,
 }
+
+/// How long a surface may keep failing before the viewer stops with its error: a window destroyed
+/// from outside fails its surface just before its `Destroyed` event arrives.
+const FAILING_FOR: Duration = Duration::from_secs(2);
 
 impl Screen {
     /// Opens the window (`size` in logical pixels) and a device that can present to it.
@@ -50,9 +110,19 @@ impl Screen {
             .find(|f| matches!(f, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm))
             .or_else(|| capabilities.formats.first().copied())
             .context("the window's surface offers no format")?;
+        // The raster image is drawn in the sRGB twin of the surface's format and copied in: the
+        // same bytes, which only formats that differ in their sRGB-ness alone can exchange.
+        let copyable = matches!(format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm)
+            && capabilities.usages.contains(wgpu::TextureUsages::COPY_DST);
+        let composition = if copyable { Composition::Copied } else { Composition::Textured };
+        let usage = match composition {
+            Composition::Copied => wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_DST,
+            Composition::Textured => wgpu::TextureUsages::RENDER_ATTACHMENT,
+        };
+        // Asked once, while the window surely exists; afterwards its `Resized` events say.
         let physical = window.inner_size();
         let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            usage,
             format,
             color_space: wgpu::SurfaceColorSpace::Auto,
             width: physical.width.max(1),
@@ -62,7 +132,8 @@ impl Screen {
             alpha_mode: capabilities.alpha_modes.first().copied().unwrap_or(wgpu::CompositeAlphaMode::Auto),
             view_formats: vec![],
         };
-        if physical.width > 0 && physical.height > 0 {
+        let zero_size = physical.width == 0 || physical.height == 0;
+        if !zero_size {
             surface.configure(&gpu.device, &config);
         }
         let egui = egui::Context::default();
@@ -76,8 +147,23 @@ impl Screen {
             Some(max_texture_side),
         );
         let painter = egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default());
-        log::info!("window surface: {format:?} on {}", gpu.describe());
-        Ok(Screen { window, gpu, surface, config, egui, input, painter })
+        let upscale = (composition == Composition::Copied).then(|| Upscale::new(&gpu.device, format));
+        log::info!("window surface: {format:?}, the 3D view {composition:?}, on {}", gpu.describe());
+        Ok(Screen {
+            window,
+            gpu,
+            surface,
+            config,
+            composition,
+            egui,
+            input,
+            painter,
+            zero_size,
+            started: Instant::now(),
+            failing: None,
+            panel: None,
+            upscale,
+        })
     }
 
     /// The surface's size in physical pixels.
@@ -85,28 +171,134 @@ impl Screen {
         (self.config.width, self.config.height)
     }
 
+    /// The format the 3D view's image must have: the surface's own bytes to copy in, else what
+    /// egui samples from (see `raster_view`).
+    pub fn image_format(&self) -> wgpu::TextureFormat {
+        match self.composition {
+            Composition::Copied => self.config.format.add_srgb_suffix(),
+            Composition::Textured => crate::raster::OUTPUT_FORMAT,
+        }
+    }
+
     /// Follows the window's new size; a zero size (minimised) is remembered and drawn no more.
     pub fn resize(&mut self, size: winit::dpi::PhysicalSize<u32>) {
-        if size.width == 0 || size.height == 0 {
+        self.zero_size = size.width == 0 || size.height == 0;
+        if self.zero_size {
             return;
         }
         self.config.width = size.width;
         self.config.height = size.height;
-        self.surface.configure(&self.gpu.device, &self.config);
+        self.configure();
+    }
+
+    /// Configures the surface at the size last reported; an error is kept as a failing surface.
+    fn configure(&mut self) {
+        if let Err(e) = self.gpu.checked(|| self.surface.configure(&self.gpu.device, &self.config)) {
+            self.fail(format!("configuring it: {e}"));
+        }
+    }
+
+    fn fail(&mut self, error: String) {
+        log::info!("the window's surface failed: {error}");
+        let since = self.failing.take().map_or_else(Instant::now, |(since, _)| since);
+        self.failing = Some((since, error));
+    }
+
+    /// The surface's error once it has failed every frame for a while: the viewer stops with it.
+    pub fn surface_failing(&self) -> Option<String> {
+        let (since, error) = self.failing.as_ref()?;
+        (since.elapsed() >= FAILING_FOR).then(|| format!("the window's surface keeps failing: {error}"))
     }
 
     /// Whether the window has no pixels (minimised): rendering is skipped.
     pub fn is_minimised(&self) -> bool {
-        let size = self.window.inner_size();
-        size.width == 0 || size.height == 0 || self.window.is_minimized() == Some(true)
+        self.zero_size || self.window.is_minimized() == Some(true)
     }
 
-    /// Tessellates and draws egui's output into the window; with `screenshot`, also draws it into
-    /// an offscreen texture and writes that as a PNG (atomically).
-    pub fn paint(&mut self, output: egui::FullOutput, screenshot: Option<&Path>) -> anyhow::Result<Presented> {
+    /// egui's input since the last frame. `egui_winit::State::take_egui_input` would do, but it
+    /// asks the window its size (see the module's header).
+    pub fn take_input(&mut self) -> egui::RawInput {
+        let pixels_per_point = egui_winit::pixels_per_point(&self.egui, &self.window);
+        let native = self.window.scale_factor() as f32;
+        let (width, height) = self.size();
+        let zero_size = self.zero_size;
+        let raw = self.input.egui_input_mut();
+        raw.time = Some(self.started.elapsed().as_secs_f64());
+        let points = egui::vec2(width as f32, height as f32) / pixels_per_point;
+        raw.screen_rect = (!zero_size).then(|| egui::Rect::from_min_size(egui::Pos2::ZERO, points));
+        raw.viewport_id = egui::ViewportId::ROOT;
+        raw.viewports.entry(egui::ViewportId::ROOT).or_default().native_pixels_per_point = Some(native);
+        raw.take()
+    }
+
+    /// The next image of the surface, or `None` (and the surface mended) when it is not ready.
+    fn acquire(&mut self) -> Option<(wgpu::SurfaceTexture, bool)> {
+        let current = match self.gpu.checked(|| self.surface.get_current_texture()) {
+            Ok(current) => current,
+            Err(e) => {
+                self.fail(format!("getting its image: {e}"));
+                return None;
+            }
+        };
+        match current {
+            wgpu::CurrentSurfaceTexture::Success(frame) => Some((frame, false)),
+            wgpu::CurrentSurfaceTexture::Suboptimal(frame) => Some((frame, true)),
+            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => None,
+            wgpu::CurrentSurfaceTexture::Outdated => {
+                self.configure();
+                None
+            }
+            wgpu::CurrentSurfaceTexture::Lost => {
+                match self.gpu.instance.create_surface(self.window.clone()) {
+                    Ok(surface) => {
+                        self.surface = surface;
+                        self.configure();
+                    }
+                    Err(e) => self.fail(format!("recreating it: {e}")),
+                }
+                None
+            }
+            wgpu::CurrentSurfaceTexture::Validation => {
+                self.fail("a validation error".into());
+                None
+            }
+        }
+    }
+
+    /// Composes the window from egui's output and the 3D view's image: with
+    /// [`Composition::Copied`], `view` is copied in, the panel copied from its cache (drawn again
+    /// first if its shapes changed), and egui draws the rest over them; otherwise egui draws it all.
+    /// With `screenshot`, composes the same into an offscreen texture and writes that as a PNG
+    /// (atomically).
+    pub fn paint(
+        &mut self,
+        output: egui::FullOutput,
+        view: Option<ViewImage>,
+        screenshot: Option<&Path>,
+    ) -> anyhow::Result<Presented> {
         self.input.handle_platform_output(&self.window, output.platform_output);
-        let jobs = self.egui.tessellate(output.shapes, output.pixels_per_point);
+        let pixels_per_point = output.pixels_per_point;
+        let view = view.filter(|_| self.composition == Composition::Copied);
         let mut textures = output.textures_delta;
+        // A changed font atlas changes the panel's glyphs without changing its shapes.
+        let atlas_changed = !textures.set.is_empty();
+        let mut shapes = output.shapes;
+        let mut panel = None;
+        if let Some(image) = view
+            && image.rect[0] > 0
+        {
+            let edge = image.rect[0];
+            let rest = shapes.split_off(panel_shapes(&shapes, edge as f32 / pixels_per_point));
+            let front = std::mem::replace(&mut shapes, rest);
+            let kept = self.panel.as_ref().is_some_and(|cache| {
+                cache.width == edge
+                    && cache.pixels_per_point == pixels_per_point
+                    && cache.texture.size() == self.surface_size()
+                    && cache.shapes == front
+            });
+            panel = Some((edge, (!kept || atlas_changed).then_some(front)));
+        }
+        let jobs = self.egui.tessellate(shapes, pixels_per_point);
         for (id, deltas) in textures.set.drain() {
             for delta in &deltas {
                 self.painter.update_texture(&self.gpu.device, &self.gpu.queue, id, delta);
@@ -114,73 +306,97 @@ impl Screen {
         }
         let freed: Vec<egui::TextureId> = textures.free.drain().collect();
         textures.clear();
-        let frame = match self.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(frame) => Some((frame, false)),
-            wgpu::CurrentSurfaceTexture::Suboptimal(frame) => Some((frame, true)),
-            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => None,
-            wgpu::CurrentSurfaceTexture::Outdated => {
-                self.resize(self.window.inner_size());
-                None
-            }
-            wgpu::CurrentSurfaceTexture::Lost => {
-                self.surface =
-                    self.gpu.instance.create_surface(self.window.clone()).context("recreating the lost surface")?;
-                self.resize(self.window.inner_size());
-                None
-            }
-            wgpu::CurrentSurfaceTexture::Validation => {
-                log::warn!("the surface reported a validation error; frame skipped");
-                None
-            }
-        };
-        let Some((frame, suboptimal)) = frame else {
+        let acquired = self.acquire();
+        let Some((frame, suboptimal)) = acquired else {
             for id in &freed {
                 self.painter.free_texture(id);
             }
             return Ok(Presented::Skipped);
         };
-        let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [self.config.width, self.config.height],
-            pixels_per_point: output.pixels_per_point,
+            pixels_per_point,
         };
+        if let Some((width, Some(front))) = &mut panel {
+            self.draw_panel(*width, std::mem::take(front), &screen);
+        }
+        let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer::ui") });
         let extra = self.painter.update_buffers(device, queue, &mut encoder, &jobs, &screen);
-        let view = frame
-            .texture
-            .create_view(&wgpu::TextureViewDescriptor { label: Some("viewer::surface_view"), ..Default::default() });
-        self.record_ui(&mut encoder, &view, &jobs, &screen);
+        let panel = panel.and(self.panel.as_ref());
+        let copies = Copies { view, panel };
+        let mut composer = Composer { device, painter: &self.painter, upscale: self.upscale.as_mut() };
+        composer.compose(&mut encoder, &frame.texture, &copies, (&jobs, &screen));
         let shot = screenshot.map(|_| {
-            let texture =
-                crate::gpu::texture::GpuTexture::target(device, "viewer::screenshot", self.size(), self.config.format);
-            self.record_ui(&mut encoder, &texture.view, &jobs, &screen);
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("viewer::screenshot"),
+                size: frame.texture.size(),
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: self.config.format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::COPY_DST
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            composer.compose(&mut encoder, &texture, &copies, (&jobs, &screen));
             texture
         });
         queue.submit(extra.into_iter().chain([encoder.finish()]));
-        queue.present(frame);
+        if let Err(e) = self.gpu.checked(|| queue.present(frame)) {
+            self.fail(format!("presenting: {e}"));
+        } else {
+            self.failing = None;
+        }
         for id in &freed {
             self.painter.free_texture(id);
         }
         if suboptimal {
-            self.resize(self.window.inner_size());
+            self.configure();
         }
         if let (Some(path), Some(texture)) = (screenshot, shot) {
-            self.write_screenshot(&texture.texture, path)?;
+            self.write_screenshot(&texture, path)?;
         }
         Ok(Presented::Shown)
     }
 
-    fn record_ui(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        target: &wgpu::TextureView,
-        jobs: &[egui::ClippedPrimitive],
+    fn surface_size(&self) -> wgpu::Extent3d {
+        wgpu::Extent3d { width: self.config.width, height: self.config.height, depth_or_array_layers: 1 }
+    }
+
+    /// Draws the panel's shapes into its cache, in a submission of its own: egui's painter keeps
+    /// one vertex buffer, which the rest of the frame's shapes overwrite.
+    fn draw_panel(
+        &mut self,
+        width: u32,
+        shapes: Vec<egui::epaint::ClippedShape>,
         screen: &egui_wgpu::ScreenDescriptor,
     ) {
+        let size = self.surface_size();
+        let texture = match self.panel.take() {
+            Some(cache) if cache.texture.size() == size => cache.texture,
+            _ => self.gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("viewer::panel"),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: self.config.format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            }),
+        };
+        let jobs = self.egui.tessellate(shapes.clone(), screen.pixels_per_point);
+        let (device, queue) = (&self.gpu.device, &self.gpu.queue);
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer::panel") });
+        let extra = self.painter.update_buffers(device, queue, &mut encoder, &jobs, screen);
+        let view = texture.create_view(&wgpu::TextureViewDescriptor { label: Some("viewer::panel_view"), ..Default::default() });
         let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("viewer::ui_pass"),
+            label: Some("viewer::panel_pass"),
             color_attachments: &[Some(crate::gpu::layout::color_attachment(
-                target,
+                &view,
                 wgpu::LoadOp::Clear(wgpu::Color::BLACK),
             ))],
             depth_stencil_attachment: None,
@@ -188,27 +404,126 @@ impl Screen {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        self.painter.render(&mut pass.forget_lifetime(), jobs, screen);
+        self.painter.render(&mut pass.forget_lifetime(), &jobs, screen);
+        queue.submit(extra.into_iter().chain([encoder.finish()]));
+        self.panel = Some(PanelCache { texture, width, pixels_per_point: screen.pixels_per_point, shapes });
     }
 
     fn write_screenshot(&self, texture: &wgpu::Texture, path: &Path) -> anyhow::Result<()> {
-        let format = self.config.format;
-        if format.block_copy_size(None) != Some(4) {
-            anyhow::bail!("screenshots of a {format:?} surface are not supported");
-        }
-        let mut pixels =
-            readback::read_rgba8(&self.gpu.device, &self.gpu.queue, texture).context("reading the screenshot back")?;
-        if matches!(format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb) {
-            for texel in pixels.chunks_exact_mut(4) {
-                texel.swap(0, 2);
-            }
-        }
-        for texel in pixels.chunks_exact_mut(4) {
-            texel[3] = 255;
-        }
-        let (width, height) = self.size();
-        let image = image::RgbaImage::from_raw(width, height, pixels).expect("one RGBA8 texel per pixel");
-        crate::output::write_png_atomically(&image, path)
+        let pixels = read_image(&self.gpu, texture).context("reading the screenshot back")?;
+        crate::output::write_png_atomically(&pixels, path)
             .with_context(|| format!("{}: cannot write the screenshot", path.display()))
     }
+}
+
+/// What composes a window: the device, egui's painter and the upscale pass.
+struct Composer<'a> {
+    device: &'a wgpu::Device,
+    painter: &'a egui_wgpu::Renderer,
+    upscale: Option<&'a mut Upscale>,
+}
+
+impl Composer<'_> {
+    /// Records one composed window into `target`: the copies, then egui's shapes over them.
+    fn compose(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::Texture,
+        copies: &Copies,
+        (jobs, screen): (&[egui::ClippedPrimitive], &egui_wgpu::ScreenDescriptor),
+    ) {
+        let target_view =
+            target.create_view(&wgpu::TextureViewDescriptor { label: Some("viewer::window_view"), ..Default::default() });
+        let pass = |encoder: &mut wgpu::CommandEncoder, label, load| {
+            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(label),
+                color_attachments: &[Some(crate::gpu::layout::color_attachment(&target_view, load))],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            })
+            .forget_lifetime()
+        };
+        let (width, height) = (target.width(), target.height());
+        let copy = |encoder: &mut wgpu::CommandEncoder, source: &wgpu::Texture, (x, y): (u32, u32), (w, h)| {
+            let (w, h) = (u32::min(w, width.saturating_sub(x)), u32::min(h, height.saturating_sub(y)));
+            if w > 0 && h > 0 {
+                let destination = wgpu::TexelCopyTextureInfo {
+                    texture: target,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x, y, z: 0 },
+                    aspect: wgpu::TextureAspect::All,
+                };
+                let extent = wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 };
+                encoder.copy_texture_to_texture(source.as_image_copy(), destination, extent);
+            }
+        };
+        let load = match copies.view {
+            Some(image) => {
+                let panel_width = copies.panel.map_or(0, |p| p.width);
+                let [x, y, w, h] = image.rect;
+                // The view and the panel tile the window but for rounding or a hidden panel;
+                // what they leave is cleared first.
+                if !(x == panel_width && y == 0 && x + w >= width && h >= height) {
+                    drop(pass(encoder, "viewer::clear_pass", wgpu::LoadOp::Clear(wgpu::Color::BLACK)));
+                }
+                if let Some(panel) = copies.panel {
+                    copy(encoder, &panel.texture, (0, 0), (panel.width, height));
+                }
+                let size = image.texture.size();
+                match &mut self.upscale {
+                    Some(upscale) if (size.width, size.height) != (w, h) => {
+                        let [w, h] = [w.min(width.saturating_sub(x)), h.min(height.saturating_sub(y))];
+                        if w > 0 && h > 0 {
+                            upscale.record(self.device, encoder, image.plain, &target_view, [x, y, w, h]);
+                        }
+                    }
+                    _ => copy(encoder, image.texture, (x, y), (size.width, size.height)),
+                }
+                wgpu::LoadOp::Load
+            }
+            None => wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+        };
+        self.painter.render(&mut pass(encoder, "viewer::ui_pass", load), jobs, screen);
+    }
+}
+
+/// What [`Composer::compose`] copies into the window before egui draws.
+struct Copies<'a> {
+    view: Option<ViewImage<'a>>,
+    panel: Option<&'a PanelCache>,
+}
+
+/// How many of egui's shapes, from the front, draw only left of `edge` (in points): the side
+/// panel's, which egui lists first. The first shape that reaches into the view ends them, so
+/// whatever egui draws later (windows, tooltips, overlays) stays above them.
+pub fn panel_shapes(shapes: &[egui::epaint::ClippedShape], edge: f32) -> usize {
+    shapes
+        .iter()
+        .take_while(|clipped| {
+            let bounds = clipped.shape.visual_bounding_rect();
+            // An empty rectangle: the shape draws nothing.
+            !bounds.is_positive() || bounds.max.x <= edge + 1e-3
+        })
+        .count()
+}
+
+/// An 8-bit RGBA or BGRA texture (sRGB or not: the bytes are the encoded values) as an opaque
+/// RGBA image.
+pub fn read_image(gpu: &Gpu, texture: &wgpu::Texture) -> anyhow::Result<image::RgbaImage> {
+    let format = texture.format();
+    if format.block_copy_size(None) != Some(4) {
+        anyhow::bail!("reading back a {format:?} texture is not supported");
+    }
+    let mut pixels = readback::read_rgba8(&gpu.device, &gpu.queue, texture)?;
+    let bgra = matches!(format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
+    for texel in pixels.chunks_exact_mut(4) {
+        if bgra {
+            texel.swap(0, 2);
+        }
+        texel[3] = 255;
+    }
+    let (width, height) = (texture.width(), texture.height());
+    Ok(image::RgbaImage::from_raw(width, height, pixels).expect("one RGBA8 texel per pixel"))
 }

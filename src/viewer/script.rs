@@ -18,11 +18,15 @@
 //! probe                         print the volume ray under the cursor (one line on stdout)
 //! material kd=0.2               edit the picked object's material
 //! load FILE                     as if FILE were dropped on the window
-//! scale 0.5                     the render scale while the camera moves
+//! scale 0.5                     the lowest render scale while the camera moves (with `fps
+//!                               off`: the scale)
+//! fps 30 | fps off              the frame rate the render scale holds while the camera moves
 //! help on | panel off           show or hide the help window, the side panel
 //! overlay off                   hide the frame times over the 3D view
 //! wait 10                       let 10 frames pass
 //! wait traced                   until the ray-traced image (and difference) is complete
+//! measure                       start `--stats`' means at the next frame (else they start
+//!                               after the last step)
 //! screenshot FILE.png           the whole window, written atomically
 //! ```
 //!
@@ -54,11 +58,14 @@ pub enum Step {
     Material(String),
     Load(PathBuf),
     Scale(f32),
+    /// A target frame rate; 0: none.
+    Fps(f32),
     Help(bool),
     Panel(bool),
     Overlay(bool),
     Wait(u32),
     WaitTraced,
+    Measure,
     Screenshot(PathBuf),
 }
 
@@ -136,6 +143,15 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
             }
             Step::Scale(s)
         }
+        "fps" if args == "off" => Step::Fps(0.0),
+        "fps" => {
+            let [fps] = numbers(args).ok_or_else(|| fail("fps N or fps off"))?;
+            if !super::config::MOTION_FPS.contains(&fps) {
+                return Err(fail("the frame rate lies between 5 and 120"));
+            }
+            Step::Fps(fps)
+        }
+        "measure" => Step::Measure,
         "help" => Step::Help(switch(args).ok_or_else(|| fail("help on or help off"))?),
         "panel" => Step::Panel(switch(args).ok_or_else(|| fail("panel on or panel off"))?),
         "overlay" => Step::Overlay(switch(args).ok_or_else(|| fail("overlay on or overlay off"))?),
@@ -171,8 +187,11 @@ mod tests {
         assert_eq!(parse("wait traced").unwrap(), Step::WaitTraced);
         assert_eq!(parse("probe").unwrap(), Step::Probe);
         assert_eq!(parse("wait 3").unwrap(), Step::Wait(3));
+        assert_eq!(parse("fps 20").unwrap(), Step::Fps(20.0));
+        assert_eq!(parse("fps off").unwrap(), Step::Fps(0.0));
+        assert_eq!(parse("measure").unwrap(), Step::Measure);
         assert_eq!(parse("screenshot out.png").unwrap(), Step::Screenshot("out.png".into()));
-        for bad in ["view sideways", "orbit 1", "split 2", "set shadows", "screenshot a.jpg", "dance", "pick nan 1"] {
+        for bad in ["view sideways", "orbit 1", "split 2", "set shadows", "screenshot a.jpg", "dance", "pick nan 1", "fps 0"] {
             let error = parse(bad).unwrap_err().to_string();
             assert!(error.contains(bad.split_whitespace().next().unwrap()), "{bad}: {error}");
         }

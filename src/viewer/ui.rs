@@ -24,15 +24,15 @@ pub struct UiModel<'a> {
     pub scene: &'a mut SceneState,
     pub view: &'a mut ViewState,
     pub navigation: &'a mut Navigation,
-    pub raster: egui::TextureId,
+    /// The raster image as an egui texture, when egui draws it (`screen::Composition::Textured`);
+    /// otherwise the image is already in the window under the UI.
+    pub raster: Option<egui::TextureId>,
     pub traced: &'a TracedView,
     /// The key of the request the current view shows (to tell stale traced images).
     pub key: u64,
     pub stats: &'a FrameStats,
     /// The rasterizer's passes in the last frame: their times (when timed) and figures.
     pub passes: &'a [crate::raster::PassReport],
-    /// The render scale of this frame's raster image.
-    pub scale: f32,
     pub camera_error: &'a mut Option<String>,
     /// Messages for the user (settings refused, screenshots written), newest last.
     pub notices: &'a [String],
@@ -163,12 +163,7 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
             model.view.help_open = true;
         }
     });
-    ui.horizontal(|ui| {
-        ui.add(egui::Slider::new(&mut model.view.motion_scale, 0.25..=1.0).step_by(0.05)).on_hover_text(
-            "The render scale while the camera moves: fewer pixels, more frames; full resolution again when it stops.",
-        );
-        ui.label("scale when moving");
-    });
+    motion_budget(ui, model.view);
     ui.separator();
 
     egui::CollapsingHeader::new(egui::RichText::new("camera").strong()).id_salt("camera").show(ui, |ui| {
@@ -215,6 +210,32 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     }
 }
 
+/// The frame budget while the camera moves: a frame rate to hold and the lowest render scale.
+fn motion_budget(ui: &mut egui::Ui, view: &mut ViewState) {
+    use super::config::{DEFAULT_MOTION_FPS, MOTION_FPS, MOTION_SCALES};
+    ui.horizontal(|ui| {
+        let mut hold = view.motion_fps > 0.0;
+        let checkbox = ui.checkbox(&mut hold, "hold").on_hover_text(
+            "While the camera moves, lower the render scale as far as needed to hold this frame rate (measured \
+             frame times); full resolution again as soon as it stops.",
+        );
+        if checkbox.changed() {
+            view.motion_fps = if hold { DEFAULT_MOTION_FPS } else { 0.0 };
+        }
+        if hold {
+            ui.add(egui::Slider::new(&mut view.motion_fps, MOTION_FPS).step_by(1.0).suffix(" fps"));
+        }
+        ui.label("while moving");
+    });
+    ui.horizontal(|ui| {
+        ui.add(egui::Slider::new(&mut view.motion_scale, MOTION_SCALES).step_by(0.05)).on_hover_text(
+            "The lowest render scale while the camera moves (the scale itself when no frame rate is held): fewer \
+             pixels, more frames.",
+        );
+        ui.label(if view.motion_fps > 0.0 { "lowest scale" } else { "scale when moving" });
+    });
+}
+
 /// Rounds a rectangle to whole physical pixels, so images drawn into it are pixel-aligned.
 fn snap(rect: Rect, pixels_per_point: f32) -> Rect {
     let round =
@@ -237,21 +258,32 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
 
     let painter = ui.painter_at(rect);
     let full = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
+    // The raster image, under everything; dimmed while it stands in for an image still to come.
+    let raster_id = model.raster;
+    let raster = |dimmed: bool| {
+        let grey = Color32::from_gray(90);
+        match raster_id {
+            Some(id) => {
+                painter.image(id, rect, full, if dimmed { grey } else { Color32::WHITE });
+            }
+            // Already in the window: darken it to the same grey (egui blends the encoded values).
+            None if dimmed => {
+                painter.rect_filled(rect, 0.0, Color32::from_black_alpha(255 - grey.r()));
+            }
+            None => {}
+        }
+    };
     let traced = model.traced.image.as_ref();
     match model.view.mode {
-        ViewMode::Raster => {
-            painter.image(model.raster, rect, full, Color32::WHITE);
-        }
+        ViewMode::Raster => raster(false),
         ViewMode::Traced => match traced {
             Some(shown) => {
                 painter.image(shown.texture.id(), rect, full, Color32::WHITE);
             }
-            None => {
-                painter.image(model.raster, rect, full, Color32::from_gray(90));
-            }
+            None => raster(true),
         },
         ViewMode::Split => {
-            painter.image(model.raster, rect, full, Color32::WHITE);
+            raster(false);
             let x = (rect.min.x + model.view.split * rect.width()) * ppp;
             let x = x.round() / ppp;
             if let Some(shown) = traced {
@@ -264,9 +296,7 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
             Some(shown) if shown.key == model.key => {
                 painter.image(shown.texture.id(), rect, full, Color32::WHITE);
             }
-            _ => {
-                painter.image(model.raster, rect, full, Color32::from_gray(90));
-            }
+            _ => raster(true),
         },
     }
     let cursor = response.hover_pos().map(|p| (p - rect.min) * ppp).map(|p| Vec2::new(p.x, p.y));
@@ -395,9 +425,10 @@ fn divider(ui: &mut egui::Ui, model: &mut UiModel, rect: Rect, x: f32) {
 }
 
 /// Frame times, the traced image's progress and the difference's mean, in the view's top-right
-/// corner.
+/// corner: what the last frame cost. It asks for no frame itself: frames come only when something
+/// changes.
 fn overlay(ui: &egui::Ui, model: &UiModel, rect: Rect) {
-    let mut text = model.stats.overlay_text(model.scale);
+    let mut text = model.stats.overlay_text();
     for pass in model.passes {
         text += &format!("\n  {}", pass.name);
         if let Some(time) = pass.time {
@@ -432,16 +463,11 @@ fn overlay(ui: &egui::Ui, model: &UiModel, rect: Rect) {
             _ => "\nFLIP: waiting for the complete traced image".to_string(),
         };
     }
-    egui::Area::new(egui::Id::unique("mirador::frame_overlay"))
-        .fixed_pos(Pos2::new(rect.max.x - 8.0, rect.min.y + 8.0))
-        .pivot(egui::Align2::RIGHT_TOP)
-        .interactable(false)
-        .show(ui.ctx(), |ui| {
-            egui::Frame::popup(ui.style()).fill(Color32::from_black_alpha(170)).show(ui, |ui| {
-                ui.add(
-                    egui::Label::new(egui::RichText::new(text).monospace().color(Color32::WHITE).size(12.0))
-                        .wrap_mode(egui::TextWrapMode::Extend),
-                );
-            });
-        });
+    // Shadowed text, no panel behind it: a filled panel costs egui about 3 ms a frame on a
+    // software GPU, every frame the view changes under it (docs/performance.md).
+    let painter = ui.painter_at(rect);
+    let galley = painter.layout_no_wrap(text, egui::FontId::monospace(12.0), Color32::WHITE);
+    let at = Pos2::new(rect.max.x - 10.0 - galley.size().x, rect.min.y + 10.0);
+    painter.galley_with_override_text_color(at + egui::vec2(1.0, 1.0), galley.clone(), Color32::BLACK);
+    painter.galley(at, galley, Color32::WHITE);
 }

@@ -47,7 +47,9 @@ pub struct ViewState {
     pub mode: ViewMode,
     /// The split view's divider, as a fraction of the view's width.
     pub split: f32,
-    /// The render scale while the camera moves.
+    /// The frame rate held while the camera moves (0: none, draw at `motion_scale`).
+    pub motion_fps: f32,
+    /// The lowest render scale while the camera moves.
     pub motion_scale: f32,
     pub panel_open: bool,
     pub help_open: bool,
@@ -64,7 +66,8 @@ impl Default for ViewState {
         ViewState {
             mode: ViewMode::Raster,
             split: 0.5,
-            motion_scale: 0.5,
+            motion_fps: super::config::DEFAULT_MOTION_FPS,
+            motion_scale: super::config::DEFAULT_MOTION_SCALE,
             panel_open: true,
             help_open: false,
             overlay_open: true,

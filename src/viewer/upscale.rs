@@ -1,0 +1,114 @@
+//! The 3D view's image stretched over the view while the camera moves (`shaders/upscale.wgsl`).
+//!
+//! A moving frame is drawn at the render scale, the camera's image size included, so the
+//! rasterizer's work (tessellation by size on screen, every pass's pixels) shrinks with it; this
+//! pass then fills the view's rectangle of the window from the small image, bilinearly, between
+//! its sRGB-encoded values. At full scale the image is copied instead, byte for byte.
+//!
+//! Why not the present pass's own upscale (`raster.render_scale`): it reads four half-float texels
+//! and runs the tone curve at every window pixel, about 11 ms for a 950×720 view on a software GPU
+//! (lavapipe), where one 8-bit texture read over a quad costs a few; and the camera's size would
+//! stay the window's, tessellating for pixels that are not drawn.
+
+use crate::gpu::layout;
+
+pub struct Upscale {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+    /// The group reading the last image stretched, kept while that image is.
+    input: Option<(wgpu::TextureView, wgpu::BindGroup)>,
+}
+
+/// A rectangle of the target, in pixels: `x, y, width, height`.
+pub type Viewport = [u32; 4];
+
+impl Upscale {
+    /// A pass writing targets of `format`, which must be a plain (not sRGB) format, like the
+    /// image views it reads: the bytes move unchanged.
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Upscale {
+        let module = crate::shaders::module(device, "upscale::shader", crate::shaders::UPSCALE);
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("upscale::bind_group_layout"),
+            entries: &[
+                layout::texture(
+                    0,
+                    wgpu::TextureSampleType::Float { filterable: true },
+                    wgpu::TextureViewDimension::D2,
+                ),
+                layout::sampler(1, wgpu::SamplerBindingType::Filtering),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("upscale::layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("upscale::pipeline"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_upscale"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleStrip, ..Default::default() },
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_upscale"),
+                compilation_options: Default::default(),
+                targets: &[Some(format.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("upscale::sampler"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        Upscale { pipeline, layout, sampler, input: None }
+    }
+
+    /// Stretches `image` (a plain view) over `viewport` of `target`, keeping the rest of it.
+    pub fn record(
+        &mut self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        image: &wgpu::TextureView,
+        target: &wgpu::TextureView,
+        [x, y, width, height]: Viewport,
+    ) {
+        if self.input.as_ref().is_none_or(|(view, _)| view != image) {
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("upscale::bind_group"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(image) },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                ],
+            });
+            self.input = Some((image.clone(), group));
+        }
+        let (_, group) = self.input.as_ref().expect("made just above");
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("upscale::pass"),
+            color_attachments: &[Some(layout::color_attachment(target, wgpu::LoadOp::Load))],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.push_debug_group("upscale");
+        pass.set_viewport(x as f32, y as f32, width as f32, height as f32, 0.0, 1.0);
+        pass.set_scissor_rect(x, y, width, height);
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, group, &[]);
+        pass.draw(0..4, 0..1);
+        pass.pop_debug_group();
+    }
+}
