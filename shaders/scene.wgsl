@@ -1,7 +1,8 @@
 // The scene pass: every surface of the scene drawn from one view, shaded per fragment by the
 // illumination model (shaders/common/lighting.wgsl) for all lights, each weighted by its
 // visibility from the shadow pass, into the linear HDR target. One module serves every variant
-// (depth prepass, opaque, and the techniques to come); src/raster/scene_pass.rs says which.
+// (depth prepass, opaque, mirrors; the transparent, refracting and volume passes compose their
+// entry points into the same module); src/raster/scene_pass.rs says which.
 //
 // Toggles that switch code on or off are pipeline constants, not uniforms: a software GPU such
 // as lavapipe runs both sides of a branch on a uniform value, so a shader that merely skips

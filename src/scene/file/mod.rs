@@ -1054,9 +1054,9 @@ pub const PHYSICAL_WORLD: f32 = 0.0509;
 /// shoulder. OBJ and PLY files have neither, so they always get the framing camera and the light.
 ///
 /// A model is made for renderers that weight glass by Fresnel and bend light through it, so its
-/// glass gets both by default (docs/scene-format.md#bare-models): `terms.fresnel`, refraction
-/// through the environment cubes, and those cubes read with the ground as their proxy (a scene
-/// file keeps the course's defaults: neither, and infinitely far).
+/// glass gets both by default (docs/scene-format.md, "A bare model as the scene"):
+/// `terms.fresnel`, refraction through the environment cubes, and those cubes read with the
+/// ground as their proxy (a scene file keeps the course's defaults: neither, and infinitely far).
 fn load_bare_model(path: &Path, import: ModelImport) -> Result<Scene, SceneError> {
     let mut scene = empty_scene(path);
     scene.settings.terms.fresnel = true;
