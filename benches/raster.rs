@@ -16,9 +16,12 @@
 //!    each lookup (world cube, lat–long, sphere map, dynamic cubes kept) as a ratio to the frame
 //!    without lookups; a dynamic capture (six views per object) drawn every frame, and a sphere
 //!    map made every frame for a turning camera, as ratios to one plain frame.
-//! 6. Volumes: samples per second of the GPU ray-marching pass and of the tracer on a 256³ grid
+//! 6. Refraction, Fresnel and local cubes (`assets/scenes/refraction.toml`: a glass ball and a
+//!    chrome ball): each refraction choice, with and without Fresnel, and each parallax proxy, as
+//!    ratios to the frame with the course's straight rays; the glass's cube drawn every frame.
+//! 7. Volumes: samples per second of the GPU ray-marching pass and of the tracer on a 256³ grid
 //!    at 1280×720, with and without early termination, and the grid's memory on each side.
-//! 7. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
+//! 8. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
 //!    about a million triangles: upload, frame, triangles, beside `trace` of the same scene.
 //!
 //! Times are wall-clock from submit to the queue being idle (the median of several frames after
@@ -32,7 +35,9 @@ use mirador::gpu::texture::GpuTexture;
 use mirador::raster::{Figure, FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer, drawn_size};
 use mirador::scene::sphereflake::{sphere_count, sphereflake_toml};
 use mirador::scene::{Attenuation, Light, LightKind, Mesh, Object, Shape};
-use mirador::settings::{EnvironmentMap, Prepass, ShadowFit, SphereView, TransparencySort, VolumeGradient};
+use mirador::settings::{
+    EnvironmentMap, Parallax, Prepass, Refraction, ShadowFit, SphereView, TransparencySort, VolumeGradient,
+};
 use mirador::trace::whitted::RayCounts;
 use mirador::trace::{RenderControl, Tracer};
 use mirador::{RenderSettings, Scene};
@@ -466,6 +471,50 @@ fn environment_costs(gpu: &Gpu) {
     println!("{:>48} {:>9.1} ms {:>7.2}× a plain frame", "one sphere-map generation", sphere * 1e3, sphere / plain);
 }
 
+/// Refraction, Fresnel and the parallax proxies on the refraction stage at 1280×720: each case's
+/// frames interleaved with the others' (the VM's speed drifts over seconds), as ratios to the
+/// frame with straight rays and no Fresnel.
+fn refraction_costs(gpu: &Gpu) {
+    let mut scene = Scene::load(&mirador::scene::builtin_path("refraction.toml")).expect("the refraction scene");
+    scene.camera.width = 1280;
+    scene.camera.height = 720;
+    let base = scene.settings.clone();
+    let case = |refraction, fresnel, parallax, refresh| {
+        let mut s = base.clone();
+        s.transparency.refraction = refraction;
+        s.terms.fresnel = fresnel;
+        s.environment.parallax = parallax;
+        s.environment.refresh = refresh;
+        s
+    };
+    let cases = [
+        ("straight rays (none)", case(Refraction::None, false, Parallax::Infinite, 0)),
+        ("straight rays, Fresnel (two draws)", case(Refraction::None, true, Parallax::Infinite, 0)),
+        ("environment", case(Refraction::Environment, false, Parallax::Infinite, 0)),
+        ("environment, Fresnel", case(Refraction::Environment, true, Parallax::Infinite, 0)),
+        ("screen", case(Refraction::Screen, false, Parallax::Infinite, 0)),
+        ("screen, Fresnel", case(Refraction::Screen, true, Parallax::Infinite, 0)),
+        ("parallax ground (straight rays)", case(Refraction::None, false, Parallax::Ground, 0)),
+        ("parallax box (straight rays)", case(Refraction::None, false, Parallax::Box, 0)),
+        ("environment, cubes drawn every frame", case(Refraction::Environment, false, Parallax::Infinite, 1)),
+    ];
+    let mut benches: Vec<Bench> = cases.iter().map(|_| Bench::new(gpu, &scene)).collect();
+    let mut times = vec![Vec::new(); cases.len()];
+    for round in 0..FRAMES + 2 {
+        for (k, (_, settings)) in cases.iter().enumerate() {
+            let (t, _) = benches[k].frame(&scene, settings);
+            if round >= 2 {
+                times[k].push(t);
+            }
+        }
+    }
+    let medians: Vec<f64> = times.into_iter().map(|t| median(t).as_secs_f64()).collect();
+    println!("\nrefraction, 1280×720, a glass ball and a chrome ball, ratios to the frame with straight rays");
+    for (k, (name, _)) in cases.iter().enumerate() {
+        println!("{name:>48} {:>9.1} ms {:>7.2}×", medians[k] * 1e3, medians[k] / medians[0]);
+    }
+}
+
 /// The phantom on a 256³ grid (the `ct` preset), filling most of a 1280×720 frame.
 const VOLUME_SCENE: &str = r#"
 [camera]
@@ -602,7 +651,8 @@ fn main() {
     let quick = args.iter().any(|a| a == "--quick");
     // Section names on the command line run those sections alone:
     // `cargo bench --bench raster -- transparency`.
-    const SECTIONS: [&str; 7] = ["showcase", "shadows", "transparency", "mirrors", "environment", "volume", "growing"];
+    const SECTIONS: [&str; 8] =
+        ["showcase", "shadows", "transparency", "mirrors", "environment", "refraction", "volume", "growing"];
     let chosen: Vec<&str> = SECTIONS.into_iter().filter(|s| args.iter().any(|a| a == s)).collect();
     let run = |section: &str| chosen.is_empty() || chosen.contains(&section);
     let gpu = Gpu::headless().expect("the benchmark needs a graphics adapter");
@@ -621,6 +671,9 @@ fn main() {
     }
     if run("environment") {
         environment_costs(&gpu);
+    }
+    if run("refraction") {
+        refraction_costs(&gpu);
     }
     if run("volume") {
         volume_costs(&gpu);

@@ -6,7 +6,9 @@
 //! image of a mirror ball, for one view direction) or a latitude–longitude map. The cube can be
 //! drawn from the object's own centre, so it reflects its neighbours too (dynamic); the map is
 //! then right for what is far and wrong for what is near (parallax), since it holds what arrives
-//! at the centre and not at each point of the surface.
+//! at the centre and not at each point of the surface; a local lookup (`environment.parallax`,
+//! docs/course/08-environment-maps.md#parallax) reads the cube where the ray meets a proxy of
+//! the scene (its ground, or its box) instead, so what lies on the proxy lines up.
 //!
 //! Run with `cargo run --release --example environment_maps [OUT.png]`; writes
 //! `environment_maps.png` by default.
@@ -18,7 +20,7 @@ use glam::Vec3;
 use mirador::compare::sheet::{Panel, rows, sheet};
 use mirador::gpu::Gpu;
 use mirador::raster::Headless;
-use mirador::settings::{EnvironmentMap, EnvironmentView, SphereView};
+use mirador::settings::{EnvironmentMap, EnvironmentView, Parallax, SphereView};
 use mirador::{RenderSettings, Scene};
 
 const EXPLANATION: &str = "\
@@ -29,8 +31,10 @@ lat-long map | ray traced.
 Middle: the maps as images: the ball's dynamic cube unfolded as a cross | the sphere map | the
 lat-long map | a fixed sphere map seen after the camera turned (the reflections turn with the
 camera) | the same map made again for the new view.
-Bottom: parallax. A red wall near the ball, then ten times as far and as big: cube (left) against
-ray traced (right) for each.";
+Third row: parallax. A red wall near the ball, then ten times as far and as big: cube (left)
+against ray traced (right) for each.
+Bottom: the floor in the ball, local lookups: the cube read infinitely far (the course's rule) |
+read where the reflected ray meets the ground | ray traced.";
 
 fn main() -> anyhow::Result<()> {
     let out = std::env::args().nth(1).map_or_else(|| PathBuf::from("environment_maps.png"), PathBuf::from);
@@ -93,7 +97,12 @@ fn main() -> anyhow::Result<()> {
         raster("far wall: cube", &far, base.clone()),
         Panel::new("far wall: ray traced", mirador::trace::render_image(&far, &base)),
     ];
-    let image = rows(&[sheet(&top), sheet(&middle), sheet(&bottom)]);
+    let local = vec![
+        raster("cube, infinitely far", &scene, base.clone()),
+        raster("cube, on the ground", &scene, variant(&|s| s.environment.parallax = Parallax::Ground)),
+        Panel::new("ray traced", mirador::trace::render_image(&scene, &base)),
+    ];
+    let image = rows(&[sheet(&top), sheet(&middle), sheet(&bottom), sheet(&local)]);
     mirador::output::write_png_atomically(&image, &out).with_context(|| format!("writing {}", out.display()))?;
     println!("wrote {}", out.display());
     Ok(())

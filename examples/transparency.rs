@@ -8,7 +8,9 @@
 //! object (wrong where objects cut through each other), per triangle (wrong only where
 //! triangles intersect or overlap in a cycle) and depth peeling (exact at every pixel). A
 //! z-buffer cannot bend rays either: the ray tracer with `ior = 1` must agree with the exact
-//! order, and with `ior = 1.5` shows what refraction adds.
+//! order, and with `ior = 1.5` shows what refraction adds. The last row follows the bent rays in
+//! the rasterizer too (`transparency.refraction`, docs/course/06-transparency.md#refraction):
+//! through the glass ball's environment cube and through the opaque image, beside the tracer.
 //!
 //! Run with `cargo run --release --example transparency [OUT.png]`; writes `transparency.png` by
 //! default.
@@ -19,7 +21,7 @@ use anyhow::Context;
 use mirador::compare::sheet::{Panel, rows, sheet};
 use mirador::gpu::Gpu;
 use mirador::raster::Headless;
-use mirador::settings::TransparencySort;
+use mirador::settings::{Parallax, Refraction, TransparencySort};
 use mirador::{RenderSettings, Scene};
 
 const EXPLANATION: &str = "\
@@ -28,7 +30,10 @@ top: unsorted (file order, nearest pane first: the panes' colours stack wrongly)
 (one crossing pane covers the other on both sides of their intersection) | per triangle (the
 crossing panes' triangles split along their diagonals); bottom: exact (depth peeling) | ray
 traced with ior 1.0 (agrees with the exact order) | ray traced with ior 1.5 (refraction bends
-the post behind the sphere, which no z-buffer order can).";
+the post behind the sphere, which no z-buffer order can).
+Last row, a solid glass ball (ior 1.5) before three boxes: the course's straight rays | refracted
+through the ball's environment cube, read on the ground (parallax), with Fresnel | refracted in
+screen space (the opaque image behind), with Fresnel | ray traced, with Fresnel.";
 
 fn main() -> anyhow::Result<()> {
     let out = std::env::args().nth(1).map_or_else(|| PathBuf::from("transparency.png"), PathBuf::from);
@@ -58,7 +63,24 @@ fn main() -> anyhow::Result<()> {
         Panel::new("ray traced, ior 1.0", mirador::trace::render_image(&straight, &settings)),
         Panel::new("ray traced, ior 1.5", mirador::trace::render_image(&scene, &settings)),
     ];
-    let image = rows(&[sheet(&top), sheet(&bottom)]);
+    let glass = Scene::load(&mirador::scene::builtin_path("refraction.toml"))?;
+    let mut headless = Headless::new(&gpu, &glass);
+    let mut refracted = |label: &str, refraction: Refraction| {
+        let mut settings = glass.settings.clone();
+        settings.transparency.refraction = refraction;
+        settings.terms.fresnel = refraction != Refraction::None;
+        settings.environment.parallax = Parallax::Ground;
+        Panel::new(label, headless.render(&gpu, &glass, &settings))
+    };
+    let mut fresnel = glass.settings.clone();
+    fresnel.terms.fresnel = true;
+    let refraction = vec![
+        refracted("straight rays (the course)", Refraction::None),
+        refracted("through the environment cube", Refraction::Environment),
+        refracted("screen space", Refraction::Screen),
+        Panel::new("ray traced", mirador::trace::render_image(&glass, &fresnel)),
+    ];
+    let image = rows(&[sheet(&top), sheet(&bottom), sheet(&refraction)]);
     mirador::output::write_png_atomically(&image, &out).with_context(|| format!("writing {}", out.display()))?;
     println!("wrote {}", out.display());
     Ok(())

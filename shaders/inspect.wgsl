@@ -17,6 +17,7 @@ const INSPECT_TRANSPARENT: u32 = 3u;
 const INSPECT_BACKGROUND: u32 = 4u;
 const INSPECT_ISOSURFACE: u32 = 5u;
 const INSPECT_VOLUME: u32 = 6u;
+const INSPECT_REFRACTION: u32 = 7u;
 
 struct InspectLight {
     // Each part of S·L_dir, before the visibility.
@@ -64,8 +65,9 @@ struct InspectFragment {
     emission: vec3f,
     env_layer: i32,
     global_ambient: vec3f,
-    _pad0: f32,
-    // kps·MPS·L(r) looked up in an environment map, and r.
+    // Fresnel's F where the surface is glass with Fresnel on (at the entry, for refraction).
+    fresnel: f32,
+    // kps·MPS·L(r) looked up in an environment map (and glass's F·kt·Mt·L(r)), and r.
     environment: vec3f,
     _pad1: f32,
     env_direction: vec3f,
@@ -76,6 +78,15 @@ struct InspectFragment {
     // What the fragment returns: the radiance it shades (premultiplied by α where it blends).
     radiance: vec3f,
     _pad4: f32,
+    // Refraction (refraction.wgsl): the exit point p2 and whether the march found it (1), the
+    // direction t2 leaving the glass and F at the exit, the transmitted term and where L(t2)
+    // came from (1: the environment, 2: the opaque image).
+    refraction_exit: vec3f,
+    refraction_found: f32,
+    refracted_direction: vec3f,
+    fresnel_exit: f32,
+    refracted: vec3f,
+    refraction_source: f32,
     lights: array<InspectLight, MAX_LIGHTS>,
 }
 
@@ -131,6 +142,23 @@ fn fs_transparent_inspect(in: VertexOut) -> @location(0) vec4f {
     let out = transparent_fragment(in);
     probe.alpha = out.a;
     inspect_record(INSPECT_TRANSPARENT, in.clip, out.rgb);
+    return out;
+}
+
+@fragment
+fn fs_transparent_fresnel_inspect(in: VertexOut) -> @location(0) vec4f {
+    probe.object = in.object;
+    let out = transparent_fresnel_fragment(in);
+    probe.alpha = 1.0;
+    inspect_record(INSPECT_TRANSPARENT, in.clip, out.rgb);
+    return out;
+}
+
+@fragment
+fn fs_refraction_inspect(in: VertexOut) -> @location(0) vec4f {
+    probe.object = in.object;
+    let out = refraction_fragment(in);
+    inspect_record(INSPECT_REFRACTION, in.clip, out.rgb);
     return out;
 }
 

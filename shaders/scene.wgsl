@@ -1,7 +1,8 @@
 // The scene pass: every surface of the scene drawn from one view, shaded per fragment by the
 // illumination model (shaders/common/lighting.wgsl) for all lights, each weighted by its
 // visibility from the shadow pass, into the linear HDR target. One module serves every variant
-// (depth prepass, opaque, and the techniques to come); src/raster/scene_pass.rs says which.
+// (depth prepass, opaque, mirrors; the transparent, refracting and volume passes compose their
+// entry points into the same module); src/raster/scene_pass.rs says which.
 //
 // Toggles that switch code on or off are pipeline constants, not uniforms: a software GPU such
 // as lavapipe runs both sides of a branch on a uniform value, so a shader that merely skips
@@ -259,13 +260,40 @@ fn shading_normal(in: VertexOut, tangents: SurfaceTangents) -> vec3f {
     return n;
 }
 
-// The radiance leaving the surface towards the viewer: ME + AG + Σ_i V_i·S_i·L_dir.
+// The tangents ∂p/∂u, ∂p/∂v of the surface: from the change of position and uv across pixels
+// (screen-space derivatives: call in uniform control flow), or the interpolated per-vertex
+// tangent t and bitangent sign·(n × t), both unit length.
+fn surface_tangents(in: VertexOut) -> SurfaceTangents {
+    if TANGENTS_PER_VERTEX {
+        let t = normalize(in.tangent.xyz);
+        return SurfaceTangents(t, sign(in.tangent.w) * cross(normalize(in.normal), t), length(in.tangent.xyz) > 0.0);
+    }
+    return tangents_from_derivatives(dpdx(in.world), dpdy(in.world), dpdx(in.uv), dpdy(in.uv));
+}
+
+// What shading a fragment found: the radiance leaving it towards the viewer, and for the
+// passes that add transmission (transparency.wgsl, refraction.wgsl) the shading normal n (turned
+// to the viewer), the view vector v and L(r), the environment looked up along the reflected
+// direction (zero where the frame has no environment map or the object looks none up).
+struct Shaded {
+    radiance: vec3f,
+    n: vec3f,
+    v: vec3f,
+    environment: vec3f,
+}
+
+// The radiance leaving the surface towards the viewer: ME + AG + Σ_i V_i·S_i·L_dir, plus the
+// mirror term kps·MPS·L(r) of a curved mirror.
 fn shade(in: VertexOut) -> vec3f {
+    return shade_surface(in).radiance;
+}
+
+fn shade_surface(in: VertexOut) -> Shaded {
     // Screen-space derivatives first, in uniform control flow: the texture's level of detail and
     // the tangents ∂p/∂u, ∂p/∂v of the surface, from the change of position and uv across pixels.
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
-    var tangents = tangents_from_derivatives(dpdx(in.world), dpdy(in.world), duv_dx, duv_dy);
+    let tangents = surface_tangents(in);
     let color = surface_color(in.uv, duv_dx, duv_dy);
     if INSPECT {
         probe.world = in.world;
@@ -280,20 +308,15 @@ fn shade(in: VertexOut) -> vec3f {
         }
     }
     if FLAT_COLOUR {
-        return color;
-    }
-    if TANGENTS_PER_VERTEX {
-        // Interpolated per-vertex tangent t and bitangent sign·(n × t), both unit length.
-        let t = normalize(in.tangent.xyz);
-        tangents = SurfaceTangents(t, sign(in.tangent.w) * cross(normalize(in.normal), t), length(in.tangent.xyz) > 0.0);
+        return Shaded(color, normalize(in.normal), view_vector(in.world), vec3f(0.0));
     }
     let v = view_vector(in.world);
     let n = facing_viewer(shading_normal(in, tangents), v);
     if BUMP_VIEW == BUMP_VIEW_NORMALS {
-        return 0.5 + 0.5 * n;
+        return Shaded(0.5 + 0.5 * n, n, v, vec3f(0.0));
     }
     if BUMP_VIEW == BUMP_VIEW_TANGENTS {
-        return 0.5 + 0.5 * normalize(tangents.tu);
+        return Shaded(0.5 + 0.5 * normalize(tangents.tu), n, v, vec3f(0.0));
     }
     let surface = Surface(
         color, material.ka, material.kd, material.ks,
@@ -337,40 +360,47 @@ fn shade(in: VertexOut) -> vec3f {
     if checker >= 0.0 {
         radiance *= mix(0.55, 1.0, checker);
     }
+    var environment_radiance = vec3f(0.0);
     if ENVIRONMENT != 0u {
         // Looked up everywhere (its derivatives need uniform control flow), kept where the
         // object reflects through a map.
-        let reflected = material.reflectance * environment_reflection(n, v, in.env_layer);
-        radiance += select(vec3f(0.0), reflected, in.env_layer != ENV_LAYER_NONE);
+        let r = 2.0 * dot(n, v) * n - v;
+        environment_radiance = select(vec3f(0.0), environment_lookup(in.world, r, in.env_layer), in.env_layer != ENV_LAYER_NONE);
+        radiance += material.reflectance * environment_radiance;
         if INSPECT {
-            probe.environment = select(vec3f(0.0), reflected, in.env_layer != ENV_LAYER_NONE);
-            probe.env_direction = 2.0 * dot(n, v) * n - v;
+            probe.environment = material.reflectance * environment_radiance;
+            probe.env_direction = r;
             probe.env_layer = in.env_layer;
         }
     }
-    return radiance;
+    return Shaded(radiance, n, v, environment_radiance);
 }
 
-// L(r) for the mirror term kps·MPS·L(r) of a curved mirror (docs/course/08-environment-maps.md), r = 2(n·v)n − v
-// looked up in the environment map. The level of detail comes from r's change across the pixel,
-// taken here in uniform control flow, so a reflection minified on a small sphere is filtered
-// rather than aliased.
-fn environment_reflection(n: vec3f, v: vec3f, layer: i32) -> vec3f {
-    let r = 2.0 * dot(n, v) * n - v;
-    let drdx = dpdx(r);
-    let drdy = dpdy(r);
+// L(d), the radiance arriving at p from direction d, looked up in the environment map: for the
+// mirror term kps·MPS·L(r) of a curved mirror (docs/course/08-environment-maps.md), r = 2(n·v)n − v,
+// and for glass's reflection and refraction. An object's own dynamic cube is read along the
+// direction the parallax setting gives (parallax_direction). The level of detail comes from the
+// direction's change across the pixel, taken here in uniform control flow, so a reflection
+// minified on a small sphere is filtered rather than aliased.
+fn environment_lookup(p: vec3f, d: vec3f, layer: i32) -> vec3f {
+    var lookup = d;
+    if ENVIRONMENT == ENV_MAP_DYNAMIC && layer >= 0 {
+        lookup = parallax_direction(environment, p, d, environment.cube_centres[layer].xyz);
+    }
+    let dx = dpdx(lookup);
+    let dy = dpdy(lookup);
     if ENVIRONMENT == ENV_MAP_SPHERE {
-        let uv = sphere_map_uv(environment.sphere_from_world * r);
+        let uv = sphere_map_uv(environment.sphere_from_world * d);
         return textureSampleGrad(env_sphere, env_sampler, uv, dpdx(uv), dpdy(uv)).rgb;
     }
     if ENVIRONMENT == ENV_MAP_LATLONG {
-        let uv = latlong_uv(r);
+        let uv = latlong_uv(d);
         return textureSampleGrad(env_latlong, env_sampler, uv, latlong_gradient(dpdx(uv)), latlong_gradient(dpdy(uv))).rgb;
     }
     if ENVIRONMENT == ENV_MAP_DYNAMIC && layer >= 0 {
-        return textureSampleGrad(env_cubes, env_sampler, r, layer, drdx, drdy).rgb;
+        return textureSampleGrad(env_cubes, env_sampler, lookup, layer, dx, dy).rgb;
     }
-    return textureSampleGrad(env_cube, env_sampler, r, drdx, drdy).rgb;
+    return textureSampleGrad(env_cube, env_sampler, d, dx, dy).rgb;
 }
 
 // Coverage α: the material's alpha times its colour texture's (glTF's base colour alpha).

@@ -20,6 +20,50 @@ fn transparent_fragment(in: VertexOut) -> vec4f {
     return vec4f(alpha * shade(in), alpha);
 }
 
+// Glass that bends light, with Fresnel (terms.fresnel): kt·Mt splits into F·kt·Mt reflected and
+// (1 − F)·kt·Mt let through, and F changes across the surface, so one blend constant cannot
+// carry it. src/raster/transparency.rs draws such glass twice: fs_transparent_transmit
+// multiplies what the pixel holds by (1 − F)·kt·Mt (the blend computes dst·src), then
+// fs_transparent_fresnel adds the surface's own radiance and its reflected share,
+// Im + F·kt·Mt·L(r) (src + dst). Together: I = Im + F·kt·Mt·L(r) + (1 − F)·kt·Mt·I.
+
+// F at a fragment of glass. The rays go straight through here, so a far wall is met at the
+// angle the near one was: F is taken as entering at that angle, 1/ior, on both walls (by
+// reciprocity the exit at the refracted angle reflects as much: exact for a slab and a sphere,
+// where a bent ray leaves at the angle it entered). Taking the far wall as leaving at the
+// unbent angle would reflect everything past the critical angle: a dark ring no glass shows.
+fn glass_reflectance(n: vec3f, v: vec3f) -> f32 {
+    return fresnel(dot(n, v), 1.0 / material.ior);
+}
+
+@fragment
+fn fs_transparent_fresnel(in: VertexOut) -> @location(0) vec4f {
+    return transparent_fresnel_fragment(in);
+}
+
+fn transparent_fresnel_fragment(in: VertexOut) -> vec4f {
+    if masked_out(in.uv) {
+        discard;
+    }
+    let shaded = shade_surface(in);
+    let f = glass_reflectance(shaded.n, shaded.v);
+    if INSPECT {
+        probe.fresnel = f;
+        probe.environment += f * material.transmission * shaded.environment;
+    }
+    return vec4f(shaded.radiance + f * material.transmission * shaded.environment, 1.0);
+}
+
+@fragment
+fn fs_transparent_transmit(in: VertexOut) -> @location(0) vec4f {
+    if masked_out(in.uv) {
+        discard;
+    }
+    let v = view_vector(in.world);
+    let n = facing_viewer(shading_normal(in, surface_tangents(in)), v);
+    return vec4f((1.0 - glass_reflectance(n, v)) * material.transmission, 1.0);
+}
+
 // Depth peeling, the exact order (Everitt 2001, here back to front): layer k is the farthest
 // transparent surface that is nearer than the opaque surface and strictly nearer than layer
 // k − 1. The pass keeps the farthest survivor (depth test Greater); a second pass shades it.

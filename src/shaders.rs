@@ -5,6 +5,7 @@
 pub const COMMON: &[(&str, &str)] = &[
     ("common/types.wgsl", include_str!("../shaders/common/types.wgsl")),
     ("common/lighting.wgsl", include_str!("../shaders/common/lighting.wgsl")),
+    ("common/optics.wgsl", include_str!("../shaders/common/optics.wgsl")),
     ("common/bump.wgsl", include_str!("../shaders/common/bump.wgsl")),
     ("common/shadow.wgsl", include_str!("../shaders/common/shadow.wgsl")),
     ("common/environment.wgsl", include_str!("../shaders/common/environment.wgsl")),
@@ -17,6 +18,8 @@ pub const SCENE: &str = concat!(
     include_str!("../shaders/scene.wgsl"),
     "\n// ---- transparency.wgsl\n",
     include_str!("../shaders/transparency.wgsl"),
+    "\n// ---- refraction.wgsl\n",
+    include_str!("../shaders/refraction.wgsl"),
     "\n// ---- volume.wgsl\n",
     include_str!("../shaders/volume.wgsl"),
     "\n// ---- inspect.wgsl\n",

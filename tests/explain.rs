@@ -332,3 +332,47 @@ fn the_json_has_the_documented_fields() {
     }
     assert!(json.get("diagnosis").is_some());
 }
+
+/// The glass ball of assets/scenes/refraction.toml at a pixel through its middle, drawn by each
+/// refraction choice with Fresnel (and by the transparency pass's two Fresnel draws with
+/// straight rays): the raster terms add up to the pixel, name `F` and the refracted term, the
+/// path found leaves the glass where the tracer's ray does, and the diagnosis speaks of
+/// refraction.
+#[test]
+fn refracting_glass_is_explained_with_its_path_and_fresnel() {
+    use mirador::settings::Refraction;
+    let scene = common::load("scenes/refraction.toml");
+    let centre = scene.camera.project(Vec3::new(-0.2, 0.8, 0.6)).expect("in view");
+    let pixel = (centre.x as u32 - 10, centre.y as u32 - 10);
+    for refraction in [Refraction::None, Refraction::Environment, Refraction::Screen] {
+        let mut settings = scene.settings.clone();
+        settings.transparency.refraction = refraction;
+        settings.terms.fresnel = true;
+        let e = explained(&scene, &settings, pixel);
+        let raster = &e.raster;
+        assert!(
+            close_half(sum(&raster.terms), raster.radiance),
+            "{refraction:?}: terms add to {} but the pixel is {}: {:#?}",
+            sum(&raster.terms),
+            raster.radiance,
+            raster.terms
+        );
+        assert!(raster.terms.iter().any(|t| t.name.contains("F = 0.04")), "{refraction:?}: {:#?}", raster.terms);
+        let diagnosis = e.diagnosis.clone().unwrap_or_default();
+        if refraction == Refraction::None {
+            assert!(raster.layers.iter().all(|l| l.lets_through.x < 0.96 * 0.95), "(1 − F)·kt·Mt: {:?}", raster.layers);
+            assert!(diagnosis.contains("n_i = n_t"), "{diagnosis}");
+            continue;
+        }
+        let surface = raster.surface.as_ref().expect("the glass");
+        assert_eq!(surface.kind, "refraction");
+        let path = surface.refraction.as_ref().expect("the path through the glass");
+        let traced_in = e.trace.rays.children.iter().find(|c| c.kind == RayKind::Refracted).expect("into the glass");
+        let traced_out = traced_in.children.iter().find(|c| c.kind == RayKind::Refracted).expect("out of it");
+        let exit = path.exit.expect("the exit on the back faces");
+        assert!(exit.distance(traced_out.origin) < 0.02, "{refraction:?}: exit {exit} vs {}", traced_out.origin);
+        assert!(path.direction.angle_between(traced_out.direction) < 1f32.to_radians(), "{path:?}");
+        assert!(term(&raster.terms, "refracted").radiance.max_element() > 0.0);
+        assert!(diagnosis.contains("glass ball"), "{refraction:?}: {diagnosis}");
+    }
+}

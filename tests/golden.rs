@@ -44,6 +44,23 @@ fn transparency_stage_per_object_and_exact() {
     }
 }
 
+/// The refraction stage: the glass ball through the environment cube and in screen space, with
+/// Fresnel, and the cubes read on the ground (the chrome ball's floor).
+#[test]
+fn refraction_stage_through_the_environment_and_the_screen() {
+    use mirador::settings::{Parallax, Refraction};
+    let scene = common::load("scenes/refraction.toml");
+    for (name, refraction) in
+        [("refraction-environment", Refraction::Environment), ("refraction-screen", Refraction::Screen)]
+    {
+        let mut settings = scene.settings.clone();
+        settings.transparency.refraction = refraction;
+        settings.terms.fresnel = true;
+        settings.environment.parallax = Parallax::Ground;
+        common::assert_golden(name, &common::raster(&scene, &settings), TOLERANCE);
+    }
+}
+
 /// Two facing mirrors: the corridor of reflections at the default depth.
 #[test]
 fn facing_mirrors() {

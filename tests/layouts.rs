@@ -128,6 +128,7 @@ fn gpu_structs_match_their_wgsl_twins_field_by_field() {
             alpha_mode,
             reflectance,
             index,
+            ior,
         }),
     );
     check_struct(
@@ -153,6 +154,10 @@ fn gpu_structs_match_their_wgsl_twins_field_by_field() {
             sun_cos_inner,
             sun_color,
             background,
+            proxy_min,
+            parallax,
+            proxy_max,
+            cube_centres,
         }),
     );
     check_struct(&scene, "Shadows", size_of::<GpuShadows>(), &fields!(GpuShadows { layers, map_size, normal_offset }));
@@ -212,7 +217,7 @@ fn instance_attributes_match_the_wgsl_locations() {
 #[test]
 fn codes_shared_by_rust_and_wgsl_agree() {
     let module = parse(&shaders::compose(shaders::SCENE));
-    let codes: [(&str, f64); 35] = [
+    let codes: [(&str, f64); 43] = [
         ("MAX_LIGHTS", uniforms::MAX_LIGHTS as f64),
         ("MAX_SHADOW_LAYERS", MAX_LAYERS as f64),
         ("LIGHT_POINT", uniforms::LIGHT_POINT.into()),
@@ -224,6 +229,14 @@ fn codes_shared_by_rust_and_wgsl_agree() {
         ("TERM_DIFFUSE", uniforms::TERM_DIFFUSE.into()),
         ("TERM_SPECULAR", uniforms::TERM_SPECULAR.into()),
         ("TERM_EMISSION", uniforms::TERM_EMISSION.into()),
+        ("TERM_FRESNEL", uniforms::TERM_FRESNEL.into()),
+        ("MAX_ENV_CUBES", uniforms::MAX_ENV_CUBES as f64),
+        ("PARALLAX_INFINITE", uniforms::PARALLAX_INFINITE.into()),
+        ("PARALLAX_GROUND", uniforms::PARALLAX_GROUND.into()),
+        ("PARALLAX_BOX", uniforms::PARALLAX_BOX.into()),
+        ("REFRACTION_ENVIRONMENT", mirador::raster::refraction::REFRACTION_ENVIRONMENT.into()),
+        ("REFRACTION_SCREEN", mirador::raster::refraction::REFRACTION_SCREEN.into()),
+        ("INSPECT_REFRACTION", mirador::raster::inspect::INSPECT_REFRACTION.into()),
         ("SHADOWS_OFF", keys::SHADOWS_OFF.into()),
         ("SHADOWS_MAP", keys::SHADOWS_MAP.into()),
         ("SHADOWS_PROJECTED", keys::SHADOWS_PROJECTED.into()),
@@ -286,12 +299,13 @@ fn every_pipeline_constant_is_an_override_of_the_scene_shader() {
     let module = parse(&shaders::compose(shaders::SCENE));
     let overrides: Vec<String> = module.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect();
     let volume_names = mirador::raster::volume::VOLUME_CONSTANT_NAMES;
-    for name in CONSTANT_NAMES.iter().chain(&volume_names) {
+    let refraction_names = mirador::raster::refraction::REFRACTION_CONSTANT_NAMES;
+    for name in CONSTANT_NAMES.iter().chain(&volume_names).chain(&refraction_names) {
         assert!(overrides.iter().any(|o| o == name), "{name} is set by scene_pass.rs but is no override of scene.wgsl");
     }
     assert_eq!(
         overrides.len(),
-        CONSTANT_NAMES.len() + volume_names.len(),
+        CONSTANT_NAMES.len() + volume_names.len() + refraction_names.len(),
         "scene.wgsl has overrides scene_pass.rs never sets: {overrides:?}"
     );
 }

@@ -54,6 +54,8 @@ mirador compare "$course/shadows-methods.toml" "${mid[@]}" -o "$out/shadows-comp
 # 6. Transparency in Z order
 example transparency transparency.png
 mirador compare "$course/transparency-refraction.toml" "${mid[@]}" -o "$out/transparency-refraction.png"
+mirador compare "$course/transparency-refraction.toml" "${mid[@]}" -o "$out/transparency-refraction-screen.png" \
+    --set 'transparency.refraction="screen"' --set terms.fresnel=true
 
 # 7. Planar mirrors
 example planar_mirror planar_mirror.png
@@ -62,6 +64,8 @@ mirador compare "$course/mirror-pair.toml" "${mid[@]}" -o "$out/mirrors-compare.
 # 8. Environment maps
 example environment_maps environment_maps.png
 mirador compare "$course/environment-ball.toml" "${mid[@]}" -o "$out/environment-compare.png"
+mirador compare "$course/environment-ball.toml" "${mid[@]}" -o "$out/environment-ground.png" \
+    --set 'environment.parallax="ground"'
 
 # 9. Whitted ray tracing
 mirador trace "$course/whitted-depth.toml" "${small[@]}" --max-depth 0 -o "$out/whitted-depth-0.png"

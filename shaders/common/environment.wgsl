@@ -31,6 +31,44 @@ struct Environment {
     // Radiance of rays that hit nothing when there is no environment.
     background: vec3f,
     _pad1: f32,
+    // The parallax proxy (PARALLAX_*): the box around the scene, its bottom the ground.
+    proxy_min: vec3f,
+    parallax: u32,
+    proxy_max: vec3f,
+    _pad2: f32,
+    // Each dynamic cube's centre, where its six views were drawn from.
+    cube_centres: array<vec4f, MAX_ENV_CUBES>,
+}
+
+const MAX_ENV_CUBES: u32 = 8u;
+
+// Environment.parallax: where a dynamic cube's lookup assumes the ray ends.
+const PARALLAX_INFINITE: u32 = 0u;
+const PARALLAX_GROUND: u32 = 1u;
+const PARALLAX_BOX: u32 = 2u;
+
+// The direction to read a cube drawn from `centre` for the ray p + t·d (docs/course/
+// 08-environment-maps.md#parallax): d itself when the ray is taken to end infinitely far, else
+// the direction from the centre to where the ray meets the proxy: the ground plane (rays going
+// down), or the wall of the box it leaves through.
+fn parallax_direction(env: Environment, p: vec3f, d: vec3f, centre: vec3f) -> vec3f {
+    if env.parallax == PARALLAX_GROUND {
+        let ground = env.proxy_min.y;
+        if d.y < 0.0 && p.y > ground {
+            return p + ((ground - p.y) / d.y) * d - centre;
+        }
+        return d;
+    }
+    if env.parallax == PARALLAX_BOX {
+        // Slabs: the nearest of the far planes along d (p is inside the box).
+        let safe = select(d, vec3f(1e-12), abs(d) < vec3f(1e-12));
+        let far = max((env.proxy_min - p) / safe, (env.proxy_max - p) / safe);
+        let t = min(min(far.x, far.y), far.z);
+        if t > 0.0 {
+            return p + t * d - centre;
+        }
+    }
+    return d;
 }
 
 // The procedural sky: a gradient from the horizon up to the zenith and down to the ground, and a

@@ -20,6 +20,8 @@ const TERM_AMBIENT: u32 = 1u;
 const TERM_DIFFUSE: u32 = 2u;
 const TERM_SPECULAR: u32 = 4u;
 const TERM_EMISSION: u32 = 8u;
+// Not a term of the model: glass's reflection and transmission weighted by Fresnel.
+const TERM_FRESNEL: u32 = 16u;
 
 struct Light {
     position: vec3f,
@@ -101,6 +103,11 @@ struct Material {
     reflectance: vec3f,
     // The material's index in the scene (for inspecting a pixel).
     index: u32,
+    // The index of refraction, for Fresnel and refraction.
+    ior: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
 }
 
 // What a transparent surface lets through, the factor of I = Im + kt·Mt·I (docs/course/06-transparency.md):

@@ -30,7 +30,10 @@ pub fn diagnose(scene: &Scene, settings: &RenderSettings, raster: &RasterSide, t
     let traced_object = rays.hit.as_ref().and_then(|h| h.object.clone());
     let raster_object = raster.surface.as_ref().and_then(|s| s.object.clone());
     let background = raster.surface.as_ref().is_none_or(|s| s.kind == "background");
-    if background != rays.hit.is_none() || (!background && raster_object != traced_object && traced_object.is_some()) {
+    // The tracer's nearest hit may be a transparent layer the rasterizer blended over its surface.
+    let in_layers = traced_object.is_some() && raster.layers.iter().any(|l| l.object == traced_object);
+    let elsewhere = !background && raster_object != traced_object && traced_object.is_some() && !in_layers;
+    if (background && !in_layers) != rays.hit.is_none() || elsewhere {
         let seen = |name: Option<String>, none: bool| {
             if none { "nothing".to_string() } else { format!("`{}`", name.unwrap_or_else(|| "an isosurface".into())) }
         };
@@ -121,7 +124,9 @@ fn shadows(settings: &RenderSettings, raster: &RasterSide, rays: &RayNode) -> Op
     None
 }
 
-/// A transparent surface the tracer refracts through, where the rasterizer goes straight on.
+/// A transparent surface the tracer refracts through: where the rasterizer goes straight on
+/// (`transparency.refraction = "none"`), or where its path through the glass, found in screen
+/// space, leaves elsewhere than the tracer's.
 fn refraction(scene: &Scene, raster: &RasterSide, rays: &RayNode) -> Option<String> {
     let refracted = rays.children.iter().find(|c| c.kind == RayKind::Refracted)?;
     let hit = rays.hit.as_ref()?;
@@ -129,13 +134,53 @@ fn refraction(scene: &Scene, raster: &RasterSide, rays: &RayNode) -> Option<Stri
     if (material.ior - 1.0).abs() < 1e-3 || raster.layers.is_empty() && raster.surface.is_none() {
         return None;
     }
-    let bent = refracted.direction.angle_between(rays.direction).to_degrees();
-    let behind = refracted.hit.as_ref().and_then(|h| h.object.clone()).unwrap_or_else(|| "the environment".into());
+    let object = hit.object.clone().unwrap_or_default();
+    // The tracer's ray out of the glass: the refracted ray's own refracted child.
+    let out = refracted.children.iter().find(|c| c.kind == RayKind::Refracted);
+    let seen =
+        |node: &RayNode| node.hit.as_ref().and_then(|h| h.object.clone()).unwrap_or_else(|| "the environment".into());
+    let path = raster.surface.as_ref().and_then(|s| s.refraction.as_ref());
+    let Some(path) = path else {
+        let bent = refracted.direction.angle_between(rays.direction).to_degrees();
+        return Some(format!(
+            "Refraction is not modelled here: transparency.refraction = \"none\" takes n_i = n_t and looks straight \
+             through `{object}` (ior {}), while the tracer's refracted ray turns {bent:.1}° and sees {}.",
+            material.ior,
+            seen(out.unwrap_or(refracted))
+        ));
+    };
+    let Some(out) = out else {
+        return Some(format!(
+            "The tracer's ray does not leave `{object}` where it enters it refracted (it reflects inside, past the \
+             critical angle); the refraction pass follows one path in and out ({}).",
+            path.mode
+        ));
+    };
+    let exit_gap = path.exit.map_or(f32::INFINITY, |exit| exit.distance(out.origin));
+    let turn = path.direction.angle_between(out.direction).to_degrees();
+    let inside = refracted.children.iter().any(|c| c.kind == RayKind::Reflected);
+    if exit_gap < 0.02 && turn < 1.0 && inside {
+        return Some(format!(
+            "The path through `{object}` agrees with the tracer's (the exits {exit_gap:.3} apart, {turn:.1}° between the \
+             rays out); the difference is the light the tracer's rays reflected inside the glass bring, which the \
+             refraction pass leaves out, or what L(t2) reads from {}.",
+            path.source
+        ));
+    }
     Some(format!(
-        "Refraction is not modelled by the rasterizer: it takes n_i = n_t and looks straight through `{}` (ior {}), \
-         while the tracer's refracted ray turns {bent:.1}° and sees {behind}.",
-        hit.object.clone().unwrap_or_default(),
-        material.ior
+        "Refraction in {} space: the rasterizer's ray leaves `{object}` {} and {turn:.1}° off the tracer's, and reads L(t2) \
+         from {}; the tracer's leaves at ({:.2}, {:.2}, {:.2}) and sees {}.",
+        if path.mode == "screen" { "screen" } else { "environment-map" },
+        if exit_gap.is_finite() {
+            format!("{exit_gap:.3} from where the tracer's does")
+        } else {
+            "where no back face was found".into()
+        },
+        path.source,
+        out.origin.x,
+        out.origin.y,
+        out.origin.z,
+        seen(out)
     ))
 }
 

@@ -20,14 +20,14 @@ use serde::Serialize;
 use crate::gpu::Gpu;
 use crate::gpu::texture::GpuTexture;
 use crate::raster::inspect::{
-    GpuInspectFragment, INSPECT_BACKGROUND, INSPECT_ISOSURFACE, INSPECT_MIRROR, INSPECT_OPAQUE, INSPECT_TRANSPARENT,
-    INSPECT_VOLUME, RasterPixel,
+    GpuInspectFragment, INSPECT_BACKGROUND, INSPECT_ISOSURFACE, INSPECT_MIRROR, INSPECT_OPAQUE, INSPECT_REFRACTION,
+    INSPECT_TRANSPARENT, INSPECT_VOLUME, RasterPixel,
 };
 use crate::raster::shadow::views::shadow_layout_in;
 use crate::raster::uniforms::{UNKNOWN_OBJECT, transmittance};
 use crate::raster::{FrameTargets, OUTPUT_FORMAT, Renderer};
 use crate::scene::Scene;
-use crate::settings::{RenderSettings, ShadowMethod, TransparencySort};
+use crate::settings::{Refraction, RenderSettings, ShadowMethod, TransparencySort};
 use crate::trace::Tracer;
 use crate::trace::explain::{RayNode, RayTree, Term};
 
@@ -59,7 +59,8 @@ pub struct RasterSide {
 /// The surface the z-buffer kept at the pixel.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RasterSurface {
-    /// `opaque`, `mirror`, `isosurface` or `background`.
+    /// `opaque`, `mirror`, `refraction` (glass the refraction pass drew), `isosurface` or
+    /// `background`.
     pub kind: &'static str,
     pub object: Option<String>,
     pub material: Option<String>,
@@ -79,6 +80,28 @@ pub struct RasterSurface {
     pub environment: Option<EnvironmentLookup>,
     /// A planar mirror's: the mirrored camera and the texel of its image.
     pub mirror: Option<MirrorLookup>,
+    /// Glass that refracts: the ray's path through it.
+    pub refraction: Option<RefractionPath>,
+    /// Fresnel's `F` at the surface, for glass weighted by it.
+    pub fresnel: Option<f32>,
+}
+
+/// The path the refraction pass found through glass (`shaders/refraction.wgsl`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RefractionPath {
+    /// `environment` or `screen`.
+    pub mode: &'static str,
+    /// Where the ray leaves the glass, found against its back faces (`None`: not found, the
+    /// ray taken to go on unbent).
+    pub exit: Option<Vec3>,
+    /// The direction it leaves in, `t2`.
+    pub direction: Vec3,
+    /// Fresnel's `F` at the exit.
+    pub exit_fresnel: f32,
+    /// Where `L(t2)` was read: `the opaque image` or `the environment cube`.
+    pub source: &'static str,
+    /// `(1 − F1)·kt·Mt·(Im2 + (1 − F2)·kt·Mt·L(t2))`.
+    pub radiance: Vec3,
 }
 
 /// Bump mapping at the pixel: `k`, `Δ` and the slopes `(du, dv) = k·∇f_h`.
@@ -98,6 +121,9 @@ pub struct EnvironmentLookup {
     pub map: String,
     /// Where a dynamic cube was captured (its object's centre).
     pub centre: Option<Vec3>,
+    /// The direction the map was read along: `r`, or for a dynamic cube with a local proxy
+    /// (`environment.parallax`) the direction from its centre to where `r` meets the proxy.
+    pub read_along: Vec3,
     /// The cube face and texel (for cubes), or the map's texel coordinates.
     pub texel: String,
     /// `kps·MPS·L(r)`.
@@ -271,21 +297,26 @@ struct Kept<'r> {
 /// its layer's depth (layers farthest first, `peel_layers` of them).
 fn kept<'r>(scene: &Scene, settings: &RenderSettings, pixel: &'r RasterPixel) -> Kept<'r> {
     let records = &pixel.fragments;
-    let solid = |r: &&GpuInspectFragment| matches!(r.kind, INSPECT_OPAQUE | INSPECT_MIRROR | INSPECT_ISOSURFACE);
+    let solid = |r: &&GpuInspectFragment| {
+        matches!(r.kind, INSPECT_OPAQUE | INSPECT_MIRROR | INSPECT_ISOSURFACE | INSPECT_REFRACTION)
+    };
     let surface = records
         .iter()
         .filter(solid)
         .min_by(|a, b| a.depth.total_cmp(&b.depth))
         .or_else(|| records.iter().find(|r| r.kind == INSPECT_BACKGROUND));
     let depth = surface.filter(|s| s.kind != INSPECT_BACKGROUND).map_or(1.0, |s| s.depth);
-    // The blend's `kt·Mt`: the material's constant, or `1 − α` where a texture's alpha blends it
-    // per pixel (`crate::raster::transparency`); a volume lets `1 − α` through.
+    // The blend's `kt·Mt`: the material's constant, `(1 − F)·kt·Mt` for glass weighted by
+    // Fresnel, or `1 − α` where a texture's alpha blends it per pixel
+    // (`crate::raster::transparency`); a volume lets `1 − α` through.
     let lets_through = |r: &GpuInspectFragment| -> Vec3 {
         if r.kind == INSPECT_VOLUME {
             return Vec3::splat(1.0 - r.alpha);
         }
         let material = &scene.materials[r.material as usize];
-        if material.alpha_mode == crate::scene::AlphaMode::Blend && material.texture.is_some() {
+        if settings.terms.fresnel && material.bends_light() {
+            (1.0 - r.fresnel) * transmittance(material)
+        } else if material.alpha_mode == crate::scene::AlphaMode::Blend && material.texture.is_some() {
             Vec3::splat(1.0 - r.alpha)
         } else {
             transmittance(material)
@@ -397,8 +428,16 @@ fn fragment_terms(scene: &Scene, record: &GpuInspectFragment, name: &str, weight
             push(format!("light `{}`: {part} × V", light.name), l.visibility * radiance);
         }
     }
-    push("environment map kps·MPS·L(r)".into(), record.environment);
+    let reflection = if record.fresnel > 0.0 {
+        format!("reflection (kps·MPS + F·kt·Mt)·L(r) from the environment map, F = {:.4}", record.fresnel)
+    } else {
+        "environment map kps·MPS·L(r)".into()
+    };
+    push(reflection, record.environment);
     push("planar mirror kps·MPS·L(r)".into(), record.mirror);
+    if record.kind == INSPECT_REFRACTION {
+        push("refracted (1 − F1)·kt·Mt·(Im2 + (1 − F2)·kt·Mt·L(t2))".into(), record.refracted);
+    }
 }
 
 fn raster_surface(
@@ -409,12 +448,14 @@ fn raster_surface(
 ) -> RasterSurface {
     let kind = match record.kind {
         INSPECT_MIRROR => "mirror",
+        INSPECT_REFRACTION => "refraction",
         INSPECT_ISOSURFACE => "isosurface",
         INSPECT_BACKGROUND => "background",
         _ => "opaque",
     };
     let background = record.kind == INSPECT_BACKGROUND;
-    let reflective = scene.materials.get(record.material as usize).is_some_and(|m| m.mirror > 0.0);
+    let reflective =
+        scene.materials.get(record.material as usize).is_some_and(|m| m.mirror > 0.0 || record.fresnel > 0.0);
     let looked_up = record.kind != INSPECT_MIRROR && record.env_direction != Vec3::ZERO;
     let environment = (reflective && looked_up && !background).then(|| environment_lookup(scene, settings, record));
     let mirror = (record.kind == INSPECT_MIRROR).then(|| {
@@ -446,6 +487,15 @@ fn raster_surface(
         }),
         environment,
         mirror,
+        refraction: (record.kind == INSPECT_REFRACTION).then(|| RefractionPath {
+            mode: if settings.transparency.refraction == Refraction::Screen { "screen" } else { "environment" },
+            exit: (record.refraction_found > 0.0).then_some(record.refraction_exit),
+            direction: record.refracted_direction,
+            exit_fresnel: record.fresnel_exit,
+            source: if record.refraction_source > 1.5 { "the opaque image" } else { "the environment cube" },
+            radiance: record.refracted,
+        }),
+        fresnel: (record.fresnel > 0.0).then_some(record.fresnel),
     }
 }
 
@@ -460,10 +510,16 @@ fn environment_lookup(scene: &Scene, settings: &RenderSettings, record: &GpuInsp
                 .then(|| crate::raster::environment::object_centre(scene, record.object as usize).0)
         })
         .flatten();
+    let read_along = match (centre, scene.bounds()) {
+        (Some(centre), Some(bounds)) => {
+            crate::raster::environment::parallax_direction(env.parallax, bounds, record.world, r, centre).normalize()
+        }
+        _ => r,
+    };
     let (map, texel) = match env.map {
         EnvironmentMap::Cube => {
             let size = env.cube_size as f32;
-            let (face, uv) = crate::scene::environment::cube_face_uv(r);
+            let (face, uv) = crate::scene::environment::cube_face_uv(read_along);
             let faces = ["+X", "−X", "+Y", "−Y", "+Z", "−Z"];
             let name = if dynamic { "cube (dynamic, captured at the object's centre)" } else { "cube (the world's)" };
             (
@@ -477,7 +533,7 @@ fn environment_lookup(scene: &Scene, settings: &RenderSettings, record: &GpuInsp
             ("lat–long map".to_string(), format!("(u, v) = ({:.3}, {:.3})", uv.x, uv.y))
         }
     };
-    EnvironmentLookup { direction: r, map, centre, texel, radiance: record.environment }
+    EnvironmentLookup { direction: r, map, centre, read_along, texel, radiance: record.environment }
 }
 
 fn raster_lights(scene: &Scene, settings: &RenderSettings, record: &GpuInspectFragment) -> Vec<RasterLight> {

@@ -162,8 +162,22 @@ fn raster_reflections(raster: &RasterSide) -> Vec<String> {
     if let Some(e) = &s.environment {
         lines.push(format!("{} looked up along r = {}, {}: {}", e.map, v3(e.direction), e.texel, v3(e.radiance)));
         if let Some(c) = e.centre {
-            lines.push(format!("the cube was captured at {}", v3(c)));
+            lines.push(format!("the cube was captured at {}, read along {}", v3(c), v3(e.read_along)));
         }
+    }
+    if let Some(f) = s.fresnel {
+        lines.push(format!("Fresnel: F = {f:.4} of kt·Mt reflected"));
+    }
+    if let Some(r) = &s.refraction {
+        let exit = r.exit.map_or("not found (taken as unbent)".to_string(), v3);
+        lines.push(format!(
+            "refraction ({}): leaves the glass at {exit} along t2 = {}, F2 = {:.4}; L(t2) from {}: {}",
+            r.mode,
+            v3(r.direction),
+            r.exit_fresnel,
+            r.source,
+            v3(r.radiance)
+        ));
     }
     if let Some(m) = &s.mirror {
         lines.push(format!(

@@ -25,6 +25,28 @@ impl GpuTexture {
         GpuTexture { texture, view }
     }
 
+    /// An image that receives copies of a target (`COPY_DST`) for shaders to read: a frame's
+    /// depth or colour as it was before a pass draws over it.
+    pub fn copy_target(
+        device: &wgpu::Device,
+        label: &str,
+        size: (u32, u32),
+        format: wgpu::TextureFormat,
+    ) -> GpuTexture {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        GpuTexture { texture, view }
+    }
+
     pub fn from_rgba8(
         device: &wgpu::Device,
         queue: &wgpu::Queue,

@@ -196,6 +196,9 @@ pub struct TransparentObject {
     pub centre: Vec3,
     /// Its transform mirrors (negative determinant): its triangles' winding flips.
     pub flipped: bool,
+    /// Its material bends light (`Material::bends_light`): the refraction pass draws it when
+    /// refraction is on.
+    pub bends_light: bool,
 }
 
 /// Per object, what does not change while the scene stays: its material, and for curved shapes
@@ -350,6 +353,7 @@ impl SceneGeometry {
                     world_from_mesh,
                     centre: world_from_mesh.transform_point3(self.meshes[&mesh].centre),
                     flipped: world_from_mesh.determinant() < 0.0,
+                    bends_light: scene.materials[material].bends_light(),
                 });
             }
         }

@@ -31,6 +31,7 @@ pub const INSPECT_TRANSPARENT: u32 = 3;
 pub const INSPECT_BACKGROUND: u32 = 4;
 pub const INSPECT_ISOSURFACE: u32 = 5;
 pub const INSPECT_VOLUME: u32 = 6;
+pub const INSPECT_REFRACTION: u32 = 7;
 
 /// `InspectLight` of `shaders/inspect.wgsl`.
 #[repr(C)]
@@ -72,7 +73,7 @@ pub struct GpuInspectFragment {
     pub emission: Vec3,
     pub env_layer: i32,
     pub global_ambient: Vec3,
-    pub _pad0: f32,
+    pub fresnel: f32,
     pub environment: Vec3,
     pub _pad1: f32,
     pub env_direction: Vec3,
@@ -81,6 +82,12 @@ pub struct GpuInspectFragment {
     pub _pad3: f32,
     pub radiance: Vec3,
     pub _pad4: f32,
+    pub refraction_exit: Vec3,
+    pub refraction_found: f32,
+    pub refracted_direction: Vec3,
+    pub fresnel_exit: f32,
+    pub refracted: Vec3,
+    pub refraction_source: f32,
     pub lights: [GpuInspectLight; MAX_LIGHTS],
 }
 

@@ -5,9 +5,9 @@
 //! - **data**: what the passes read and share: [`targets`], [`keys`], [`uniforms`], [`view`],
 //!   [`geometry`], [`scene_gpu`] (the scene's buffers, textures, bind groups and the scene
 //!   shader), [`context`] (the frame context, encoder and report);
-//! - **passes**: [`shadow`], [`scene_pass`], [`transparency`], [`volume`], [`mirror`],
-//!   [`environment`], [`overlays`], [`present`], [`inspect`], each owning what it keeps per scene
-//!   and per target, with a `prepare` that hands out what can record;
+//! - **passes**: [`shadow`], [`scene_pass`], [`refraction`], [`transparency`], [`volume`],
+//!   [`mirror`], [`environment`], [`overlays`], [`present`], [`inspect`], each owning what it
+//!   keeps per scene and per target, with a `prepare` that hands out what can record;
 //! - **frame**: [`frame`] (the plan, [`Renderer`], and the one function that draws a view).
 
 pub mod context;
@@ -19,6 +19,7 @@ pub mod keys;
 pub mod mirror;
 pub mod overlays;
 pub mod present;
+pub mod refraction;
 pub mod scene_gpu;
 pub mod scene_pass;
 pub mod shadow;

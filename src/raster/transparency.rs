@@ -61,7 +61,8 @@ use wgpu::util::DeviceExt;
 use super::context::{Figure, FrameContext, FrameEncoder};
 use super::geometry::{DrawListId, TransparentObject, build_mesh};
 use super::keys::{FrameKey, MaterialKey, constants};
-use super::scene_gpu::{SceneGpu, SceneLayouts, SceneShader};
+use super::refraction::refracts;
+use super::scene_gpu::{SceneLayouts, SceneShader};
 use super::scene_pass::scissor;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
 use super::uniforms::{ALPHA_BLEND, GpuInstance, Vertex};
@@ -70,7 +71,7 @@ use super::volume::{RaySpan, VolumeSet};
 use crate::gpu::layout;
 use crate::gpu::texture::GpuTexture;
 use crate::scene::Scene;
-use crate::settings::TransparencySort;
+use crate::settings::{Refraction, TransparencySort};
 use crate::texture::tangents::tangents_or_generate;
 
 /// How the blend finds `kt·Mt`.
@@ -80,6 +81,10 @@ enum Blend {
     Constant,
     /// `1 − α`, with the fragment's coverage `α` in the source alpha.
     Coverage,
+    /// Glass weighted by Fresnel, first draw: `I·(1 − F)·kt·Mt`, the factor from the fragment.
+    Transmit,
+    /// Glass weighted by Fresnel, second draw: `Im + F·kt·Mt·L(r)` added.
+    Add,
 }
 
 /// Which faces a draw keeps, in the view's terms.
@@ -181,8 +186,7 @@ impl TransparencyPass {
             };
             let (steps, peel) = match sort {
                 TransparencySort::Exact => {
-                    let draws = (0..geometry.transparent.len())
-                        .filter(|&i| Some(geometry.transparent[i].object) != view.skip)
+                    let draws = drawn(ctx, view)
                         .map(|object| Step::Draw(Draw::Object { object, winding: Faces::Both }))
                         .collect();
                     (draws, Some(self.peel_index(ctx.device(), targets)))
@@ -198,12 +202,13 @@ impl TransparencyPass {
             let depth = if peel.is_some() { Depth::Equal } else { Depth::Less };
             for step in &steps {
                 if let Step::Draw(draw) = step {
-                    let key = pipeline_key(ctx.scene_gpu, view.key, draw, depth);
-                    self.pipelines.entry(key).or_insert_with(|| shading_pipeline(ctx, key));
+                    for key in pipeline_keys(ctx, view.key, draw, depth) {
+                        self.pipelines.entry(key).or_insert_with(|| shading_pipeline(ctx, key));
+                    }
                 }
             }
             if peel.is_some() {
-                for object in &geometry.transparent {
+                for object in drawn(ctx, view).map(|i| &geometry.transparent[i]) {
                     let key = (view.key, ctx.scene_gpu.material_keys[object.material]);
                     if !self.peel_pipelines.contains_key(&key) {
                         let pipeline = peel_pipeline(ctx, &self.peel_layout, key);
@@ -237,9 +242,11 @@ impl TransparencyPass {
     /// list first when the draw list changed. Returns whether it sorted.
     fn sort_triangles(&mut self, ctx: &FrameContext, view: &FrameView) -> bool {
         let geometry = &ctx.scene_gpu.geometry;
-        let current = geometry.draw_list();
+        let current = (geometry.draw_list(), ctx.settings.transparency.refraction);
         if self.triangles.as_ref().is_none_or(|t| t.geometry != current) {
-            self.triangles = Some(TriangleList::new(ctx.device(), ctx.scene, &geometry.transparent, current));
+            let objects: Vec<TransparentObject> =
+                geometry.transparent.iter().filter(|o| !refracts(ctx.settings, o)).cloned().collect();
+            self.triangles = Some(TriangleList::new(ctx.device(), ctx.scene, &objects, current));
         }
         let list = self.triangles.as_mut().expect("made just above");
         list.sort(ctx.device(), ctx.queue(), view.slot, view.view.eye, -view.view.view_axis)
@@ -299,7 +306,7 @@ fn object_steps(ctx: &FrameContext, view: &FrameView, sort: TransparencySort) ->
             winding: if objects[object].flipped != view.view.mirrored { faces.swapped() } else { faces },
         })
     };
-    let kept = (0..objects.len()).filter(|&i| Some(objects[i].object) != view.skip);
+    let kept = drawn(ctx, view);
     if sort == TransparencySort::Unsorted {
         let volumes = std::iter::once(Step::Volumes(VolumeSet::All));
         return volumes.chain(kept.map(|object| object_draw(object, Faces::Both))).collect();
@@ -320,14 +327,28 @@ fn object_steps(ctx: &FrameContext, view: &FrameView, sort: TransparencySort) ->
         .collect()
 }
 
-fn pipeline_key(scene_gpu: &SceneGpu, frame: FrameKey, draw: &Draw, depth: Depth) -> PipelineKey {
+/// The transparent objects this pass draws in `view`, by index: all but the one the view looks
+/// out of, and the glass the refraction pass draws.
+fn drawn<'c>(ctx: &'c FrameContext, view: &FrameView) -> impl Iterator<Item = usize> + 'c {
+    let objects = &ctx.scene_gpu.geometry.transparent;
+    let skip = view.skip;
+    (0..objects.len()).filter(move |&i| Some(objects[i].object) != skip && !refracts(ctx.settings, &objects[i]))
+}
+
+/// The pipelines of one draw, in the order they draw it: one blend, or for glass weighted by
+/// Fresnel the multiplication by `(1 − F)·kt·Mt` and then the addition of `Im + F·kt·Mt·L(r)`.
+fn pipeline_keys(ctx: &FrameContext, frame: FrameKey, draw: &Draw, depth: Depth) -> Vec<PipelineKey> {
+    let scene_gpu = ctx.scene_gpu;
     let (material, faces) = match *draw {
         Draw::Object { object, winding } => (scene_gpu.geometry.transparent[object].material, winding),
         Draw::Triangles { material, .. } => (material, Faces::Both),
     };
     let key = scene_gpu.material_keys[material];
+    if ctx.settings.terms.fresnel && ctx.scene.materials[material].bends_light() {
+        return vec![(Blend::Transmit, faces, depth, frame, key), (Blend::Add, faces, depth, frame, key)];
+    }
     let blend = if key.alpha_mode == ALPHA_BLEND && key.color_texture { Blend::Coverage } else { Blend::Constant };
-    (blend, faces, depth, frame, key)
+    vec![(blend, faces, depth, frame, key)]
 }
 
 /// The pass with every view's order decided and its pipelines compiled.
@@ -388,8 +409,6 @@ impl PreparedTransparency<'_> {
         depth: Depth,
     ) {
         let scene_gpu = ctx.scene_gpu;
-        let key = pipeline_key(scene_gpu, view.key, draw, depth);
-        pass.set_pipeline(&self.pass.pipelines[&key]);
         let material = match *draw {
             Draw::Object { object, .. } => scene_gpu.geometry.transparent[object].material,
             Draw::Triangles { material, .. } => material,
@@ -397,17 +416,20 @@ impl PreparedTransparency<'_> {
         let t = scene_gpu.transmittance[material].as_dvec3();
         pass.set_blend_constant(wgpu::Color { r: t.x, g: t.y, b: t.z, a: 1.0 });
         pass.set_bind_group(1, &scene_gpu.materials()[material], &[]);
-        match draw {
-            Draw::Object { object, .. } => {
-                let object: &TransparentObject = &scene_gpu.geometry.transparent[*object];
-                scene_gpu.geometry.draw_instances(pass, object.mesh, object.instance..object.instance + 1);
-            }
-            Draw::Triangles { indices, .. } => {
-                let list = self.pass.triangles.as_ref().expect("sorted in prepare");
-                pass.set_vertex_buffer(0, list.vertices.slice(..));
-                pass.set_vertex_buffer(1, list.identity.slice(..));
-                pass.set_index_buffer(list.orders[&view.slot].indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(indices.clone(), 0, 0..1);
+        for key in pipeline_keys(ctx, view.key, draw, depth) {
+            pass.set_pipeline(&self.pass.pipelines[&key]);
+            match draw {
+                Draw::Object { object, .. } => {
+                    let object: &TransparentObject = &scene_gpu.geometry.transparent[*object];
+                    scene_gpu.geometry.draw_instances(pass, object.mesh, object.instance..object.instance + 1);
+                }
+                Draw::Triangles { indices, .. } => {
+                    let list = self.pass.triangles.as_ref().expect("sorted in prepare");
+                    pass.set_vertex_buffer(0, list.vertices.slice(..));
+                    pass.set_vertex_buffer(1, list.identity.slice(..));
+                    pass.set_index_buffer(list.orders[&view.slot].indices.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(indices.clone(), 0, 0..1);
+                }
             }
         }
     }
@@ -425,7 +447,7 @@ impl PreparedTransparency<'_> {
         composite: &mut Composite,
     ) -> u64 {
         let scene_gpu = ctx.scene_gpu;
-        let objects = &scene_gpu.geometry.transparent;
+        let objects: Vec<&TransparentObject> = drawn(ctx, view).map(|i| &scene_gpu.geometry.transparent[i]).collect();
         let peel = &self.pass.peels[peel].1;
         let view_offset = [scene_gpu.views.offset(view.slot)];
         let mut recorded = 0;
@@ -447,7 +469,7 @@ impl PreparedTransparency<'_> {
                 // Layer 0 peels below the opaque depth alone; layer k below layer k − 1 too.
                 let limits = if layer == 0 { &peel.first } else { &peel.below[(layer - 1) % 2] };
                 pass.set_bind_group(3, limits, &[]);
-                for object in objects.iter().filter(|o| Some(o.object) != view.skip) {
+                for object in &objects {
                     let key = (view.key, scene_gpu.material_keys[object.material]);
                     pass.set_pipeline(&self.pass.peel_pipelines[&key]);
                     pass.set_bind_group(1, &scene_gpu.materials()[object.material], &[]);
@@ -504,18 +526,17 @@ fn begin<'e>(
     pass
 }
 
-/// `I = Im + kt·Mt·I`; the target's alpha is left as it is.
+/// `I = Im + kt·Mt·I` (or one of its two halves for glass weighted by Fresnel); the target's
+/// alpha is left as it is.
 fn blend_state(blend: Blend) -> wgpu::BlendState {
-    let dst_factor = match blend {
-        Blend::Constant => wgpu::BlendFactor::Constant,
-        Blend::Coverage => wgpu::BlendFactor::OneMinusSrcAlpha,
+    let (src_factor, dst_factor) = match blend {
+        Blend::Constant => (wgpu::BlendFactor::One, wgpu::BlendFactor::Constant),
+        Blend::Coverage => (wgpu::BlendFactor::One, wgpu::BlendFactor::OneMinusSrcAlpha),
+        Blend::Transmit => (wgpu::BlendFactor::Zero, wgpu::BlendFactor::Src),
+        Blend::Add => (wgpu::BlendFactor::One, wgpu::BlendFactor::One),
     };
     wgpu::BlendState {
-        color: wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor,
-            operation: wgpu::BlendOperation::Add,
-        },
+        color: wgpu::BlendComponent { src_factor, dst_factor, operation: wgpu::BlendOperation::Add },
         alpha: wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::Zero,
             dst_factor: wgpu::BlendFactor::One,
@@ -545,7 +566,13 @@ fn shading_pipeline(ctx: &FrameContext, key: PipelineKey) -> wgpu::RenderPipelin
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module: &ctx.shader.module,
-            entry_point: Some(if frame.inspect { "fs_transparent_inspect" } else { "fs_transparent" }),
+            entry_point: Some(match (blend, frame.inspect) {
+                (Blend::Transmit, _) => "fs_transparent_transmit",
+                (Blend::Add, false) => "fs_transparent_fresnel",
+                (Blend::Add, true) => "fs_transparent_fresnel_inspect",
+                (_, false) => "fs_transparent",
+                (_, true) => "fs_transparent_inspect",
+            }),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             targets: &[Some(wgpu::ColorTargetState {
                 format: HDR_FORMAT,
@@ -620,8 +647,9 @@ impl PeelTargets {
 /// view: buffer writes land before the frame's commands run, so views sharing one would all draw
 /// the last view's order.)
 struct TriangleList {
-    /// The draw list the triangles were taken from.
-    geometry: DrawListId,
+    /// The draw list the triangles were taken from, and the refraction setting (glass it draws
+    /// is left out).
+    geometry: (DrawListId, Refraction),
     vertices: wgpu::Buffer,
     /// One identity instance: the vertices are already in world space.
     identity: wgpu::Buffer,
@@ -644,7 +672,12 @@ struct SortedOrder {
 }
 
 impl TriangleList {
-    fn new(device: &wgpu::Device, scene: &Scene, objects: &[TransparentObject], geometry: DrawListId) -> TriangleList {
+    fn new(
+        device: &wgpu::Device,
+        scene: &Scene,
+        objects: &[TransparentObject],
+        geometry: (DrawListId, Refraction),
+    ) -> TriangleList {
         let mut vertices = Vec::new();
         let mut triangles = Vec::new();
         let mut centroids = Vec::new();

@@ -10,6 +10,10 @@ use crate::settings::RenderSettings;
 
 pub const MAX_LIGHTS: usize = 16;
 
+/// The most objects with a dynamic environment cube of their own (six views each); the others
+/// reflect the world's.
+pub const MAX_ENV_CUBES: usize = 8;
+
 /// `Light.kind` codes (`LIGHT_*` in `shaders/common/types.wgsl`).
 pub const LIGHT_POINT: u32 = 0;
 pub const LIGHT_DIRECTIONAL: u32 = 1;
@@ -22,6 +26,8 @@ pub const TERM_AMBIENT: u32 = 1;
 pub const TERM_DIFFUSE: u32 = 2;
 pub const TERM_SPECULAR: u32 = 4;
 pub const TERM_EMISSION: u32 = 8;
+/// Not a term of the model: glass's reflection and transmission weighted by Fresnel.
+pub const TERM_FRESNEL: u32 = 16;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -97,7 +103,8 @@ impl GpuFrame {
         let terms = bit(t.ambient, TERM_AMBIENT)
             | bit(t.diffuse, TERM_DIFFUSE)
             | bit(t.specular, TERM_SPECULAR)
-            | bit(t.emission, TERM_EMISSION);
+            | bit(t.emission, TERM_EMISSION)
+            | bit(t.fresnel, TERM_FRESNEL);
         GpuFrame {
             ambient: ambient.to_array(),
             light_count: lights.len().min(MAX_LIGHTS) as u32,
@@ -138,6 +145,9 @@ pub struct GpuMaterial {
     pub reflectance: [f32; 3],
     /// The material's index in the scene (set by the upload; for inspecting a pixel).
     pub index: u32,
+    /// The index of refraction, for Fresnel and refraction.
+    pub ior: f32,
+    pub _pad: [f32; 3],
 }
 
 /// `ALPHA_*` codes: how a material's coverage is read.
@@ -198,6 +208,8 @@ impl Material {
             alpha_mode: alpha_mode_code(self.alpha_mode),
             reflectance: (self.mirror * self.mirror_color).to_array(),
             index: 0,
+            ior: self.ior,
+            _pad: [0.0; 3],
         }
     }
 }
@@ -290,7 +302,19 @@ pub struct GpuEnvironment {
     pub _pad0: f32,
     pub background: [f32; 3],
     pub _pad1: f32,
+    /// The parallax proxy (`PARALLAX_*`): the box around the scene, its bottom the ground.
+    pub proxy_min: [f32; 3],
+    pub parallax: u32,
+    pub proxy_max: [f32; 3],
+    pub _pad2: f32,
+    /// Each dynamic cube's centre, where its six views were drawn from.
+    pub cube_centres: [[f32; 4]; MAX_ENV_CUBES],
 }
+
+/// `Environment.parallax`: where a dynamic cube's lookup assumes the ray ends.
+pub const PARALLAX_INFINITE: u32 = 0;
+pub const PARALLAX_GROUND: u32 = 1;
+pub const PARALLAX_BOX: u32 = 2;
 
 /// A 3×3 matrix as WGSL's `mat3x3f` lays it out: columns of four floats.
 pub fn mat3_columns(m: Mat3) -> [[f32; 4]; 3] {

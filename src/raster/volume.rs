@@ -352,7 +352,8 @@ impl VolumePass {
                 if isosurfaces {
                     self.pipeline(ctx, key(true, (false, false)));
                     if !self.depth_copies.iter().any(|(depth, _)| *depth == targets.depth.view) {
-                        let copy = depth_copy_target(ctx.device(), targets.size);
+                        let copy =
+                            GpuTexture::copy_target(ctx.device(), "volume::depth_copy", targets.size, DEPTH_FORMAT);
                         self.depth_copies.push((targets.depth.view.clone(), copy));
                     }
                 }
@@ -505,19 +506,4 @@ impl PreparedVolumes<'_> {
             pass.draw(0..36, 0..1);
         }
     }
-}
-
-fn depth_copy_target(device: &wgpu::Device, size: (u32, u32)) -> GpuTexture {
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("volume::depth_copy"),
-        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: DEPTH_FORMAT,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    let view = texture.create_view(&Default::default());
-    GpuTexture { texture, view }
 }

@@ -138,6 +138,12 @@ impl Material {
     pub fn is_transparent(&self) -> bool {
         self.transmission > 0.0 || self.alpha_mode == AlphaMode::Blend
     }
+
+    /// Whether rays through it bend (kt > 0 and ior ≠ 1; alpha-blended coverage passes straight
+    /// through): what the rasterizer's refraction draws, and what Fresnel weights.
+    pub fn bends_light(&self) -> bool {
+        self.transmission > 0.0 && self.ior != 1.0 && self.alpha_mode != AlphaMode::Blend
+    }
 }
 
 impl Default for Material {

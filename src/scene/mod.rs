@@ -14,6 +14,7 @@ pub mod light;
 pub mod material;
 pub mod mesh;
 pub mod obj;
+pub mod optics;
 pub mod ply;
 pub mod shading;
 pub mod sphereflake;

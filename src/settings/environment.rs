@@ -27,6 +27,10 @@ section! {
         /// changes (objects, materials, lights, settings; not the camera).
         #[values(unit("frames").slider(0.0, 600.0))]
         refresh: u32 = 0,
+        /// Where a dynamic cube's lookup assumes the reflected (or refracted) ray ends: infinitely
+        /// far (the course's rule: only the direction counts), or on a proxy of the scene, so
+        /// what is near lines up with the tracer (parallax correction).
+        parallax: Parallax = Parallax::Infinite,
         /// Whose view the sphere map is made for: the first frame's camera, or every frame's.
         sphere_view: SphereView = SphereView::Fixed,
         /// Teaching views over the frame (see `environment.inset`): the cube map unfolded as a
@@ -50,6 +54,22 @@ choices! {
         Sphere,
         /// Longitude and latitude of `r` (`α = a·u`, `β = b·v`), with explicit gradients.
         Latlong,
+    }
+}
+
+choices! {
+    /// Where the lookup of a dynamic cube assumes the ray ends
+    /// (docs/course/08-environment-maps.md#parallax).
+    pub enum Parallax {
+        /// Infinitely far: the cube is read along the ray's direction `r` alone.
+        Infinite,
+        /// On the scene's ground, the plane through its lowest point: a ray going down is read
+        /// along the direction from the cube's centre to where it meets the plane; a ray going up
+        /// along `r`.
+        Ground,
+        /// On the box around the scene: every ray is read along the direction from the cube's
+        /// centre to where it leaves the box (a room's walls).
+        Box,
     }
 }
 

@@ -362,7 +362,7 @@ macro_rules! choices {
         }
     ) => {
         $(#[$attr])*
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, ::serde::Serialize, ::serde::Deserialize, ::clap::ValueEnum)]
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, ::serde::Serialize, ::serde::Deserialize, ::clap::ValueEnum)]
         #[serde(rename_all = "snake_case")]
         pub enum $name {
             $( $(#[$variant_attr])* $variant, )+

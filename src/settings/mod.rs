@@ -28,14 +28,14 @@ mod transparency;
 mod volume;
 
 pub use bump::{BumpSettings, BumpView, TangentSource};
-pub use environment::{EnvironmentMap, EnvironmentSettings, EnvironmentView, SphereView};
+pub use environment::{EnvironmentMap, EnvironmentSettings, EnvironmentView, Parallax, SphereView};
 pub use mirrors::{MAX_MIRROR_DEPTH, MirrorSettings, MirrorView};
 pub use raster::{Prepass, RasterSettings};
 pub use shadows::{ShadowFilter, ShadowFit, ShadowMethod, ShadowSettings, ShadowView};
 pub use terms::TermSettings;
 pub use textures::{TextureFilter, TextureSettings, TracerLod};
 pub use trace::{AccelKind, AntiAliasing, TraceSettings};
-pub use transparency::{MAX_PEEL_LAYERS, TransparencySettings, TransparencySort};
+pub use transparency::{MAX_PEEL_LAYERS, Refraction, TransparencySettings, TransparencySort};
 pub use volume::{VOLUME_SAMPLES_WHITE, VolumeGradient, VolumeMode, VolumeReconstruction, VolumeSettings, VolumeView};
 
 use field::{choices, section};

@@ -1,5 +1,5 @@
 //! The terms of the illumination model (docs/course/02-illumination.md), each drawn or left out: teaching
-//! toggles.
+//! toggles; and Fresnel's weighting of glass (docs/course/06-transparency.md#fresnel).
 
 use super::field::section;
 
@@ -18,5 +18,11 @@ section! {
         specular: bool = true,
         /// `ME`, the material's own emitted radiance, added whatever the lights.
         emission: bool = true,
+        /// Fresnel's reflectance `F` of dielectrics (materials with `kt > 0`), exact for
+        /// unpolarized light: the transmitted share splits into `F·kt·MT` reflected and
+        /// `(1 − F)·kt·MT` transmitted, `F` rising from 4 % head-on (ior 1.5) to 1 at grazing
+        /// angles. Off: the course's model, all of `kt·MT` transmitted; `ior = 1` gives `F = 0`
+        /// either way.
+        fresnel: bool = false,
     }
 }

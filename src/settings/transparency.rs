@@ -21,6 +21,24 @@ section! {
         /// loses the nearest ones.
         #[values(closed(1.0, MAX_PEEL_LAYERS as f64))]
         peel_layers: u32 = 8,
+        /// How a surface that bends light (`kt > 0`, `ior ≠ 1`, not alpha-blended) is drawn: the
+        /// course's straight rays, or refracted at its front and back faces and looked up in its
+        /// environment cube or in the opaque image behind it.
+        refraction: Refraction = Refraction::None,
+    }
+}
+
+choices! {
+    /// How the rasterizer shows glass with `ior ≠ 1` (docs/course/06-transparency.md#refraction).
+    pub enum Refraction {
+        /// The course's `n_i = n_t`: rays go straight through, `I = Im + kt·Mt·I`.
+        None,
+        /// Refracted at the front face and at the back face (found by a search against the
+        /// object's back faces), then looked up in the object's environment cube.
+        Environment,
+        /// Refracted at both faces, then followed through the opaque image behind the surface
+        /// (a search against its depth), the world where it leaves the screen.
+        Screen,
     }
 }
 

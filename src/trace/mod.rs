@@ -12,10 +12,12 @@
 //!
 //! Where the two renderers should differ, and why: spheres, tori and rounded boxes are exact
 //! here and tessellated in the rasterizer (silhouettes differ by up to the tessellation error);
-//! the rasterizer has no shadows, reflections or refraction until their techniques land; and
-//! only `center` sampling looks at the same points the rasterizer does; textures pick their mip
-//! level from ray cones here and from screen derivatives there (the same level on a surface
-//! facing the camera, see `texture`).
+//! the rasterizer approximates what rays do exactly here (shadow maps for shadow rays, a
+//! mirrored camera or a cube map for reflected rays, two refractions found in screen space for
+//! refracted ones; docs/architecture.md lists each technique's assumption); only `center`
+//! sampling looks at the same points the rasterizer does; textures pick their mip level from
+//! ray cones here and from screen derivatives there (the same level on a surface facing the
+//! camera, see `texture`).
 
 pub mod accel;
 pub mod explain;
@@ -68,6 +70,7 @@ impl<'s> Tracer<'s> {
                 primitives,
                 accelerator,
                 terms: settings.terms.into(),
+                fresnel: settings.terms.fresnel,
                 max_depth: settings.trace.max_depth,
                 shadows: settings.shadows.enabled,
                 textures: SceneTextures::new(scene),

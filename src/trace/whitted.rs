@@ -29,10 +29,13 @@
 //!   `α`, a shadow ray carries `α·kt·MT + (1 − α)`: grey `1 − α` for a blended surface without
 //!   kt, 1 through a mask's holes. Shadow rays carry no cone, so they read the texture's alpha at
 //!   level 0. A ray gives up after [`MAX_LAYERS`] masked hits (seeing the environment) or occluders.
-//! - **Refraction.** The side is read from the geometric normal: a ray against it enters the
-//!   object (`η = 1/ior`), a ray along it leaves (`η = ior`). With `sin²θt = η²(1 − cos²θi) > 1`
-//!   there is total internal reflection: no ray leaves, and the `kt·MT` energy goes to the
-//!   reflected direction instead.
+//! - **Refraction** (`crate::scene::optics`). The side is read from the geometric normal: a ray
+//!   against it enters the object (`η = 1/ior`), a ray along it leaves (`η = ior`). With
+//!   `sin²θt = η²(1 − cos²θi) > 1` there is total internal reflection: no ray leaves, and the
+//!   `kt·MT` energy goes to the reflected direction instead. With `terms.fresnel` the same split
+//!   happens at every angle: `F·kt·MT` joins the reflected ray, `(1 − F)·kt·MT` the refracted
+//!   one (`F` = 1 on total internal reflection, so the two rules agree there). Shadow rays
+//!   through glass carry `kt·MT` unweighted.
 //! - **Self-intersection.** Secondary and shadow rays start a small distance off the surface, on
 //!   the side they leave towards, along the geometric normal: `ε = 1e-4·max(1, |p|∞)`, which
 //!   scales with the scene's coordinates (a fixed ε is too small far from the origin, where
@@ -60,6 +63,7 @@ use super::explain::{Observer, RayKind, SurfaceState, Unobserved, VolumeState};
 use super::geometry::{Primitive, SurfaceHit};
 use super::texture::SceneTextures;
 use super::volume::{TracedVolumes, heat_colour, voxel_illumination, world_normal};
+use crate::scene::optics::{fresnel, refract, relative_index};
 use crate::scene::shading::{
     SurfaceSample, Terms, direct, direct_terms, emission_and_global_ambient, emitted_and_ambient, facing_viewer,
 };
@@ -104,6 +108,8 @@ pub struct Whitted<'s> {
     pub primitives: Vec<Primitive>,
     pub accelerator: Box<dyn Accelerator>,
     pub terms: Terms,
+    /// Weight glass's reflection and transmission by Fresnel's `F` (`terms.fresnel`).
+    pub fresnel: bool,
     pub max_depth: u32,
     /// Whether shadow rays are cast; without them every light is visible everywhere.
     pub shadows: bool,
@@ -378,14 +384,29 @@ impl Whitted<'_> {
         let mut reflected_name = "mirror kps·MPS·L(r)";
         if material.transmission > 0.0 {
             let weight = material.transmission * material.transmission_color;
+            // Fresnel splits kt·MT between the two directions; without it, all goes on through.
+            let reflectance = if self.fresnel {
+                fresnel(n.dot(v), relative_index(v, hit.geometric_normal, material.ior))
+            } else {
+                0.0
+            };
             match refract(v, hit.geometric_normal, n, material.ior) {
                 Some(t) => {
                     counts.refracted += 1;
                     let origin = hit.point - offset * outside;
                     let kind = (depth + 1, RayKind::Refracted);
                     let through = self.radiance_observed(&Ray { origin, direction: t }, cone, kind, counts, observer);
-                    observer.term("transmitted kt·MT·L(t)".into(), weight * through);
-                    rad += weight * through;
+                    let (name, weight_t) = if self.fresnel {
+                        (format!("transmitted (1 − F)·kt·MT·L(t), F = {reflectance:.4}"), (1.0 - reflectance) * weight)
+                    } else {
+                        ("transmitted kt·MT·L(t)".to_string(), weight)
+                    };
+                    observer.term(name, weight_t * through);
+                    rad += weight_t * through;
+                    if reflectance > 0.0 {
+                        reflect_weight += reflectance * weight;
+                        reflected_name = "mirror kps·MPS·L(r), and F·kt·MT·L(r) by Fresnel";
+                    }
                 }
                 None => {
                     reflect_weight += weight;
@@ -472,53 +493,5 @@ impl Whitted<'_> {
         }
         observer.end(transmitted);
         transmitted
-    }
-}
-
-/// The refracted direction of the view vector `v` (unit, pointing away from the surface) at a
-/// surface with outward geometric normal `geometric` and shading normal `n` (facing `v`), or
-/// `None` on total internal reflection.
-pub fn refract(v: Vec3, geometric: Vec3, n: Vec3, ior: f32) -> Option<Vec3> {
-    let entering = v.dot(geometric) > 0.0;
-    let eta = if entering { 1.0 / ior } else { ior };
-    let cos_i = n.dot(v).clamp(0.0, 1.0);
-    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
-    if sin2_t > 1.0 {
-        return None;
-    }
-    let cos_t = (1.0 - sin2_t).sqrt();
-    Some((-eta * v + (eta * cos_i - cos_t) * n).normalize())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn snell_bends_towards_the_normal_entering_glass() {
-        // 45° incidence onto glass (ior 1.5): sin θt = sin 45° / 1.5.
-        let v = Vec3::new(-1.0, 1.0, 0.0).normalize();
-        let t = refract(v, Vec3::Y, Vec3::Y, 1.5).unwrap();
-        let sin_t = t.x.abs();
-        assert!((sin_t - 45f32.to_radians().sin() / 1.5).abs() < 1e-6);
-        assert!(t.y < 0.0 && t.x > 0.0, "the ray goes on into the glass: {t}");
-    }
-
-    #[test]
-    fn total_internal_reflection_past_the_critical_angle() {
-        // Leaving glass: critical angle asin(1/1.5) ≈ 41.81°.
-        let critical = (1.0f32 / 1.5).asin();
-        let inside_normal = Vec3::NEG_Y; // the shading normal faces v, which is inside
-        for (angle, escapes) in [(critical - 0.01, true), (critical + 0.01, false)] {
-            let v = Vec3::new(-angle.sin(), -angle.cos(), 0.0);
-            assert_eq!(refract(v, Vec3::Y, inside_normal, 1.5).is_some(), escapes, "at {} degrees", angle.to_degrees());
-        }
-    }
-
-    #[test]
-    fn index_one_passes_straight_through() {
-        let v = Vec3::new(0.3, 0.8, -0.2).normalize();
-        let t = refract(v, Vec3::Y, Vec3::Y, 1.0).unwrap();
-        assert!(t.abs_diff_eq(-v, 1e-6));
     }
 }

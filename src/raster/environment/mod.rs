@@ -30,19 +30,20 @@ use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 pub mod pass;
 
 use super::targets::HDR_FORMAT;
-use super::uniforms::{ENV_CUBE, ENV_LATLONG, ENV_NONE, ENV_SKY, ENV_SPHERE, GpuEnvironment, mat3_columns};
+use super::uniforms::{
+    ENV_CUBE, ENV_LATLONG, ENV_NONE, ENV_SKY, ENV_SPHERE, GpuEnvironment, PARALLAX_BOX, PARALLAX_GROUND,
+    PARALLAX_INFINITE, mat3_columns,
+};
 use super::view::View;
 use crate::gpu::layout;
 use crate::gpu::mipmap::{MipmapGenerator, mip_level_count};
 use crate::gpu::uniform::UniformBuffer;
 use crate::scene::environment::cube_direction;
 use crate::scene::{Camera, EnvImage, EnvironmentSource, Scene};
-use crate::settings::{EnvironmentMap, EnvironmentView, RenderSettings, SphereView};
+use crate::settings::{EnvironmentMap, EnvironmentView, Parallax, RenderSettings, SphereView};
 use crate::shaders;
 
-/// The most objects with a dynamic cube of their own (six views each); the others reflect the
-/// world's.
-pub const MAX_ENV_CUBES: usize = 8;
+pub use super::uniforms::MAX_ENV_CUBES;
 
 /// Every environment map's format: linear radiance, filterable, up to 65,504.
 pub const ENV_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -51,23 +52,43 @@ pub const ENV_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 const MAX_MADE_SIZE: u32 = 4096;
 
 /// The objects that get a dynamic cube: curved mirrors (`kps·MPS` non-zero) that are not planar
-/// mirrors, in the scene's order, at most [`MAX_ENV_CUBES`]; and warnings for those left out.
+/// mirrors, and glass that bends light (its refraction and its Fresnel reflection look the cube
+/// up), in the scene's order, at most [`MAX_ENV_CUBES`]; and warnings for those left out.
 pub fn reflective_objects(scene: &Scene, planar_mirrors: &[usize]) -> (Vec<usize>, Vec<String>) {
     let mut objects: Vec<usize> = (0..scene.objects.len())
         .filter(|&i| {
             let material = &scene.materials[scene.objects[i].material.0];
-            material.mirror > 0.0 && material.mirror_color != Vec3::ZERO && !planar_mirrors.contains(&i)
+            let mirror = material.mirror > 0.0 && material.mirror_color != Vec3::ZERO;
+            (mirror || material.bends_light()) && !planar_mirrors.contains(&i)
         })
         .collect();
     let mut warnings = Vec::new();
     if objects.len() > MAX_ENV_CUBES {
         warnings.push(format!(
-            "{} curved mirrors: the first {MAX_ENV_CUBES} get dynamic environment cubes, the others reflect the world's",
+            "{} curved mirrors and glass objects: the first {MAX_ENV_CUBES} get dynamic environment cubes, the others reflect the world's",
             objects.len()
         ));
         objects.truncate(MAX_ENV_CUBES);
     }
     (objects, warnings)
+}
+
+/// The direction a dynamic cube drawn from `centre` is read along for the ray `p + t·d`, the twin
+/// of `parallax_direction` in `shaders/common/environment.wgsl`: `d` itself when the ray is taken
+/// to end infinitely far; else from the centre to where the ray meets the proxy, the ground (the
+/// plane `y = bounds.min.y`, for rays going down) or the box `bounds` (the wall it leaves by).
+pub fn parallax_direction(parallax: Parallax, (min, max): (Vec3, Vec3), p: Vec3, d: Vec3, centre: Vec3) -> Vec3 {
+    match parallax {
+        Parallax::Infinite => d,
+        Parallax::Ground if d.y < 0.0 && p.y > min.y => p + ((min.y - p.y) / d.y) * d - centre,
+        Parallax::Ground => d,
+        Parallax::Box => {
+            let safe = Vec3::select(d.abs().cmplt(Vec3::splat(1e-12)), Vec3::splat(1e-12), d);
+            let far = ((min - p) / safe).max((max - p) / safe);
+            let t = far.min_element();
+            if t > 0.0 { p + t * d - centre } else { d }
+        }
+    }
 }
 
 /// The camera of cube face `face` (+X −X +Y −Y +Z −Z) at `centre`: 90° square, its image's
@@ -564,6 +585,22 @@ impl EnvironmentMaps {
         remake
     }
 
+    /// Sets where the dynamic cubes' lookups take rays to end: `parallax` (`PARALLAX_*`) on the box
+    /// `bounds` around the scene, each cube drawn from its entry of `centres`.
+    pub fn set_proxy(&mut self, parallax: Parallax, bounds: Option<(Vec3, Vec3)>, centres: &[Vec3]) {
+        let (min, max) = bounds.unwrap_or((Vec3::ZERO, Vec3::ZERO));
+        self.world.parallax = match (parallax, bounds) {
+            (_, None) | (Parallax::Infinite, _) => PARALLAX_INFINITE,
+            (Parallax::Ground, Some(_)) => PARALLAX_GROUND,
+            (Parallax::Box, Some(_)) => PARALLAX_BOX,
+        };
+        self.world.proxy_min = min.to_array();
+        self.world.proxy_max = max.to_array();
+        for (slot, centre) in self.world.cube_centres.iter_mut().zip(centres) {
+            *slot = centre.extend(1.0).to_array();
+        }
+    }
+
     /// Whether the dynamic cubes are due for drawing, given what they would see (`key`); counts
     /// the frame.
     pub fn capture_due(&mut self, key: u64, refresh: u32) -> bool {
@@ -645,6 +682,11 @@ fn world_uniform(scene: &Scene) -> GpuEnvironment {
         _pad0: 0.0,
         background: scene.background.to_array(),
         _pad1: 0.0,
+        proxy_min: [0.0; 3],
+        parallax: PARALLAX_INFINITE,
+        proxy_max: [0.0; 3],
+        _pad2: 0.0,
+        cube_centres: [[0.0; 4]; MAX_ENV_CUBES],
     };
     let Some(environment) = &scene.environment else { return gpu };
     gpu.intensity = environment.intensity;
@@ -687,4 +729,27 @@ pub fn capture_key(scene: &Scene, settings: &RenderSettings) -> u64 {
     };
     format!("{settings:?}").hash(&mut hasher);
     hasher.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parallax_reads_the_cube_where_the_ray_meets_the_proxy() {
+        let bounds = (Vec3::new(-5.0, 0.0, -5.0), Vec3::new(5.0, 2.0, 5.0));
+        let centre = Vec3::new(0.0, 1.0, 0.0);
+        // From a point on a ball's underside, 45° down: the floor at (1, 0, 0), seen from the
+        // centre along (1, −1, 0).
+        let (p, d) = (Vec3::new(0.5, 0.5, 0.0), Vec3::new(1.0, -1.0, 0.0).normalize());
+        let ground = parallax_direction(Parallax::Ground, bounds, p, d, centre);
+        assert!(ground.normalize().abs_diff_eq(Vec3::new(1.0, -1.0, 0.0).normalize(), 1e-6), "{ground}");
+        assert_eq!(parallax_direction(Parallax::Infinite, bounds, p, d, centre), d);
+        // Going up, the ground proxy is infinitely far; the box's ceiling is at y = 2, reached
+        // at (0.5, 2, 1.5).
+        let up = Vec3::new(0.0, 1.0, 1.0).normalize();
+        assert_eq!(parallax_direction(Parallax::Ground, bounds, p, up, centre), up);
+        let boxed = parallax_direction(Parallax::Box, bounds, p, up, centre);
+        assert!(boxed.normalize().abs_diff_eq(Vec3::new(0.5, 1.0, 1.5).normalize(), 1e-6), "{boxed}");
+    }
 }

@@ -16,7 +16,7 @@ use crate::raster::context::{Figure, FrameEncoder};
 use crate::raster::targets::FrameTargets;
 use crate::raster::view::View;
 use crate::scene::Scene;
-use crate::settings::{EnvironmentMap, EnvironmentView, RenderSettings};
+use crate::settings::{EnvironmentMap, EnvironmentView, Refraction, RenderSettings};
 
 pub struct EnvironmentPass {
     pub converter: Converter,
@@ -74,6 +74,8 @@ impl EnvironmentPass {
             self.maps = Some(maps);
         }
         let maps = self.maps.as_mut().expect("made just above");
+        let centres: Vec<Vec3> = self.objects.iter().map(|&object| object_centre(scene, object).0).collect();
+        maps.set_proxy(env.parallax, bounds, &centres);
         let rotation = view_rotation(&scene.camera);
         let sphere_made = maps.prepare(&gpu.device, &gpu.queue, &self.converter, mipmaps, settings, rotation);
         let drawn = env.enabled && env.dynamic && env.map == EnvironmentMap::Cube;
@@ -89,7 +91,13 @@ impl EnvironmentPass {
             self.capture = Some(FrameTargets::new(&gpu.device, size));
         }
         let mut faces = Vec::new();
-        for (cube, &object) in self.objects.iter().enumerate() {
+        // Glass's cubes only when its refraction or its Fresnel reflection reads them.
+        let glass_reads = settings.transparency.refraction != Refraction::None || settings.terms.fresnel;
+        let wanted = |object: usize| {
+            let material = &scene.materials[scene.objects[object].material.0];
+            glass_reads || material.mirror > 0.0 || !material.bends_light()
+        };
+        for (cube, &object) in self.objects.iter().enumerate().filter(|(_, o)| wanted(**o)) {
             let (centre, inner) = object_centre(scene, object);
             let (near, far) = capture_range(inner, bounds);
             faces.extend((0..6).map(|face| CubeFace {

@@ -6,7 +6,8 @@
 //! plan ──► shadow maps (pass 1 of §4; layers kept while their light and the casters stay)
 //!      ──► lighting inputs (group 2: maps, projected mask, environment maps)
 //!      ──► per view: [depth prepass → projected polygons] → opaque + mirrors + world
-//!                    → isosurfaces → transparent surfaces and composited volumes, in order
+//!                    → isosurfaces → refracting glass
+//!                    → transparent surfaces and composited volumes, in order
 //!          cube faces (copied into their cube) · mirrored cameras, deepest first · main camera
 //!      ──► teaching overlays ──► present (output transform, upscale)
 //! ```
@@ -24,6 +25,7 @@ use super::inspect::{Inspector, RasterPixel};
 use super::mirror::pass::{MirrorPass, volumes as mirror_volumes};
 use super::overlays::{FRUSTUM_COLOUR, Overlays, WIREFRAME_COLOUR, box_edges};
 use super::present::PresentPass;
+use super::refraction::{PreparedRefraction, RefractionPass};
 use super::scene_gpu::{DrawnAlone, SceneGpu, SceneLayouts, SceneShader};
 use super::scene_pass::{MirrorImages, PreparedScene, ScenePass};
 use super::shadow::projected::ProjectedPass;
@@ -49,6 +51,7 @@ pub struct Renderer {
     shadow: ShadowPass,
     projected: ProjectedPass,
     scene: ScenePass,
+    refraction: RefractionPass,
     transparency: TransparencyPass,
     volumes: VolumePass,
     mirrors: MirrorPass,
@@ -69,6 +72,8 @@ struct Phases<'p> {
     scene: PreparedScene<'p>,
     projected: &'p ProjectedPass,
     volumes: PreparedVolumes<'p>,
+    /// `None`: no glass is refracted.
+    refraction: Option<PreparedRefraction<'p>>,
     /// `None`: transparent surfaces are drawn with the opaque ones (or there are none).
     transparency: Option<PreparedTransparency<'p>>,
 }
@@ -99,6 +104,7 @@ impl Renderer {
             shadow: ShadowPass::new(device, &layouts),
             projected: ProjectedPass::new(device, &layouts),
             scene: ScenePass::new(device, &layouts, &shader),
+            refraction: RefractionPass::new(device, &layouts, &shader),
             transparency: TransparencyPass::new(device, &layouts, &shader),
             overlays: Overlays::new(device, &layouts),
             present: PresentPass::new(device, output_format),
@@ -195,6 +201,7 @@ impl Renderer {
             scene: self.scene.prepare(&ctx, &views, !plan.mirror_nodes.is_empty()),
             projected: &self.projected,
             volumes: self.volumes.prepare(&ctx, &views),
+            refraction: plan.transparency.then(|| self.refraction.prepare(&ctx, &views)).flatten(),
             transparency: plan.transparency.then(|| self.transparency.prepare(&ctx, &mut frame, &views)),
         };
         // Cube faces first (a mirror may reflect a curved mirror), each copied into its cube;
@@ -284,8 +291,8 @@ impl Renderer {
 
 /// Draws one view's phases into its targets, the same for the main camera, a mirrored camera
 /// and a cube face: the opaque surfaces (after a depth prepass and the projected-shadow mask
-/// where the view has them), with the reflections `mirrors` show; the isosurfaces; then the
-/// transparent surfaces and the composited volumes in one order.
+/// where the view has them), with the reflections `mirrors` show; the isosurfaces; the glass that
+/// refracts; then the transparent surfaces and the composited volumes in one order.
 fn record_view(
     ctx: &FrameContext,
     frame: &mut FrameEncoder,
@@ -302,6 +309,9 @@ fn record_view(
     }
     phases.scene.record_opaque(ctx, frame, view, targets, (transparent_later, mirrors));
     phases.volumes.record_isosurfaces(ctx, frame, view, targets);
+    if let Some(refraction) = &phases.refraction {
+        refraction.record(ctx, frame, view, targets);
+    }
     let mut composite =
         |frame: &mut FrameEncoder, span: RaySpan| phases.volumes.composite(ctx, frame, view, targets, span);
     match &phases.transparency {

@@ -23,7 +23,7 @@ use super::gltf::{GltfCamera, GltfProjection};
 use super::light::{Attenuation, Light, LightKind};
 use super::material::{AlphaMode, ColorSpace, Material, MaterialId, ProceduralHeight, TextureId, Wrap};
 use super::{ModelImport, Object, Scene, SceneError, Shape, texture};
-use crate::settings::RenderSettings;
+use crate::settings::{Parallax, Refraction, RenderSettings};
 
 /// Reads a scene file: TOML, or a bare model (glTF, OBJ or PLY, told by the file's extension).
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
@@ -1052,8 +1052,16 @@ pub const PHYSICAL_WORLD: f32 = 0.0509;
 /// A bare model: its own camera if it has one, else one framing it; its own lights if it has
 /// any (then in [`PHYSICAL_WORLD`]), else a white directional light from over the viewer's
 /// shoulder. OBJ and PLY files have neither, so they always get the framing camera and the light.
+///
+/// A model is made for renderers that weight glass by Fresnel and bend light through it, so its
+/// glass gets both by default (docs/scene-format.md, "A bare model as the scene"):
+/// `terms.fresnel`, refraction through the environment cubes, and those cubes read with the
+/// ground as their proxy (a scene file keeps the course's defaults: neither, and infinitely far).
 fn load_bare_model(path: &Path, import: ModelImport) -> Result<Scene, SceneError> {
     let mut scene = empty_scene(path);
+    scene.settings.terms.fresnel = true;
+    scene.settings.transparency.refraction = Refraction::Environment;
+    scene.settings.environment.parallax = Parallax::Ground;
     if !import.lights.is_empty() {
         scene.ambient = Vec3::splat(PHYSICAL_WORLD);
         scene.background = Vec3::splat(PHYSICAL_WORLD);

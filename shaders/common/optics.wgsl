@@ -1,0 +1,43 @@
+// Light crossing a smooth interface (docs/course/06-transparency.md): Snell's law and Fresnel's
+// equations, the WGSL twin of src/scene/optics.rs. tests/refraction.rs runs both on the same
+// cases. `v` is the unit view vector (away from the surface), `geometric` the outward normal,
+// `n` the shading normal turned to face `v`.
+
+// η = n_i/n_t: 1/ior entering (v on the outside), ior leaving.
+fn relative_index(v: vec3f, geometric: vec3f, ior: f32) -> f32 {
+    return select(ior, 1.0 / ior, dot(v, geometric) > 0.0);
+}
+
+// What Snell's law gives: the refracted direction, or none on total internal reflection.
+struct Refracted {
+    direction: vec3f,
+    valid: bool,
+}
+
+fn refract_view(v: vec3f, geometric: vec3f, n: vec3f, ior: f32) -> Refracted {
+    let eta = relative_index(v, geometric, ior);
+    let cos_i = clamp(dot(n, v), 0.0, 1.0);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+    if sin2_t > 1.0 {
+        return Refracted(vec3f(0.0), false);
+    }
+    let cos_t = sqrt(1.0 - sin2_t);
+    return Refracted(normalize(-eta * v + (eta * cos_i - cos_t) * n), true);
+}
+
+// Fresnel's reflectance for unpolarized light, exact: the mean of r_s² and r_p²; 1 on total
+// internal reflection, 0 for η = 1.
+fn fresnel(cos_i_in: f32, eta: f32) -> f32 {
+    if eta == 1.0 {
+        return 0.0;
+    }
+    let cos_i = clamp(cos_i_in, 0.0, 1.0);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = sqrt(1.0 - sin2_t);
+    let r_s = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_p = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5 * (r_s * r_s + r_p * r_p);
+}
