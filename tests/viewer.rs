@@ -23,6 +23,11 @@ fn on_path(program: &str) -> bool {
 
 /// The viewer with `args`, under `xvfb-run -a` when it exists, else on the current display.
 fn viewer(args: &[&str], config_home: &Path) -> Output {
+    viewer_with(args, config_home, None)
+}
+
+/// [`viewer`] with one more variable in its environment.
+fn viewer_with(args: &[&str], config_home: &Path, variable: Option<(&str, &str)>) -> Output {
     let binary = env!("CARGO_BIN_EXE_mirador");
     let mut command = if on_path("xvfb-run") {
         let mut c = Command::new("xvfb-run");
@@ -37,6 +42,9 @@ fn viewer(args: &[&str], config_home: &Path) -> Output {
         );
     };
     command.arg("view").args(args).env("XDG_CONFIG_HOME", config_home).env_remove("WAYLAND_DISPLAY");
+    if let Some((key, value)) = variable {
+        command.env(key, value);
+    }
     let output = command.output().expect("running the viewer");
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!stderr.contains("panicked"), "the viewer panicked: {stderr}");
@@ -96,14 +104,24 @@ fn flip(reference: &image::RgbaImage, test: &image::RgbaImage, what: &str, dir: 
     d.flip_mean
 }
 
+/// The window's 3D view is the headless render, whichever way it reaches the window: copied into
+/// the surface (what lavapipe's surface allows), or drawn by egui as a texture (what surfaces
+/// that take no copies get, forced here by `MIRADOR_COMPOSITION`).
 #[test]
 fn the_showcase_in_the_window_is_the_headless_render() {
-    let dir = scratch("raster");
+    showcase_in_the_window(None);
+}
+
+#[test]
+fn the_showcase_drawn_by_egui_as_a_texture_is_the_headless_render() {
+    showcase_in_the_window(Some("textured"));
+}
+
+fn showcase_in_the_window(composition: Option<&str>) {
+    let dir = scratch(&format!("raster-{}", composition.unwrap_or("copied")));
     let shot = dir.join("raster.png");
-    let output = viewer(
-        &["--size", "1000x600", "--frames", "3", "--step", "overlay off", "--screenshot", shot.to_str().unwrap()],
-        &dir,
-    );
+    let args = ["--size", "1000x600", "--frames", "3", "--step", "overlay off", "--screenshot", shot.to_str().unwrap()];
+    let output = viewer_with(&args, &dir, composition.map(|c| ("MIRADOR_COMPOSITION", c)));
     succeeded(&output);
     let views = views(&output);
     let [(path, view)] = &views[..] else { panic!("one screenshot line expected: {output:?}") };
@@ -478,4 +496,50 @@ fn inspect_mode_shows_both_columns_and_draws_the_ray_tree() {
         region.pixels().filter(|p| p[0] < 40 && p[1] < 40 && p[2] < 40).count() as f32 / (500.0 * 120.0)
     };
     assert!(dark(&with) > 0.6 && dark(&without) < 0.3, "window fill {} vs {}", dark(&with), dark(&without));
+}
+
+/// The window taken away from outside, as a window manager or `xkill` does it: destroyed
+/// (`xdotool windowclose`, an `XDestroyWindow`; twice, since the panic this guards against came
+/// in one run of two) the viewer says so in one line and exits cleanly; its connection to the
+/// display killed (`xdotool windowkill`, an `XKillClient`) it exits with Xlib's own line. Never a
+/// panic, never a hang (each run is bounded by `timeout`).
+///
+/// Needs `xdotool` beside Xvfb (`apt-get install xdotool`; `.ci/run` does).
+#[test]
+fn a_window_taken_away_from_outside_ends_the_viewer_without_a_panic() {
+    assert!(
+        on_path("xvfb-run") && on_path("xdotool"),
+        "this test needs xvfb-run and xdotool (`apt-get install xvfb xdotool`, as .ci/run does)"
+    );
+    let dir = scratch("window-gone");
+    // The viewer in the background; once its window is up and has drawn for a while, the window
+    // is taken away and the viewer waited for.
+    let script = r#"
+        "$0" view --size 800x450 & viewer=$!
+        xdotool search --sync --onlyvisible --name '^Mirador$' > /dev/null
+        sleep 3
+        xdotool search --name '^Mirador$' "$1"
+        wait "$viewer"
+        echo "viewer exit status: $?"
+    "#;
+    for how in ["windowclose", "windowclose", "windowkill"] {
+        let output = Command::new("timeout")
+            .args(["120", "xvfb-run", "-a", "-s", "-screen 0 1280x720x24", "sh", "-c", script])
+            .args([env!("CARGO_BIN_EXE_mirador"), how])
+            .env("XDG_CONFIG_HOME", &dir)
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .expect("running the viewer under Xvfb");
+        let (stdout, stderr) = (String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr));
+        let what = format!("{how}: status {:?}\nstdout: {stdout}\nstderr: {stderr}", output.status.code());
+        assert!(output.status.code() != Some(124), "the viewer did not exit: {what}");
+        assert!(!stderr.contains("panicked"), "the viewer panicked: {what}");
+        let status = stdout.lines().find_map(|l| l.strip_prefix("viewer exit status: ")).unwrap_or("none");
+        if how == "windowclose" {
+            assert_eq!(status, "0", "a destroyed window ends the viewer cleanly: {what}");
+            assert!(stderr.contains("the window was destroyed"), "and says so: {what}");
+        } else {
+            assert!(status != "none" && status != "101", "the display lost ends the viewer (101 is a panic): {what}");
+        }
+    }
 }

@@ -36,6 +36,8 @@ use crate::scene::{Camera, Light};
 const SETTLE: Duration = Duration::from_millis(250);
 /// How soon a frame the surface was not ready for is tried again.
 const RETRY: Duration = Duration::from_millis(50);
+/// The longest a screenshot waits for egui's animations to end.
+const SCREENSHOT_PATIENCE: Duration = Duration::from_secs(2);
 /// The longest a `wait traced` step waits.
 const TRACE_TIMEOUT: Duration = Duration::from_secs(600);
 
@@ -64,6 +66,8 @@ pub struct Viewer {
     /// The 3D view's size in pixels, and where it sits in the window.
     pub view_pixels: Option<(u32, u32, u32, u32)>,
     screenshot: Option<PathBuf>,
+    /// Since when a screenshot has waited for egui's animations to end.
+    screenshot_waiting: Option<Instant>,
     /// Print the volume ray under the cursor after this frame's UI (the `probe` step).
     print_probe: bool,
     /// The inspected pixel, and a pixel to inspect once the view has its size.
@@ -126,15 +130,19 @@ impl Viewer {
             key: 0,
             view_pixels: None,
             screenshot: None,
+            screenshot_waiting: None,
             print_probe: false,
             inspection: None,
             inspect_next: None,
         }
     }
 
-    /// Whether every scripted step has run.
+    /// Whether every scripted step has run and every screenshot asked for is written.
     pub fn script_done(&self) -> bool {
-        self.script.steps.is_empty() && self.script.wait_frames == 0 && self.script.wait_traced_since.is_none()
+        self.script.steps.is_empty()
+            && self.script.wait_frames == 0
+            && self.script.wait_traced_since.is_none()
+            && self.screenshot.is_none()
     }
 
     /// Whether a `measure` step said where the stats start.
@@ -230,7 +238,8 @@ impl Viewer {
         self.apply(&output, input, start);
         // Compared without the image size, which the frame sets below.
         let camera = &self.scene.scene.camera;
-        let moved = Camera { width: camera_before.width, height: camera_before.height, ..camera.clone() } != camera_before;
+        let moved =
+            Camera { width: camera_before.width, height: camera_before.height, ..camera.clone() } != camera_before;
 
         // The raster image at the view's size, drawn at the render scale.
         let ppp = full.pixels_per_point;
@@ -246,7 +255,8 @@ impl Viewer {
             // rasterizer's work shrinks with the scale; the view's size otherwise (picking, pans).
             let scaled = |n: u32| ((n as f32 * scale).round() as u32).clamp(1, n);
             let drawn_size = (scaled(width), scaled(height));
-            let filter = if drawn_size == (width, height) { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
+            let filter =
+                if drawn_size == (width, height) { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
             (self.scene.scene.camera.width, self.scene.scene.camera.height) = drawn_size;
             let scene = (&self.scene.scene, self.scene.revision);
             // Each pass is timed on its own only for the overlay, which lists them.
@@ -262,7 +272,7 @@ impl Viewer {
         }
 
         let paint_start = Instant::now();
-        let screenshot = self.screenshot.take();
+        let screenshot = self.screenshot_due(repaint);
         let view = match (self.raster.image(), self.view_pixels) {
             (Some((texture, plain)), Some((x, y, w, h))) => Some(ViewImage { texture, plain, rect: [x, y, w, h] }),
             _ => None,
@@ -306,6 +316,21 @@ impl Viewer {
         let at_once = self.scripted || next.is_some_and(|t| t <= now);
         self.last_frame = Some((start, at_once));
         Ok(FrameEnd { next })
+    }
+
+    /// The screenshot to write this frame: the one asked for, unless egui is animating (a window
+    /// fading in, a section opening), when it waits for the animation to end, up to
+    /// [`SCREENSHOT_PATIENCE`]. The scripted steps wait with it, so it shows the state the steps
+    /// before it set up.
+    fn screenshot_due(&mut self, repaint: Option<Duration>) -> Option<PathBuf> {
+        self.screenshot.as_ref()?;
+        let since = *self.screenshot_waiting.get_or_insert_with(Instant::now);
+        let animating = repaint.is_some_and(|delay| delay.is_zero());
+        if animating && since.elapsed() < SCREENSHOT_PATIENCE {
+            return None;
+        }
+        self.screenshot_waiting = None;
+        self.screenshot.take()
     }
 
     /// Whether the camera moved within the last [`SETTLE`].
@@ -443,6 +468,9 @@ impl Viewer {
 
     /// Runs the next scripted step, or goes on waiting.
     fn run_script(&mut self, input: &mut CameraInput) -> anyhow::Result<()> {
+        if self.screenshot.is_some() {
+            return Ok(());
+        }
         if self.script.wait_frames > 0 {
             self.script.wait_frames -= 1;
             return Ok(());

@@ -120,6 +120,7 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
         frames: 0,
         next_frame: None,
         finished: false,
+        screenshot_asked: false,
     };
     event_loop.run_app(&mut app).context("the window's event loop failed")?;
     app.outcome
@@ -140,6 +141,8 @@ struct App {
     /// When the last frame asked for the next one.
     next_frame: Option<Instant>,
     finished: bool,
+    /// Whether the run's `--screenshot` was asked for.
+    screenshot_asked: bool,
 }
 
 impl App {
@@ -212,13 +215,19 @@ impl App {
             return;
         }
         let scripted = self.options.frames;
-        let last = scripted.is_some_and(|n| self.frames + 1 >= n) && viewer.script_done();
-        if last && let Some(path) = &self.options.screenshot {
+        // The run's screenshot, asked for once, at the last frame; the run ends when it is written.
+        let due = scripted.is_some_and(|n| self.frames + 1 >= n) && viewer.script_done();
+        if due
+            && !self.screenshot_asked
+            && let Some(path) = &self.options.screenshot
+        {
+            self.screenshot_asked = true;
             viewer.request_screenshot(path.clone());
         }
         let was_done = viewer.script_done();
         let result = viewer.frame(screen);
         self.frames += 1;
+        let last = due && viewer.script_done();
         // Measure the state the script set up, not the steps getting there nor the first frames
         // (the driver compiles its pipelines lazily), unless a `measure` step said where.
         if !viewer.measured() && ((!was_done && viewer.script_done()) || (self.frames == 2 && viewer.script_done())) {

@@ -4,13 +4,13 @@
 //! A frame of the window is composed by copies wherever it can ([`Screen::paint`]): the 3D view's
 //! image (the rasterizer's frame, already through the output transform) is copied into the view's
 //! rectangle, the side panel's pixels are copied from where egui last drew them, and egui draws
-//! only the rest (the overlays over the view) each frame. On a software GPU (lavapipe) egui costs
-//! about 27 ns a pixel it covers: drawing the image as a textured rectangle over a 950×720 view
-//! took about 20 ms a frame, the side panel 10 to 20 ms, as much as the rasterizer's frame itself,
-//! where a copy takes about a millisecond (docs/performance.md). The panel is drawn again only when
-//! its shapes change: they are the front of egui's list of shapes, up to the first that reaches
-//! into the view ([`panel_shapes`]). A surface that takes no copies (the GL backend's) falls back
-//! to egui drawing everything, the image as a texture ([`Composition::Textured`]).
+//! only the rest (the overlays over the view) each frame. The panel is drawn again only when its
+//! shapes change: they are the front of egui's list of shapes, up to the first that reaches into
+//! the view ([`panel_shapes`]). A surface that takes no copies (the GL backend's) falls back to
+//! egui drawing everything, the image as a texture ([`Composition::Textured`]; forced with
+//! `MIRADOR_COMPOSITION=textured`). Measured on lavapipe at 1280×720 (docs/performance.md), the
+//! copies save about 2 ms of a still frame's 12.6 and 4 ms of an orbiting frame's 44: less than
+//! keeping an unchanged image and drawing moving frames small, which is where the time went.
 //!
 //! The window can go away under the program: a minimised window has a zero size (nothing is drawn
 //! until it comes back), a resized one is reconfigured, an outdated surface is reconfigured and a
@@ -114,7 +114,10 @@ impl Screen {
         // same bytes, which only formats that differ in their sRGB-ness alone can exchange.
         let copyable = matches!(format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm)
             && capabilities.usages.contains(wgpu::TextureUsages::COPY_DST);
-        let composition = if copyable { Composition::Copied } else { Composition::Textured };
+        // `MIRADOR_COMPOSITION=textured` takes the other surfaces' path on any surface: to test it
+        // and to measure what the copies save (benches/viewer.sh).
+        let forced = std::env::var("MIRADOR_COMPOSITION").is_ok_and(|v| v == "textured");
+        let composition = if copyable && !forced { Composition::Copied } else { Composition::Textured };
         let usage = match composition {
             Composition::Copied => wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_DST,
             Composition::Textured => wgpu::TextureUsages::RENDER_ATTACHMENT,
@@ -313,10 +316,8 @@ impl Screen {
             }
             return Ok(Presented::Skipped);
         };
-        let screen = egui_wgpu::ScreenDescriptor {
-            size_in_pixels: [self.config.width, self.config.height],
-            pixels_per_point,
-        };
+        let screen =
+            egui_wgpu::ScreenDescriptor { size_in_pixels: [self.config.width, self.config.height], pixels_per_point };
         if let Some((width, Some(front))) = &mut panel {
             self.draw_panel(*width, std::mem::take(front), &screen);
         }
@@ -392,7 +393,8 @@ impl Screen {
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer::panel") });
         let extra = self.painter.update_buffers(device, queue, &mut encoder, &jobs, screen);
-        let view = texture.create_view(&wgpu::TextureViewDescriptor { label: Some("viewer::panel_view"), ..Default::default() });
+        let view = texture
+            .create_view(&wgpu::TextureViewDescriptor { label: Some("viewer::panel_view"), ..Default::default() });
         let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("viewer::panel_pass"),
             color_attachments: &[Some(crate::gpu::layout::color_attachment(
@@ -432,18 +434,19 @@ impl Composer<'_> {
         copies: &Copies,
         (jobs, screen): (&[egui::ClippedPrimitive], &egui_wgpu::ScreenDescriptor),
     ) {
-        let target_view =
-            target.create_view(&wgpu::TextureViewDescriptor { label: Some("viewer::window_view"), ..Default::default() });
+        let target_view = target
+            .create_view(&wgpu::TextureViewDescriptor { label: Some("viewer::window_view"), ..Default::default() });
         let pass = |encoder: &mut wgpu::CommandEncoder, label, load| {
-            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some(label),
-                color_attachments: &[Some(crate::gpu::layout::color_attachment(&target_view, load))],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            })
-            .forget_lifetime()
+            encoder
+                .begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some(label),
+                    color_attachments: &[Some(crate::gpu::layout::color_attachment(&target_view, load))],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                })
+                .forget_lifetime()
         };
         let (width, height) = (target.width(), target.height());
         let copy = |encoder: &mut wgpu::CommandEncoder, source: &wgpu::Texture, (x, y): (u32, u32), (w, h)| {

@@ -191,7 +191,9 @@ mod tests {
         assert_eq!(parse("fps off").unwrap(), Step::Fps(0.0));
         assert_eq!(parse("measure").unwrap(), Step::Measure);
         assert_eq!(parse("screenshot out.png").unwrap(), Step::Screenshot("out.png".into()));
-        for bad in ["view sideways", "orbit 1", "split 2", "set shadows", "screenshot a.jpg", "dance", "pick nan 1", "fps 0"] {
+        for bad in
+            ["view sideways", "orbit 1", "split 2", "set shadows", "screenshot a.jpg", "dance", "pick nan 1", "fps 0"]
+        {
             let error = parse(bad).unwrap_err().to_string();
             assert!(error.contains(bad.split_whitespace().next().unwrap()), "{bad}: {error}");
         }

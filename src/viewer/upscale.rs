@@ -6,9 +6,8 @@
 //! its sRGB-encoded values. At full scale the image is copied instead, byte for byte.
 //!
 //! Why not the present pass's own upscale (`raster.render_scale`): it reads four half-float texels
-//! and runs the tone curve at every window pixel, about 11 ms for a 950×720 view on a software GPU
-//! (lavapipe), where one 8-bit texture read over a quad costs a few; and the camera's size would
-//! stay the window's, tessellating for pixels that are not drawn.
+//! and runs the tone curve at every window pixel, where this pass reads one 8-bit texel; and the
+//! camera's size would stay the window's, tessellating for pixels that are not drawn.
 
 use crate::gpu::layout;
 
@@ -31,11 +30,7 @@ impl Upscale {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("upscale::bind_group_layout"),
             entries: &[
-                layout::texture(
-                    0,
-                    wgpu::TextureSampleType::Float { filterable: true },
-                    wgpu::TextureViewDimension::D2,
-                ),
+                layout::texture(0, wgpu::TextureSampleType::Float { filterable: true }, wgpu::TextureViewDimension::D2),
                 layout::sampler(1, wgpu::SamplerBindingType::Filtering),
             ],
         });
