@@ -18,6 +18,18 @@
 
 use std::time::Duration;
 
+/// The frame rate held while the camera moves, by default. A software GPU (lavapipe on two
+/// cores) draws the showcase's flat-colour floor at about 23 frames a second in a 950×720 view;
+/// aiming at 30 keeps orbiting under the cost of that floor (docs/performance.md), and where the
+/// frames are cheaper the scale rises to meet it.
+pub const DEFAULT_MOTION_FPS: f32 = 30.0;
+/// The frame rates the panel offers (0, outside it, turns the target off).
+pub const MOTION_FPS: std::ops::RangeInclusive<f32> = 5.0..=120.0;
+/// The lowest render scale while moving, by default: a quarter of the pixels in each direction.
+pub const DEFAULT_MOTION_SCALE: f32 = 0.25;
+/// The lowest render scales the panel offers.
+pub const MOTION_SCALES: std::ops::RangeInclusive<f32> = 0.1..=1.0;
+
 /// The scales the budget picks from are multiples of this.
 pub const STEP: f32 = 0.05;
 

@@ -16,20 +16,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::budget::{DEFAULT_MOTION_FPS, DEFAULT_MOTION_SCALE, MOTION_FPS, MOTION_SCALES};
 use super::view_mode::ViewMode;
 use crate::RenderSettings;
-
-/// The frame rate held while the camera moves, by default. A software GPU (lavapipe on two
-/// cores) draws the showcase's flat-colour floor at about 26 frames a second at 1280×720; 30
-/// keeps orbiting at or under the cost of that floor (docs/performance.md); a GPU holds it at
-/// full scale.
-pub const DEFAULT_MOTION_FPS: f32 = 30.0;
-/// The frame rates the panel offers (0, outside it, turns the target off).
-pub const MOTION_FPS: std::ops::RangeInclusive<f32> = 5.0..=120.0;
-/// The lowest render scale while moving, by default: a quarter of the pixels in each direction.
-pub const DEFAULT_MOTION_SCALE: f32 = 0.25;
-/// The lowest render scales the panel offers.
-pub const MOTION_SCALES: std::ops::RangeInclusive<f32> = 0.1..=1.0;
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]

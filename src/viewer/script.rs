@@ -146,7 +146,7 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
         "fps" if args == "off" => Step::Fps(0.0),
         "fps" => {
             let [fps] = numbers(args).ok_or_else(|| fail("fps N or fps off"))?;
-            if !super::config::MOTION_FPS.contains(&fps) {
+            if !super::budget::MOTION_FPS.contains(&fps) {
                 return Err(fail("the frame rate lies between 5 and 120"));
             }
             Step::Fps(fps)

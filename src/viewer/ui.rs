@@ -212,7 +212,7 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
 
 /// The frame budget while the camera moves: a frame rate to hold and the lowest render scale.
 fn motion_budget(ui: &mut egui::Ui, view: &mut ViewState) {
-    use super::config::{DEFAULT_MOTION_FPS, MOTION_FPS, MOTION_SCALES};
+    use super::budget::{DEFAULT_MOTION_FPS, MOTION_FPS, MOTION_SCALES};
     ui.horizontal(|ui| {
         let mut hold = view.motion_fps > 0.0;
         let checkbox = ui.checkbox(&mut hold, "hold").on_hover_text(

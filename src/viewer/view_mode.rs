@@ -66,8 +66,8 @@ impl Default for ViewState {
         ViewState {
             mode: ViewMode::Raster,
             split: 0.5,
-            motion_fps: super::config::DEFAULT_MOTION_FPS,
-            motion_scale: super::config::DEFAULT_MOTION_SCALE,
+            motion_fps: super::budget::DEFAULT_MOTION_FPS,
+            motion_scale: super::budget::DEFAULT_MOTION_SCALE,
             panel_open: true,
             help_open: false,
             overlay_open: true,
