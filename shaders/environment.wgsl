@@ -13,8 +13,11 @@
 @group(0) @binding(1) var env_sampler: sampler;
 // The lat–long or sphere-map source image.
 @group(0) @binding(2) var source_2d: texture_2d<f32>;
-// The cube source: the world's cube, or one reflective object's dynamic cube.
+// The cube source: the world's cube.
 @group(0) @binding(3) var source_cube: texture_cube<f32>;
+// The reflective objects' dynamic cubes, for the cross view of the first. A cube of the array
+// cannot be viewed as a cube of its own on GL (src/gpu/texture.rs, Layers).
+@group(0) @binding(4) var source_cubes: texture_cube_array<f32>;
 
 struct ConvertOut {
     @builtin(position) clip: vec4f,
@@ -85,11 +88,17 @@ fn letterbox(uv: vec2f, aspect: f32) -> vec2f {
 
 const OUTSIDE: vec4f = vec4f(0.02, 0.02, 0.02, 1.0);
 
+// Where a point of the cross view falls: whether on a face, and the direction the face shows
+// there.
+struct CrossPoint {
+    inside: bool,
+    direction: vec3f,
+}
+
 // The cube's faces unfolded as a horizontal cross (src/scene/environment.rs, unfold_cross):
 // +Y above +Z; −X, +Z, +X, −Z in a row; −Y below.
-@fragment
-fn fs_view_cross(in: ConvertOut) -> @location(0) vec4f {
-    let p = letterbox(in.uv, 4.0 / 3.0);
+fn cross_point(uv: vec2f) -> CrossPoint {
+    let p = letterbox(uv, 4.0 / 3.0);
     let cell = vec2i(floor(p * vec2f(4.0, 3.0)));
     let local = fract(p * vec2f(4.0, 3.0));
     var face = 6u;
@@ -100,11 +109,24 @@ fn fs_view_cross(in: ConvertOut) -> @location(0) vec4f {
     } else if cell.x == 1 && cell.y == 2 {
         face = 3u;
     }
-    let radiance = textureSampleLevel(source_cube, env_sampler, cube_direction(min(face, 5u), local), 0.0).rgb;
-    if face == 6u || any(p < vec2f(0.0)) || any(p > vec2f(1.0)) {
-        return OUTSIDE;
-    }
-    return vec4f(radiance, 1.0);
+    let inside = face != 6u && all(p >= vec2f(0.0)) && all(p <= vec2f(1.0));
+    return CrossPoint(inside, cube_direction(min(face, 5u), local));
+}
+
+// The world's cube as a cross.
+@fragment
+fn fs_view_cross(in: ConvertOut) -> @location(0) vec4f {
+    let at = cross_point(in.uv);
+    let radiance = textureSampleLevel(source_cube, env_sampler, at.direction, 0.0).rgb;
+    return select(OUTSIDE, vec4f(radiance, 1.0), at.inside);
+}
+
+// The first dynamic cube as a cross.
+@fragment
+fn fs_view_cross_dynamic(in: ConvertOut) -> @location(0) vec4f {
+    let at = cross_point(in.uv);
+    let radiance = textureSampleLevel(source_cubes, env_sampler, at.direction, 0, 0.0).rgb;
+    return select(OUTSIDE, vec4f(radiance, 1.0), at.inside);
 }
 
 // A 2D map (the sphere map, the lat–long map) as it is, at its own aspect.

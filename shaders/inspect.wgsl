@@ -99,6 +99,10 @@ struct Inspection {
 }
 
 @group(2) @binding(11) var<storage, read_write> inspection: Inspection;
+// The shadow maps again, as floats: the stored depth of each light's lookup is read here, in the
+// `*_inspect` entry points alone, because GLSL has no texelFetch of a depth texture and
+// `visibility` is part of every plain entry point too (src/gpu/layout.rs, depth_texels).
+@group(2) @binding(12) var shadow_texels: texture_2d_array<f32>;
 
 var<private> probe: InspectFragment;
 // The light `visibility` is evaluated for, so it can fill that light's record.
@@ -112,6 +116,12 @@ fn inspect_record(kind: u32, clip: vec4f, radiance: vec3f) {
     }
     let index = atomicAdd(&inspection.count, 1u);
     if index < MAX_INSPECTED {
+        for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {
+            let light = probe.lights[i];
+            if light.layer >= 0 {
+                probe.lights[i].stored_depth = textureLoad(shadow_texels, vec2u(light.texel), light.layer, 0).x;
+            }
+        }
         probe.kind = kind;
         probe.depth = clip.z;
         probe.material = material.index;

@@ -4,8 +4,16 @@
 // read with textureLoad, so an sRGB texture is decoded to linear before averaging; the result is
 // written twice: to the texture's level (an sRGB target encodes it again) and, unrounded, to a
 // 16-bit float scratch level that the next level reads, so 8-bit rounding never accumulates.
+//
+// A cube's face is first drawn, texel for texel, into a plain 2D image that level 1 reads
+// (fs_mipmap_face_*): GL samples a cube only through a view of the whole cube, and textureLoad
+// has no cube form (src/gpu/texture.rs, Layers).
 
 @group(0) @binding(0) var mip_source: texture_2d<f32>;
+// The cube whose face is copied, its mip level 0, read with a nearest sampler.
+@group(0) @binding(1) var face_sampler: sampler;
+@group(0) @binding(2) var face_cube: texture_cube<f32>;
+@group(0) @binding(3) var face_cubes: texture_cube_array<f32>;
 
 // The source texels one output texel averages along an axis of n texels: `count` texels from
 // `first` with `weights`. Even n: 2j, 2j+1 at ½ each; odd n = 2h + 1: 2j, 2j+1, 2j+2 at
@@ -56,4 +64,34 @@ fn fs_mipmap(@builtin(position) pixel: vec4f) -> MipmapOut {
         }
     }
     return MipmapOut(sum, sum);
+}
+
+struct FaceOut {
+    @builtin(position) position: vec4f,
+    // The layer copied: face layer % 6 of cube layer / 6.
+    @location(0) @interpolate(flat) layer: u32,
+}
+
+@vertex
+fn vs_mipmap_face(@builtin(vertex_index) index: u32, @builtin(instance_index) layer: u32) -> FaceOut {
+    return FaceOut(fullscreen_position(index), layer);
+}
+
+// The direction through the centre of the target's texel at `position` on `face` of a cube of
+// `size` texels a side. Nearest sampling there reads exactly that texel: the centre lies half a
+// texel from every edge, far beyond the rounding of the cube lookup's projection.
+fn face_texel_direction(position: vec4f, face: u32, size: u32) -> vec3f {
+    return cube_direction(face, position.xy / f32(size));
+}
+
+@fragment
+fn fs_mipmap_face_cube(in: FaceOut) -> @location(0) vec4f {
+    let d = face_texel_direction(in.position, in.layer, textureDimensions(face_cube).x);
+    return textureSampleLevel(face_cube, face_sampler, d, 0.0);
+}
+
+@fragment
+fn fs_mipmap_face_cubes(in: FaceOut) -> @location(0) vec4f {
+    let d = face_texel_direction(in.position, in.layer % 6u, textureDimensions(face_cubes).x);
+    return textureSampleLevel(face_cubes, face_sampler, d, in.layer / 6u, 0.0);
 }

@@ -11,10 +11,10 @@ struct ShownLayer {
     depth_ratio: f32,
 }
 
-@group(0) @binding(1) var shadow_maps: texture_depth_2d_array;
+// The stored depths themselves, in x: read as floats, since GLSL has no texelFetch of a depth
+// texture (src/gpu/layout.rs, depth_texels).
+@group(0) @binding(1) var shadow_maps: texture_2d_array<f32>;
 @group(0) @binding(2) var<uniform> shown_layer: ShownLayer;
-// Nearest, no comparison: the stored depths themselves (GL cannot textureLoad a depth texture).
-@group(0) @binding(3) var map_sampler: sampler;
 
 @vertex
 fn vs_shadow_map_view(@builtin(vertex_index) index: u32) -> @builtin(position) vec4f {
@@ -30,7 +30,8 @@ fn fs_shadow_map_view(@builtin(position) pixel: vec4f) -> @location(0) vec4f {
     if any(uv < vec2f(0.0)) || any(uv >= vec2f(1.0)) {
         return vec4f(0.02, 0.02, 0.03, 1.0);
     }
-    let depth = textureSampleLevel(shadow_maps, map_sampler, uv, shown_layer.layer, 0);
+    let map_size = textureDimensions(shadow_maps);
+    let depth = textureLoad(shadow_maps, min(vec2u(uv * vec2f(map_size)), map_size - 1u), shown_layer.layer, 0).x;
     // A perspective view's depth crowds towards 1; shown as distance over the far plane instead.
     let r = shown_layer.depth_ratio;
     let distance = select(depth, r / (1.0 - depth * (1.0 - r)), r > 0.0);

@@ -29,7 +29,7 @@ const BISECTION_STEPS: u32 = 6u;
 
 // Group 3: opaque_depth (binding 0, transparency.wgsl) is a copy of the view's depth before the
 // glass is drawn; the glass's nearest back faces; a copy of the opaque image.
-@group(3) @binding(8) var back_depth: texture_depth_2d;
+@group(3) @binding(8) var back_depth: texture_2d<f32>;
 @group(3) @binding(9) var back_normal: texture_2d<f32>;
 @group(3) @binding(10) var opaque_image: texture_2d<f32>;
 
@@ -74,7 +74,7 @@ fn box_exit(p: vec3f, d: vec3f) -> f32 {
 // projection (up to MARCH_STEPS steps), until the segment's depth passes the image's; then
 // bisects the last step. The depth along a projected segment is linear in the image, so each
 // step compares exactly what the z-buffer would.
-fn screen_march(depth: texture_depth_2d, p: vec3f, d: vec3f, distance: f32) -> ScreenHit {
+fn screen_march(depth: texture_2d<f32>, p: vec3f, d: vec3f, distance: f32) -> ScreenHit {
     let size = vec2f(textureDimensions(depth));
     // A little past `distance`, so a surface right at its end (the scene's box) is crossed;
     // and in front of the near plane (clip z ≥ 0, linear along the segment).
@@ -107,7 +107,7 @@ fn screen_march(depth: texture_depth_2d, p: vec3f, d: vec3f, distance: f32) -> S
     for (var i = 1u; i <= steps; i++) {
         let t = end * f32(i) / f32(steps);
         let pixel = vec2i(mix(a.pixel, b.pixel, t));
-        if mix(a.depth, b.depth, t) > textureLoad(depth, pixel, 0) {
+        if mix(a.depth, b.depth, t) > textureLoad(depth, pixel, 0).x {
             after = t;
             break;
         }
@@ -118,7 +118,7 @@ fn screen_march(depth: texture_depth_2d, p: vec3f, d: vec3f, distance: f32) -> S
     }
     for (var i = 0u; i < BISECTION_STEPS; i++) {
         let t = 0.5 * (before + after);
-        if mix(a.depth, b.depth, t) > textureLoad(depth, vec2i(mix(a.pixel, b.pixel, t)), 0) {
+        if mix(a.depth, b.depth, t) > textureLoad(depth, vec2i(mix(a.pixel, b.pixel, t)), 0).x {
             after = t;
         } else {
             before = t;

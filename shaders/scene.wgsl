@@ -152,7 +152,6 @@ fn visibility(light: Light, p: vec3f, facing: vec3f, pixel: vec2f) -> vec3f {
         let texel = min(vec2u(coordinates.xy * f32(shadows.map_size)), vec2u(shadows.map_size - 1u));
         probe.lights[probe_light].layer = i32(layer);
         probe.lights[probe_light].texel = vec2f(texel);
-        probe.lights[probe_light].stored_depth = textureLoad(shadow_maps, texel, layer, 0);
         probe.lights[probe_light].receiver_depth = coordinates.z;
         probe.lights[probe_light].lit = v.x;
     }

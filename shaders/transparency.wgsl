@@ -67,13 +67,15 @@ fn fs_transparent_transmit(in: VertexOut) -> @location(0) vec4f {
 // Depth peeling, the exact order (Everitt 2001, here back to front): layer k is the farthest
 // transparent surface that is nearer than the opaque surface and strictly nearer than layer
 // k − 1. The pass keeps the farthest survivor (depth test Greater); a second pass shades it.
-@group(3) @binding(0) var opaque_depth: texture_depth_2d;
-@group(3) @binding(1) var peeled_depth: texture_depth_2d;
+// Depth images read with textureLoad are declared as float textures, depth in x: GLSL has no
+// texelFetch of a depth texture (src/gpu/layout.rs, depth_texels).
+@group(3) @binding(0) var opaque_depth: texture_2d<f32>;
+@group(3) @binding(1) var peeled_depth: texture_2d<f32>;
 
 @fragment
 fn fs_peel(in: VertexOut) {
     let pixel = vec2i(in.clip.xy);
-    let limit = min(textureLoad(opaque_depth, pixel, 0), textureLoad(peeled_depth, pixel, 0));
+    let limit = min(textureLoad(opaque_depth, pixel, 0).x, textureLoad(peeled_depth, pixel, 0).x);
     if in.clip.z >= limit || masked_out(in.uv) {
         discard;
     }

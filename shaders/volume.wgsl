@@ -54,7 +54,7 @@ struct Volume {
 
 // Group 3 bindings 0 and 1 are transparency.wgsl's `opaque_depth` (the view's depth: a copy of
 // it for isosurfaces, which write depth) and `peeled_depth`.
-@group(3) @binding(3) var near_depth: texture_depth_2d;
+@group(3) @binding(3) var near_depth: texture_2d<f32>;
 @group(3) @binding(4) var<uniform> volume: Volume;
 @group(3) @binding(5) var volume_texture: texture_3d<f32>;
 @group(3) @binding(6) var volume_sampler: sampler;
@@ -110,14 +110,14 @@ fn volume_ray(pixel: vec2f) -> VolumeRay {
         ray.origin = view.eye;
         ray.direction = normalize(q.xyz - view.eye * q.w);
     }
-    var t_end = depth_distance(ray, ndc, textureLoad(opaque_depth, vec2i(pixel), 0));
+    var t_end = depth_distance(ray, ndc, textureLoad(opaque_depth, vec2i(pixel), 0).x);
     var t_start = 0.0;
     if VOLUME_FAR_LIMIT {
-        t_end = min(t_end, depth_distance(ray, ndc, textureLoad(peeled_depth, vec2i(pixel), 0)));
+        t_end = min(t_end, depth_distance(ray, ndc, textureLoad(peeled_depth, vec2i(pixel), 0).x));
     }
     if VOLUME_NEAR_LIMIT {
         // No layer here (the peel is cleared to 0): nothing in front bounds the ray.
-        let depth = textureLoad(near_depth, vec2i(pixel), 0);
+        let depth = textureLoad(near_depth, vec2i(pixel), 0).x;
         if depth > 0.0 {
             t_start = depth_distance(ray, ndc, depth);
         }

@@ -42,6 +42,15 @@ pub fn texture(
     }
 }
 
+/// A depth image that the fragment stage reads with `textureLoad`, declared `texture_2d<f32>`
+/// and bound as unfilterable floats (the depth in `.x`) rather than as a `texture_depth_2d`:
+/// naga cannot translate `textureLoad` of a depth texture to GLSL, so a shader that does it
+/// fails to build on the GL backend. WebGPU lets a depth image be read as unfilterable floats,
+/// and every backend returns the same stored depth either way.
+pub fn depth_texels(binding: u32, view_dimension: wgpu::TextureViewDimension) -> wgpu::BindGroupLayoutEntry {
+    texture(binding, wgpu::TextureSampleType::Float { filterable: false }, view_dimension)
+}
+
 /// A filterable 2D colour texture read by the fragment stage.
 pub fn texture_2d(binding: u32) -> wgpu::BindGroupLayoutEntry {
     texture(binding, wgpu::TextureSampleType::Float { filterable: true }, wgpu::TextureViewDimension::D2)

@@ -25,14 +25,22 @@
 //! footprint, so the mean is kept. The GPU chain is rounded to 8 bits at every level; the CPU
 //! chain stays in f32; tests/mipmaps.rs checks they agree within 1/255 on every level.
 //!
-//! Limits: one pass per level (no single-pass downsampler); only 2D textures whose format can be
-//! rendered to and read as float; meant for 8-bit textures (a 32-bit float texture's levels would
-//! pass through the 16-bit scratch and lose precision).
+//! Cubes and cube arrays get a chain per face. Level 1 cannot read a face's level 0 as a 2D view
+//! of that layer: GL samples a cube only through a view of the whole cube ([`Layers`]), and
+//! `textureLoad` has no cube form. So each face is first drawn into a transient 2D image of the
+//! scratch's format, texel for texel (a nearest lookup at each texel's centre direction), and
+//! level 1 reads that image; Mirador's cubes are half floats, the scratch's own format, so the
+//! copy is exact and the chain is the one a 2D view of the layer would give.
+//!
+//! Limits: one pass per level (no single-pass downsampler); only 2D textures and cubes (not 2D
+//! arrays) whose format can be rendered to and read as float; meant for 8-bit textures and half
+//! floats (a 32-bit float texture's levels would pass through the 16-bit scratch and lose
+//! precision).
 
 use std::collections::HashMap;
 use std::sync::Mutex;
 
-use super::texture::GpuTexture;
+use super::texture::{GpuTexture, Layers};
 use crate::gpu::layout;
 use crate::shaders;
 use crate::texture::mipmap::Filter;
@@ -61,6 +69,51 @@ pub struct MipmapGenerator {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: Mutex<HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>>,
+    /// Copying one face of a cube, and of a cube array, into a 2D image.
+    face_of_cube: FaceCopy,
+    face_of_cubes: FaceCopy,
+    /// Nearest, clamped: each face texel read at its centre is that texel.
+    face_sampler: wgpu::Sampler,
+}
+
+/// The pass that draws one face of a cube (or of a cube array) into a 2D image for level 1 to
+/// read (`fs_mipmap_face_*` in `shaders/mipmap.wgsl`).
+struct FaceCopy {
+    layout: wgpu::BindGroupLayout,
+    pipeline: wgpu::RenderPipeline,
+    /// The binding the cube is read through.
+    binding: u32,
+}
+
+impl FaceCopy {
+    fn new(
+        device: &wgpu::Device,
+        module: &wgpu::ShaderModule,
+        dimension: wgpu::TextureViewDimension,
+        (binding, fragment): (u32, &str),
+    ) -> FaceCopy {
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("mipmap::face_layout"),
+            entries: &[
+                layout::sampler(1, wgpu::SamplerBindingType::NonFiltering),
+                layout::texture(binding, wgpu::TextureSampleType::Float { filterable: false }, dimension),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("mipmap::face_pipeline_layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = layout::fullscreen_pipeline(
+            device,
+            "mipmap::face_pipeline",
+            &pipeline_layout,
+            module,
+            ("vs_mipmap_face", fragment),
+            &[Some(SCRATCH_FORMAT.into())],
+        );
+        FaceCopy { layout, pipeline, binding }
+    }
 }
 
 impl MipmapGenerator {
@@ -85,7 +138,21 @@ impl MipmapGenerator {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        MipmapGenerator { module, layout, pipeline_layout, pipelines: Mutex::new(HashMap::new()) }
+        MipmapGenerator {
+            face_of_cube: FaceCopy::new(device, &module, wgpu::TextureViewDimension::Cube, (2, "fs_mipmap_face_cube")),
+            face_of_cubes: FaceCopy::new(
+                device,
+                &module,
+                wgpu::TextureViewDimension::CubeArray,
+                (3, "fs_mipmap_face_cubes"),
+            ),
+            face_sampler: device
+                .create_sampler(&wgpu::SamplerDescriptor { label: Some("mipmap::face_sampler"), ..Default::default() }),
+            module,
+            layout,
+            pipeline_layout,
+            pipelines: Mutex::new(HashMap::new()),
+        }
     }
 
     fn pipeline(&self, device: &wgpu::Device, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
@@ -111,8 +178,9 @@ impl MipmapGenerator {
     /// their own chain). Submit the encoder to run them; nothing else is needed before sampling
     /// the texture in a later submission (or later in the same encoder).
     ///
-    /// Panics (a programmer error) unless `texture` is 2D, single-sample, and has
-    /// `TEXTURE_BINDING | RENDER_ATTACHMENT` usage with a renderable float format.
+    /// Panics (a programmer error) unless `texture` is a 2D image, a cube or a cube array
+    /// ([`Layers`]), single-sample, and has `TEXTURE_BINDING | RENDER_ATTACHMENT` usage with a
+    /// renderable float format.
     pub fn record(&self, device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture) {
         self.record_layers(device, encoder, texture, 0..texture.depth_or_array_layers());
     }
@@ -137,6 +205,12 @@ impl MipmapGenerator {
             texture.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT),
             "a texture needs TEXTURE_BINDING | RENDER_ATTACHMENT usage to have its mipmaps generated"
         );
+        let face_copy = match Layers::of(texture) {
+            Layers::Single => None,
+            Layers::Cube => Some(&self.face_of_cube),
+            Layers::Cubes(_) => Some(&self.face_of_cubes),
+            Layers::Array(_) => panic!("mipmaps are generated for 2D images and cubes, not for 2D arrays"),
+        };
         let format = texture.format();
         let pipeline = self.pipeline(device, format);
         let level1 =
@@ -164,11 +238,47 @@ impl MipmapGenerator {
                 ..Default::default()
             })
         };
+        // A cube's level 0, one face at a time, as the 2D image level 1 reads; and the group
+        // that reads the whole cube (its level 0) to draw it.
+        let face = face_copy.map(|copy| {
+            let image = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("mipmap::face"),
+                size: wgpu::Extent3d { depth_or_array_layers: 1, ..texture.size() },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: SCRATCH_FORMAT,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            });
+            let cube = texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("mipmap::face_source"),
+                dimension: Some(Layers::of(texture).view_dimension()),
+                base_mip_level: 0,
+                mip_level_count: Some(1),
+                ..Default::default()
+            });
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("mipmap::face_group"),
+                layout: &copy.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.face_sampler) },
+                    wgpu::BindGroupEntry { binding: copy.binding, resource: wgpu::BindingResource::TextureView(&cube) },
+                ],
+            });
+            (&copy.pipeline, group, level_view(&image, 0, 0))
+        });
         encoder.push_debug_group("mipmap");
         for layer in layers {
+            if let Some((pipeline, group, image)) = &face {
+                draw(encoder, "mipmap::face_pass", (pipeline, group), &[image], layer);
+            }
             for level in 1..levels {
-                let source =
-                    if level == 1 { level_view(texture, 0, layer) } else { level_view(&scratch, level - 2, 0) };
+                let source = match &face {
+                    _ if level > 1 => level_view(&scratch, level - 2, 0),
+                    Some((_, _, image)) => image.clone(),
+                    None => level_view(texture, 0, layer),
+                };
                 let targets = [level_view(&scratch, level - 1, 0), level_view(texture, level, layer)];
                 let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("mipmap::bind_group"),
@@ -178,26 +288,37 @@ impl MipmapGenerator {
                         resource: wgpu::BindingResource::TextureView(&source),
                     }],
                 });
-                // Every texel is drawn, so the old contents need not be loaded.
-                let attachment =
-                    |view| Some(layout::color_attachment(view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)));
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("mipmap::pass"),
-                    color_attachments: &[attachment(&targets[0]), attachment(&targets[1])],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.push_debug_group("mipmap level");
-                pass.set_pipeline(&pipeline);
-                pass.set_bind_group(0, &group, &[]);
-                pass.draw(0..3, 0..1);
-                pass.pop_debug_group();
+                draw(encoder, "mipmap::pass", (&pipeline, &group), &[&targets[0], &targets[1]], 0);
             }
         }
         encoder.pop_debug_group();
     }
+}
+
+/// One fullscreen triangle of `pipeline` with `group` into `targets`, as instance `instance`.
+/// Every texel is drawn, so the targets' old contents are not loaded.
+fn draw(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    (pipeline, group): (&wgpu::RenderPipeline, &wgpu::BindGroup),
+    targets: &[&wgpu::TextureView],
+    instance: u32,
+) {
+    let attachments: Vec<_> = targets
+        .iter()
+        .map(|view| Some(layout::color_attachment(view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT))))
+        .collect();
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &attachments,
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, group, &[]);
+    pass.draw(0..3, instance..instance + 1);
 }
 
 /// Fills levels `1..` of `texture` from its level 0 and submits the work (without waiting). A

@@ -28,6 +28,12 @@ pub enum GpuError {
     NoAdapter { tried: String },
     #[error("the {adapter} adapter refused to create a device: {source}")]
     Device { adapter: String, source: wgpu::RequestDeviceError },
+    #[error(
+        "the {adapter} adapter cannot sample arrays of cube maps (wgpu's DownlevelFlags::CUBE_ARRAY_TEXTURES; \
+         WebGL2 and OpenGL ES without EXT_texture_cube_map_array lack them), and the dynamic environment \
+         cubes of the rasterizer are one"
+    )]
+    NoCubeArrays { adapter: String },
     #[error("MIRADOR_LIMITS={0}: unknown value; `downlevel` is the only one")]
     UnknownLimits(String),
     #[error(
@@ -43,7 +49,17 @@ impl Gpu {
     /// A device with no window, preferring Vulkan and falling back to GL, unless `WGPU_BACKEND`
     /// names the backends to try.
     pub fn headless() -> Result<Gpu, GpuError> {
-        let (gpu, ()) = Gpu::first_adapter(wgpu::InstanceDescriptor::new_without_display_handle, |_| Some(()))?;
+        Gpu::first_headless(backend_order())
+    }
+
+    /// A device with no window on `backends`, whatever `WGPU_BACKEND` says: how one process
+    /// compares two backends (`tests/gl_backend.rs`).
+    pub fn headless_on(backends: wgpu::Backends) -> Result<Gpu, GpuError> {
+        Gpu::first_headless(vec![backends])
+    }
+
+    fn first_headless(order: Vec<wgpu::Backends>) -> Result<Gpu, GpuError> {
+        let (gpu, ()) = Gpu::first_adapter(order, wgpu::InstanceDescriptor::new_without_display_handle, |_| Some(()))?;
         Ok(gpu)
     }
 
@@ -55,7 +71,7 @@ impl Gpu {
         W: wgpu::rwh::HasWindowHandle + wgpu::rwh::HasDisplayHandle + std::fmt::Debug + Send + Sync + 'static,
     {
         let descriptor = || wgpu::InstanceDescriptor::new_with_display_handle(Box::new(window.clone()));
-        Gpu::first_adapter(descriptor, |instance| match instance.create_surface(window.clone()) {
+        Gpu::first_adapter(backend_order(), descriptor, |instance| match instance.create_surface(window.clone()) {
             Ok(surface) => Some(surface),
             Err(e) => {
                 log::info!("no surface for the window: {e}");
@@ -64,16 +80,13 @@ impl Gpu {
         })
     }
 
-    /// Tries the backends in order; for each, `attach` may make something the adapter must be
-    /// compatible with (a window's surface), and the first adapter found wins.
+    /// Tries the backends of `order` in turn; for each, `attach` may make something the adapter
+    /// must be compatible with (a window's surface), and the first adapter found wins.
     fn first_adapter<T: SurfaceLike>(
+        order: Vec<wgpu::Backends>,
         descriptor: impl Fn() -> wgpu::InstanceDescriptor,
         attach: impl Fn(&wgpu::Instance) -> Option<T>,
     ) -> Result<(Gpu, T), GpuError> {
-        let order = match wgpu::Backends::from_env() {
-            Some(chosen) => vec![chosen],
-            None => vec![wgpu::Backends::VULKAN, wgpu::Backends::GL],
-        };
         let mut tried = Vec::new();
         for backends in order {
             let mut d = descriptor().with_env();
@@ -93,9 +106,15 @@ impl Gpu {
     /// A device for `adapter`, asking only for what every backend Mirador supports can give,
     /// and for the adapter's largest textures. `MIRADOR_LIMITS=downlevel` leaves the texture size
     /// at wgpu's downlevel default (2048 pixels a side), to try Mirador as a small device runs it.
+    /// An adapter without cube-map arrays is refused here, with the reason, rather than by a
+    /// validation error when the first frame binds its environment maps: desktop GL and Vulkan
+    /// have them, WebGL2 does not.
     pub fn with_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, GpuError> {
         let info = adapter.get_info();
         log::info!("adapter: {} ({:?})", info.name, info.backend);
+        if !adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::CUBE_ARRAY_TEXTURES) {
+            return Err(GpuError::NoCubeArrays { adapter: info.name });
+        }
         let required_limits = match std::env::var("MIRADOR_LIMITS") {
             Ok(value) if value == "downlevel" => wgpu::Limits::downlevel_defaults(),
             Ok(value) => return Err(GpuError::UnknownLimits(value)),
@@ -108,6 +127,7 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|source| GpuError::Device { adapter: info.name.clone(), source })?;
+        seamless_cubes_on_desktop_gl(&device);
         Ok(Gpu { instance, adapter, device, queue })
     }
 
@@ -152,6 +172,37 @@ impl Gpu {
             None => Ok(value),
             Some(error) => Err(reported(&error)),
         }
+    }
+}
+
+/// Turns on seamless cube-map filtering where wgpu's GL backend runs on a desktop OpenGL context
+/// (as it does on Mesa's llvmpipe), which leaves it off. WebGPU filters across a cube's faces,
+/// as Vulkan and OpenGL ES 3 always do; without it, a lookup near an edge clamps to its own face,
+/// and every mirror ball showed its cube's seams as faint lines (FLIP 0.02 over the worst
+/// region of the environment stage against Vulkan; none with it, `tests/gl_backend.rs`).
+fn seamless_cubes_on_desktop_gl(device: &wgpu::Device) {
+    #[cfg(any(windows, target_os = "linux", target_os = "android", target_os = "freebsd"))]
+    {
+        use glow::HasContext;
+        // SAFETY: the context is wgpu's own, locked (and made current) for the call; enabling a
+        // capability wgpu never sets changes nothing wgpu keeps track of.
+        unsafe {
+            if let Some(hal) = device.as_hal::<wgpu::hal::api::Gles>() {
+                let gl = hal.context().lock();
+                // An ES context has no such switch: its cube maps are always seamless.
+                if !gl.version().is_embedded {
+                    gl.enable(glow::TEXTURE_CUBE_MAP_SEAMLESS);
+                }
+            }
+        }
+    }
+}
+
+/// The backends to try, in order: the ones `WGPU_BACKEND` names, else Vulkan, then GL.
+fn backend_order() -> Vec<wgpu::Backends> {
+    match wgpu::Backends::from_env() {
+        Some(chosen) => vec![chosen],
+        None => vec![wgpu::Backends::VULKAN, wgpu::Backends::GL],
     }
 }
 

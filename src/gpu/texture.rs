@@ -1,4 +1,4 @@
-//! Textures: render targets and sampled images.
+//! Textures: render targets, sampled images, and layered textures ([`Layers`]).
 
 /// A texture with the default view of all its levels.
 pub struct GpuTexture {
@@ -73,5 +73,119 @@ impl GpuTexture {
         );
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
         GpuTexture { texture, view }
+    }
+}
+
+/// What the layers of a 2D texture are, decided once, when it is made, for every backend.
+///
+/// WebGPU leaves that open until a view is made: any 2D texture with six layers may be viewed as
+/// a cube, a 2D array or six 2D images. GL cannot: wgpu's GL backend picks the texture's GL
+/// target at creation from its size alone (wgpu-hal's `get_info_from_desc`): a square texture
+/// whose layer count is a multiple of 6 becomes a `CUBE_MAP` (six layers) or a
+/// `CUBE_MAP_ARRAY`, any other with one layer a `TEXTURE_2D`, with more a `TEXTURE_2D_ARRAY`.
+/// A shader can then sample it only through a view of that one kind, of all its layers (a view
+/// of layer k alone cannot be bound for sampling at all; drawing into one layer is fine).
+/// Anything else reads black, with an error in the log. So every layered texture is made by
+/// [`Layers::texture`], which pads the layer count until GL's rule gives the kind asked for,
+/// and sampled through the view it returns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layers {
+    /// One image: `D2` views.
+    Single,
+    /// `n` images of one size, sampled through a `D2Array` view.
+    Array(u32),
+    /// One cube: six square faces, sampled through a `Cube` view.
+    Cube,
+    /// `n` cubes, sampled through a `CubeArray` view (a device needs
+    /// `DownlevelFlags::CUBE_ARRAY_TEXTURES`, which [`super::Gpu::with_adapter`] checks).
+    Cubes(u32),
+}
+
+impl Layers {
+    /// How many layers a texture of these layers and of `width × height` texels is made with.
+    /// An array gets at least two layers (one would make a `TEXTURE_2D`), and one more when
+    /// square and a multiple of 6 (six shadow-map layers of one point light would make a cube);
+    /// a cube array at least two cubes (one would make a `CUBE_MAP`). The padding layers are
+    /// never drawn into nor read.
+    pub fn count(self, (width, height): (u32, u32)) -> u32 {
+        match self {
+            Layers::Single => 1,
+            Layers::Array(n) => {
+                let n = n.max(2);
+                if width == height && n.is_multiple_of(6) { n + 1 } else { n }
+            }
+            Layers::Cube => 6,
+            Layers::Cubes(n) => 6 * n.max(2),
+        }
+    }
+
+    /// The view dimension the texture is sampled through.
+    pub fn view_dimension(self) -> wgpu::TextureViewDimension {
+        match self {
+            Layers::Single => wgpu::TextureViewDimension::D2,
+            Layers::Array(_) => wgpu::TextureViewDimension::D2Array,
+            Layers::Cube => wgpu::TextureViewDimension::Cube,
+            Layers::Cubes(_) => wgpu::TextureViewDimension::CubeArray,
+        }
+    }
+
+    /// What a 2D texture's layers are, read back from its size by GL's rule: what a texture made
+    /// by [`Layers::texture`] was made as (a padded count reads as the padded number).
+    pub fn of(texture: &wgpu::Texture) -> Layers {
+        Layers::by_gl_rule(texture.depth_or_array_layers(), texture.width() == texture.height())
+    }
+
+    /// wgpu-hal's `get_info_from_desc`: the kind GL makes of `count` layers, square or not.
+    fn by_gl_rule(count: u32, square: bool) -> Layers {
+        match count {
+            1 => Layers::Single,
+            6 if square => Layers::Cube,
+            n if square && n.is_multiple_of(6) => Layers::Cubes(n / 6),
+            n => Layers::Array(n),
+        }
+    }
+
+    /// A 2D texture of these layers, made from `descriptor` with its layer count set by
+    /// [`Layers::count`], and the view of all its layers and levels to sample it through.
+    /// Panics (a programmer error) on a cube that is not square or a texture that is not 2D.
+    pub fn texture(self, device: &wgpu::Device, descriptor: &wgpu::TextureDescriptor) -> GpuTexture {
+        let (width, height) = (descriptor.size.width, descriptor.size.height);
+        assert!(descriptor.dimension == wgpu::TextureDimension::D2, "layers are those of a 2D texture");
+        assert!(width == height || !matches!(self, Layers::Cube | Layers::Cubes(_)), "a cube's faces are square");
+        let size = wgpu::Extent3d { depth_or_array_layers: self.count((width, height)), ..descriptor.size };
+        let texture = device.create_texture(&wgpu::TextureDescriptor { size, ..descriptor.clone() });
+        debug_assert_eq!(Layers::of(&texture).view_dimension(), self.view_dimension(), "GL's rule reads it back");
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: descriptor.label,
+            dimension: Some(self.view_dimension()),
+            ..Default::default()
+        });
+        GpuTexture { texture, view }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Layers;
+
+    /// Every kind keeps its kind under GL's rule, however many it holds.
+    #[test]
+    fn padded_counts_read_back_as_the_kind_asked_for() {
+        let kind = |layers: Layers| std::mem::discriminant(&layers);
+        for n in 1..=25 {
+            for (layers, size) in
+                [(Layers::Array(n), (64, 64)), (Layers::Array(n), (64, 32)), (Layers::Cubes(n), (8, 8))]
+            {
+                let count = layers.count(size);
+                let held = if matches!(layers, Layers::Cubes(_)) { 6 * n } else { n };
+                assert!(count >= held, "{layers:?}: {count} layers");
+                let read = Layers::by_gl_rule(count, size.0 == size.1);
+                assert_eq!(kind(read), kind(layers), "{layers:?} of {size:?}: {count} layers");
+            }
+        }
+        assert_eq!(Layers::Array(6).count((512, 512)), 7, "one point light's six layers");
+        assert_eq!(Layers::Array(1).count((512, 512)), 2);
+        assert_eq!(Layers::Cubes(1).count((16, 16)), 12);
+        assert_eq!(Layers::Cube.count((16, 16)), 6);
     }
 }

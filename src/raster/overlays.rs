@@ -96,7 +96,6 @@ struct MapView {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     uniform: UniformBuffer<GpuShownLayer>,
-    sampler: wgpu::Sampler,
 }
 
 #[repr(C)]
@@ -113,9 +112,8 @@ impl MapView {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("overlays::map_view_layout"),
             entries: &[
-                layout::texture(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
+                layout::depth_texels(1, wgpu::TextureViewDimension::D2Array),
                 layout::uniform(2, wgpu::ShaderStages::FRAGMENT),
-                layout::sampler(3, wgpu::SamplerBindingType::NonFiltering),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -132,11 +130,7 @@ impl MapView {
             &[Some(HDR_FORMAT.into())],
         );
         let uniform = UniformBuffer::new(device, "overlays::map_view_uniform", &GpuShownLayer::zeroed());
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("overlays::map_view_sampler"),
-            ..Default::default()
-        });
-        MapView { pipeline, layout, uniform, sampler }
+        MapView { pipeline, layout, uniform }
     }
 
     fn record(
@@ -156,7 +150,6 @@ impl MapView {
             entries: &[
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(maps) },
                 wgpu::BindGroupEntry { binding: 2, resource: self.uniform.binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&self.sampler) },
             ],
         });
         let hdr = &targets.hdr.view;

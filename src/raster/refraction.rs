@@ -83,7 +83,7 @@ struct RefractionImages {
 
 impl RefractionPass {
     pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SceneShader) -> RefractionPass {
-        let depth = |binding| layout::texture(binding, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2);
+        let depth = |binding| layout::depth_texels(binding, wgpu::TextureViewDimension::D2);
         let colour = |binding| {
             layout::texture(
                 binding,

@@ -34,8 +34,9 @@ pub struct SceneLayouts {
 }
 
 impl SceneLayouts {
-    /// The layouts; `inspect` adds the inspection buffer to the lighting group (binding 11,
-    /// `shaders/inspect.wgsl`), for a renderer that inspects pixels.
+    /// The layouts; `inspect` adds the inspection buffer and the shadow maps read as floats to
+    /// the lighting group (bindings 11 and 12, `shaders/inspect.wgsl`), for a renderer that
+    /// inspects pixels.
     pub fn new(device: &wgpu::Device, inspect: bool) -> SceneLayouts {
         let both = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let frame = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -82,6 +83,7 @@ impl SceneLayouts {
                 },
                 count: None,
             });
+            lighting_entries.push(layout::depth_texels(12, wgpu::TextureViewDimension::D2Array));
         }
         let lighting = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::lighting_layout"),

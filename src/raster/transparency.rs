@@ -147,7 +147,7 @@ struct ViewSteps {
 
 impl TransparencyPass {
     pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SceneShader) -> TransparencyPass {
-        let depth = |binding| layout::texture(binding, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2);
+        let depth = |binding| layout::depth_texels(binding, wgpu::TextureViewDimension::D2);
         let peel_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("transparency::peel_group_layout"),
             entries: &[depth(0), depth(1)],

@@ -226,7 +226,7 @@ pub struct VolumePass {
 
 impl VolumePass {
     pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SceneShader) -> VolumePass {
-        let depth = |binding| layout::texture(binding, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2);
+        let depth = |binding| layout::depth_texels(binding, wgpu::TextureViewDimension::D2);
         let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("volume::group_layout"),
             entries: &[

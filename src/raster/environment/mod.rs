@@ -37,6 +37,7 @@ use super::uniforms::{
 use super::view::View;
 use crate::gpu::layout;
 use crate::gpu::mipmap::{MipmapGenerator, mip_level_count};
+use crate::gpu::texture::Layers;
 use crate::gpu::uniform::UniformBuffer;
 use crate::scene::environment::cube_direction;
 use crate::scene::{Camera, EnvImage, EnvironmentSource, Scene};
@@ -166,6 +167,8 @@ pub struct Converter {
     to_latlong: wgpu::RenderPipeline,
     to_sphere: wgpu::RenderPipeline,
     view_cross: wgpu::RenderPipeline,
+    /// The first dynamic cube unfolded, read from the cube array.
+    view_cross_dynamic: wgpu::RenderPipeline,
     /// A sphere or lat–long map shown as an image.
     view_image: wgpu::RenderPipeline,
     /// Trilinear; u repeats (the lat–long map's wrap), v clamps.
@@ -183,6 +186,7 @@ impl Converter {
                 layout::sampler(1, wgpu::SamplerBindingType::Filtering),
                 layout::texture(2, filterable, wgpu::TextureViewDimension::D2),
                 layout::texture(3, filterable, wgpu::TextureViewDimension::Cube),
+                layout::texture(4, filterable, wgpu::TextureViewDimension::CubeArray),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -206,6 +210,7 @@ impl Converter {
             to_latlong: pipeline("fs_to_latlong", ENV_FORMAT),
             to_sphere: pipeline("fs_to_sphere", ENV_FORMAT),
             view_cross: pipeline("fs_view_cross", hdr),
+            view_cross_dynamic: pipeline("fs_view_cross_dynamic", hdr),
             view_image: pipeline("fs_view_image", hdr),
             group_layout,
             sampler: device.create_sampler(&wgpu::SamplerDescriptor {
@@ -221,12 +226,12 @@ impl Converter {
         }
     }
 
+    /// The group that reads `sources`: a 2D map, a cube and a cube array.
     fn group(
         &self,
         device: &wgpu::Device,
         params: &UniformBuffer<GpuEnvironment>,
-        source_2d: &wgpu::TextureView,
-        source_cube: &wgpu::TextureView,
+        (source_2d, source_cube, source_cubes): (&wgpu::TextureView, &wgpu::TextureView, &wgpu::TextureView),
     ) -> wgpu::BindGroup {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("environment::group"),
@@ -236,6 +241,7 @@ impl Converter {
                 wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(source_2d) },
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(source_cube) },
+                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(source_cubes) },
             ],
         })
     }
@@ -302,41 +308,34 @@ pub struct MapTexture {
 }
 
 impl MapTexture {
-    /// A map of `layers` layers (6 per cube) with a full mip chain, viewed as `dimension`.
-    fn new(
-        device: &wgpu::Device,
-        label: &str,
-        (width, height): (u32, u32),
-        layers: u32,
-        dimension: wgpu::TextureViewDimension,
-    ) -> MapTexture {
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
-            mip_level_count: mip_level_count(width, height),
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: ENV_FORMAT,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::COPY_DST
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            label: Some(label),
-            dimension: Some(dimension),
-            ..Default::default()
-        });
-        MapTexture { texture, view }
+    /// A map of `layers` (a 2D map, the world's cube, the dynamic cubes) with a full mip chain,
+    /// viewed as what its layers are.
+    fn new(device: &wgpu::Device, label: &str, (width, height): (u32, u32), layers: Layers) -> MapTexture {
+        let map = layers.texture(
+            device,
+            &wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: mip_level_count(width, height),
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: ENV_FORMAT,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING
+                    | wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::COPY_DST
+                    | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            },
+        );
+        MapTexture { texture: map.texture, view: map.view }
     }
 
-    /// A 2D map holding `image` times `intensity` (clamped to what half floats hold).
+    /// A 2D map holding `image` times `intensity` (clamped to what half floats hold), or a cube
+    /// of six.
     fn upload(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, images: &[&EnvImage], intensity: f32) -> Self {
         let (width, height) = (images[0].width, images[0].height);
-        let dimension =
-            if images.len() == 6 { wgpu::TextureViewDimension::Cube } else { wgpu::TextureViewDimension::D2 };
-        let map = MapTexture::new(device, label, (width, height), images.len() as u32, dimension);
+        let layers = if images.len() == 6 { Layers::Cube } else { Layers::Single };
+        let map = MapTexture::new(device, label, (width, height), layers);
         for (layer, image) in images.iter().enumerate() {
             let halves: Vec<u16> = image
                 .texels
@@ -361,7 +360,7 @@ impl MapTexture {
         map
     }
 
-    /// The view of one layer's level 0, to draw into.
+    /// The view of one layer's level 0, to draw into (never to sample: see [`Layers`]).
     fn layer(&self, layer: u32) -> wgpu::TextureView {
         self.texture.create_view(&wgpu::TextureViewDescriptor {
             label: Some("environment::layer"),
@@ -370,17 +369,6 @@ impl MapTexture {
             mip_level_count: Some(1),
             base_array_layer: layer,
             array_layer_count: Some(1),
-            ..Default::default()
-        })
-    }
-
-    /// The six layers from `first` seen as one cube.
-    fn cube(&self, first: u32) -> wgpu::TextureView {
-        self.texture.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("environment::cube"),
-            dimension: Some(wgpu::TextureViewDimension::Cube),
-            base_array_layer: first,
-            array_layer_count: Some(6),
             ..Default::default()
         })
     }
@@ -405,8 +393,11 @@ pub struct EnvironmentMaps {
     pub cube: MapTexture,
     pub sphere: MapTexture,
     pub latlong: MapTexture,
-    /// Six layers per object of `SceneGpu::env_objects` (six for none, unused).
+    /// Six layers per object of `SceneGpu::env_objects`, in a cube array of at least two cubes
+    /// ([`Layers::count`]; 1×1 texels for none, unused).
     pub dynamic: MapTexture,
+    /// How many of the cube array's cubes belong to objects.
+    dynamic_cubes: u32,
     /// `environment.cube_size` when they were made.
     pub cube_size: u32,
     /// The view rotation the sphere map was last made for.
@@ -439,9 +430,11 @@ impl EnvironmentMaps {
         };
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("environment::encoder") });
-        let stand_in = |label| MapTexture::new(device, label, (1, 1), 1, wgpu::TextureViewDimension::D2);
-        let stand_in_cube =
-            MapTexture::new(device, "environment::no_cube", (1, 1), 6, wgpu::TextureViewDimension::Cube);
+        let stand_in = |label| MapTexture::new(device, label, (1, 1), Layers::Single);
+        let stand_in_cube = MapTexture::new(device, "environment::no_cube", (1, 1), Layers::Cube);
+        // Bound where no cube array is read, and always where a group is drawn into the dynamic
+        // cubes (a texture may not be read and drawn into in one pass).
+        let stand_in_cubes = MapTexture::new(device, "environment::no_cubes", (1, 1), Layers::Cubes(1));
         let sphere_source = match source {
             Some(EnvironmentSource::Sphere(image)) => {
                 MapTexture::upload(device, queue, "environment::sphere_source", &[image], intensity)
@@ -452,26 +445,14 @@ impl EnvironmentMaps {
             Some(EnvironmentSource::LatLong(image)) => {
                 MapTexture::upload(device, queue, "environment::latlong", &[image], intensity)
             }
-            _ => MapTexture::new(
-                device,
-                "environment::latlong",
-                (2 * map_size, map_size),
-                1,
-                wgpu::TextureViewDimension::D2,
-            ),
+            _ => MapTexture::new(device, "environment::latlong", (2 * map_size, map_size), Layers::Single),
         };
         let cube = match source {
             Some(EnvironmentSource::Cube(faces)) => {
                 let faces: Vec<&EnvImage> = faces.iter().collect();
                 MapTexture::upload(device, queue, "environment::cube", &faces, intensity)
             }
-            _ => MapTexture::new(
-                device,
-                "environment::cube",
-                (cube_face, cube_face),
-                6,
-                wgpu::TextureViewDimension::Cube,
-            ),
+            _ => MapTexture::new(device, "environment::cube", (cube_face, cube_face), Layers::Cube),
         };
         // Sources first: their mip chains are what the conversions read.
         mipmaps.record(device, &mut encoder, &sphere_source.texture);
@@ -485,46 +466,40 @@ impl EnvironmentMaps {
             _ => {}
         }
         if !matches!(source, Some(EnvironmentSource::Cube(_))) {
-            let group = pass.group(device, &params, source_2d, &stand_in_cube.view);
+            let group = pass.group(device, &params, (source_2d, &stand_in_cube.view, &stand_in_cubes.view));
             for face in 0..6 {
                 Converter::draw(&mut encoder, &pass.to_cube, &group, &cube.layer(face), face);
             }
             mipmaps.record(device, &mut encoder, &cube.texture);
         }
         // Reads the source, or the world's cube made from it (what the sphere map is made from).
-        let reads_world = pass.group(device, &params, &sphere_source.view, &cube.view);
+        let reads_world = pass.group(device, &params, (&sphere_source.view, &cube.view, &stand_in_cubes.view));
         if !matches!(source, Some(EnvironmentSource::LatLong(_))) {
             Converter::draw(&mut encoder, &pass.to_latlong, &reads_world, &latlong.layer(0), 0);
             mipmaps.record(device, &mut encoder, &latlong.texture);
         }
-        let sphere =
-            MapTexture::new(device, "environment::sphere", (map_size, map_size), 1, wgpu::TextureViewDimension::D2);
-        let layers = 6 * dynamic_cubes.max(1) as u32;
+        let sphere = MapTexture::new(device, "environment::sphere", (map_size, map_size), Layers::Single);
+        let dynamic_cubes = dynamic_cubes as u32;
         let dynamic_size = if dynamic_cubes == 0 { 1 } else { cube_size };
-        let dynamic = MapTexture::new(
-            device,
-            "environment::dynamic",
-            (dynamic_size, dynamic_size),
-            layers,
-            wgpu::TextureViewDimension::CubeArray,
-        );
+        let dynamic =
+            MapTexture::new(device, "environment::dynamic", (dynamic_size, dynamic_size), Layers::Cubes(dynamic_cubes));
         // Until it is drawn, each dynamic cube shows the world (a neighbour's cube seen in the
         // first frame's captures is the world alone, not black).
         if dynamic_cubes > 0 {
-            let group = pass.group(device, &params, source_2d, &cube.view);
-            for layer in 0..layers {
+            let group = pass.group(device, &params, (source_2d, &cube.view, &stand_in_cubes.view));
+            for layer in 0..6 * dynamic_cubes {
                 // The world's radiance at the dynamic cube's texels.
                 Converter::draw(&mut encoder, &pass.to_cube, &group, &dynamic.layer(layer), layer % 6);
             }
-            mipmaps.record(device, &mut encoder, &dynamic.texture);
+            mipmaps.record_layers(device, &mut encoder, &dynamic.texture, 0..6 * dynamic_cubes);
         }
         queue.submit([encoder.finish()]);
-        let dynamic_or_world = if dynamic_cubes > 0 { dynamic.cube(0) } else { cube.cube(0) };
+        let reads = |source_2d, source_cubes| pass.group(device, &params, (source_2d, &cube.view, source_cubes));
         let views = ViewGroups {
-            cross_world: pass.group(device, &params, &latlong.view, &cube.view),
-            cross_dynamic: pass.group(device, &params, &latlong.view, &dynamic_or_world),
-            sphere: pass.group(device, &params, &sphere.view, &cube.view),
-            latlong: pass.group(device, &params, &latlong.view, &cube.view),
+            cross_world: reads(&latlong.view, &stand_in_cubes.view),
+            cross_dynamic: (dynamic_cubes > 0).then(|| reads(&latlong.view, &dynamic.view)),
+            sphere: reads(&sphere.view, &stand_in_cubes.view),
+            latlong: reads(&latlong.view, &stand_in_cubes.view),
         };
         EnvironmentMaps {
             reads_world,
@@ -535,6 +510,7 @@ impl EnvironmentMaps {
             sphere,
             latlong,
             dynamic,
+            dynamic_cubes,
             cube_size,
             sphere_made_for: None,
             captured: None,
@@ -618,6 +594,11 @@ impl EnvironmentMaps {
         self.captured = None;
     }
 
+    /// The layers of the dynamic cubes that objects own (the cube array's padding left out).
+    pub fn dynamic_layers(&self) -> std::ops::Range<u32> {
+        0..6 * self.dynamic_cubes
+    }
+
     /// Copies `image` (a capture target of the cube size) into layer `layer` of the dynamic cubes.
     pub fn store_capture(&self, encoder: &mut wgpu::CommandEncoder, image: &wgpu::Texture, layer: u32) {
         encoder.copy_texture_to_texture(
@@ -645,8 +626,10 @@ impl EnvironmentMaps {
         let aspect = |map: &MapTexture| map.texture.width() as f32 / map.texture.height() as f32;
         let (pipeline, group, aspect) = match settings.view {
             EnvironmentView::Off => return,
-            EnvironmentView::Cross if settings.dynamic => (&pass.view_cross, &self.views.cross_dynamic, 4.0 / 3.0),
-            EnvironmentView::Cross => (&pass.view_cross, &self.views.cross_world, 4.0 / 3.0),
+            EnvironmentView::Cross => match &self.views.cross_dynamic {
+                Some(group) if settings.dynamic => (&pass.view_cross_dynamic, group, 4.0 / 3.0),
+                _ => (&pass.view_cross, &self.views.cross_world, 4.0 / 3.0),
+            },
             EnvironmentView::Sphere => (&pass.view_image, &self.views.sphere, aspect(&self.sphere)),
             EnvironmentView::Latlong => (&pass.view_image, &self.views.latlong, aspect(&self.latlong)),
         };
@@ -656,10 +639,10 @@ impl EnvironmentMaps {
 }
 
 /// What each teaching view reads: the cube unfolded (the world's, or the first reflective
-/// object's), the sphere map, the lat–long map.
+/// object's when there is one), the sphere map, the lat–long map.
 struct ViewGroups {
     cross_world: wgpu::BindGroup,
-    cross_dynamic: wgpu::BindGroup,
+    cross_dynamic: Option<wgpu::BindGroup>,
     sphere: wgpu::BindGroup,
     latlong: wgpu::BindGroup,
 }

@@ -128,7 +128,8 @@ impl EnvironmentPass {
 
     /// Makes the dynamic cubes' mip chains once their faces are drawn.
     pub fn finish_faces(&self, gpu: &Gpu, mipmaps: &MipmapGenerator, frame: &mut FrameEncoder, faces: usize) {
-        mipmaps.record(&gpu.device, &mut frame.encoder, &self.maps().dynamic.texture);
+        let maps = self.maps();
+        mipmaps.record_layers(&gpu.device, &mut frame.encoder, &maps.dynamic.texture, maps.dynamic_layers());
         frame.end("environment cubes", &[("faces", Figure::Count(faces as u64))]);
     }
 

@@ -381,6 +381,7 @@ fn lighting_group<'c>(
         ];
         if let Some(buffer) = inspection {
             entries.push(wgpu::BindGroupEntry { binding: 11, resource: buffer.as_entire_binding() });
+            entries.push(texture(12, maps.depth));
         }
         let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("frame::lighting_group"),

@@ -38,6 +38,7 @@ use super::scene_gpu::{SceneGpu, SceneLayouts, VERTEX_BUFFERS};
 use super::targets::DEPTH_FORMAT;
 use super::uniforms::ALPHA_MASK;
 use super::view::{View, ViewSlot};
+use crate::gpu::texture::{GpuTexture, Layers};
 use crate::gpu::uniform::UniformBuffer;
 use crate::gpu::{Gpu, layout};
 use crate::settings::ShadowSettings;
@@ -93,28 +94,28 @@ struct ShadowTargets {
     transmission_layers: Vec<wgpu::TextureView>,
 }
 
+/// A 2D array of `layers` square maps (padded so that GL keeps it an array: [`Layers`]), the
+/// view the lookups sample it through, and a view of each layer to draw it.
 fn array_texture(
     device: &wgpu::Device,
     label: &str,
     size: u32,
     layers: u32,
     format: wgpu::TextureFormat,
-) -> (wgpu::Texture, wgpu::TextureView, Vec<wgpu::TextureView>) {
-    let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        view_formats: &[],
-    });
-    let array = texture.create_view(&wgpu::TextureViewDescriptor {
-        label: Some(label),
-        dimension: Some(wgpu::TextureViewDimension::D2Array),
-        ..Default::default()
-    });
+) -> (wgpu::TextureView, Vec<wgpu::TextureView>) {
+    let GpuTexture { texture, view: array } = Layers::Array(layers).texture(
+        device,
+        &wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+    );
     let per_layer = (0..layers)
         .map(|layer| {
             texture.create_view(&wgpu::TextureViewDescriptor {
@@ -126,16 +127,16 @@ fn array_texture(
             })
         })
         .collect();
-    (texture, array, per_layer)
+    (array, per_layer)
 }
 
 impl ShadowTargets {
     /// At least one layer of each, so the opaque pass can always bind them; 1×1 when unused.
     fn new(device: &wgpu::Device, size: u32, layers: u32, with_transmission: bool) -> ShadowTargets {
         let layers = layers.max(1);
-        let (_, depth_array, depth_layers) = array_texture(device, "shadow::depth_maps", size, layers, DEPTH_FORMAT);
+        let (depth_array, depth_layers) = array_texture(device, "shadow::depth_maps", size, layers, DEPTH_FORMAT);
         let (transmission_size, transmission_layers_count) = if with_transmission { (size, layers) } else { (1, 1) };
-        let (_, transmission_array, transmission_layers) = array_texture(
+        let (transmission_array, transmission_layers) = array_texture(
             device,
             "shadow::transmission_maps",
             transmission_size,
