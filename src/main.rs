@@ -134,8 +134,8 @@ struct ViewArgs {
     /// A scripted step, one per frame, in order: `set KEY=VALUE`, `view raster|traced|split|difference`,
     /// `split X`, `orbit DX DY`, `pan DX DY`, `zoom N`, `frame`, `reset`, `navigate orbit|fly`,
     /// `walk X Y Z`, `pick X Y`, `cursor X Y`, `probe`, `material KEY=VALUE`, `load FILE`, `scale S`,
-    /// `fps N|off`, `help on|off`, `panel on|off`, `overlay on|off`, `wait N`, `wait traced`, `measure`,
-    /// `screenshot FILE.png`.
+    /// `fps N|off`, `help on|off`, `panel on|off`, `overlay on|off`, `wait N`, `wait 2s`,
+    /// `wait traced`, `measure`, `screenshot FILE.png`.
     #[arg(long = "step", value_name = "STEP", requires = "frames")]
     steps: Vec<String>,
     /// A file of steps, one a line (`#` comments); run before any --step.

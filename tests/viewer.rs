@@ -262,7 +262,7 @@ fn a_scene_file_changed_on_disk_is_reloaded() {
     assert!(on_path("xvfb-run"), "install Xvfb (`sudo apt-get install xvfb`) to run the viewer tests");
     let mut child = Command::new("xvfb-run")
         .args(["-a", binary, "view", scene.to_str().unwrap(), "--size", "480x320", "--frames", "2"])
-        .args(["--step", "wait 60"])
+        .args(["--step", "wait 3s"])
         .env("XDG_CONFIG_HOME", &dir)
         .env("RUST_LOG", "mirador=info")
         .stdout(std::process::Stdio::piped())

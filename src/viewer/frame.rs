@@ -80,6 +80,8 @@ pub struct Viewer {
 struct Script {
     steps: VecDeque<Step>,
     wait_frames: u32,
+    /// A `wait 2s` step's end.
+    wait_until: Option<Instant>,
     wait_traced_since: Option<Instant>,
     /// A `measure` step ran: the stats start where it said, not after the last step.
     measured: bool,
@@ -141,6 +143,7 @@ impl Viewer {
     pub fn script_done(&self) -> bool {
         self.script.steps.is_empty()
             && self.script.wait_frames == 0
+            && self.script.wait_until.is_none()
             && self.script.wait_traced_since.is_none()
             && self.screenshot.is_none()
     }
@@ -475,6 +478,12 @@ impl Viewer {
             self.script.wait_frames -= 1;
             return Ok(());
         }
+        if let Some(until) = self.script.wait_until {
+            if Instant::now() < until {
+                return Ok(());
+            }
+            self.script.wait_until = None;
+        }
         if let Some(since) = self.script.wait_traced_since {
             let difference = self.view.mode == ViewMode::Difference;
             if self.request.is_some() && self.traced.complete(self.key, difference) {
@@ -538,6 +547,7 @@ impl Viewer {
             Step::Inspect(pixel) => self.inspect_next = Some(pixel),
             Step::Probe => self.print_probe = true,
             Step::Wait(frames) => self.script.wait_frames = frames,
+            Step::WaitFor(time) => self.script.wait_until = Some(Instant::now() + time),
             Step::WaitTraced => self.script.wait_traced_since = Some(Instant::now()),
             Step::Screenshot(path) => self.screenshot = Some(path),
         }

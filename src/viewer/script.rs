@@ -24,6 +24,7 @@
 //! help on | panel off           show or hide the help window, the side panel
 //! overlay off                   hide the frame times over the 3D view
 //! wait 10                       let 10 frames pass
+//! wait 2s                       let 2 seconds pass (frames go on being drawn)
 //! wait traced                   until the ray-traced image (and difference) is complete
 //! measure                       start `--stats`' means at the next frame (else they start
 //!                               after the last step)
@@ -64,6 +65,8 @@ pub enum Step {
     Panel(bool),
     Overlay(bool),
     Wait(u32),
+    /// Let this much time pass, frames being drawn all along.
+    WaitFor(std::time::Duration),
     WaitTraced,
     Measure,
     Screenshot(PathBuf),
@@ -156,7 +159,12 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
         "panel" => Step::Panel(switch(args).ok_or_else(|| fail("panel on or panel off"))?),
         "overlay" => Step::Overlay(switch(args).ok_or_else(|| fail("overlay on or overlay off"))?),
         "wait" if args == "traced" => Step::WaitTraced,
-        "wait" => Step::Wait(args.parse().map_err(|_| fail("wait N (frames) or wait traced"))?),
+        "wait" if args.ends_with('s') => {
+            let seconds = args[..args.len() - 1].parse::<f32>().ok().filter(|s| s.is_finite() && *s >= 0.0);
+            let seconds = seconds.filter(|s| *s <= 3600.0).ok_or_else(|| fail("wait 2s: seconds, up to an hour"))?;
+            Step::WaitFor(std::time::Duration::from_secs_f32(seconds))
+        }
+        "wait" => Step::Wait(args.parse().map_err(|_| fail("wait N (frames), wait 2s or wait traced"))?),
         "screenshot" if args.to_ascii_lowercase().ends_with(".png") => Step::Screenshot(PathBuf::from(args)),
         "screenshot" => return Err(fail("the screenshot must be a .png file")),
         _ => return Err(fail("unknown step (see `mirador view --help`)")),
@@ -187,13 +195,23 @@ mod tests {
         assert_eq!(parse("wait traced").unwrap(), Step::WaitTraced);
         assert_eq!(parse("probe").unwrap(), Step::Probe);
         assert_eq!(parse("wait 3").unwrap(), Step::Wait(3));
+        assert_eq!(parse("wait 1.5s").unwrap(), Step::WaitFor(std::time::Duration::from_millis(1500)));
         assert_eq!(parse("fps 20").unwrap(), Step::Fps(20.0));
         assert_eq!(parse("fps off").unwrap(), Step::Fps(0.0));
         assert_eq!(parse("measure").unwrap(), Step::Measure);
         assert_eq!(parse("screenshot out.png").unwrap(), Step::Screenshot("out.png".into()));
-        for bad in
-            ["view sideways", "orbit 1", "split 2", "set shadows", "screenshot a.jpg", "dance", "pick nan 1", "fps 0"]
-        {
+        for bad in [
+            "view sideways",
+            "orbit 1",
+            "split 2",
+            "set shadows",
+            "screenshot a.jpg",
+            "dance",
+            "pick nan 1",
+            "fps 0",
+            "wait -1s",
+            "wait 1hs",
+        ] {
             let error = parse(bad).unwrap_err().to_string();
             assert!(error.contains(bad.split_whitespace().next().unwrap()), "{bad}: {error}");
         }
