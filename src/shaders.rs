@@ -27,6 +27,7 @@ pub const SCENE: &str = concat!(
 );
 pub const PRESENT: &str = include_str!("../shaders/present.wgsl");
 pub const MIPMAP: &str = include_str!("../shaders/mipmap.wgsl");
+pub const DEPTH_COPY: &str = include_str!("../shaders/depth_copy.wgsl");
 pub const SHADOW: &str = include_str!("../shaders/shadow.wgsl");
 pub const SHADOW_PROJECTED: &str = include_str!("../shaders/shadow_projected.wgsl");
 pub const OVERLAYS: &str = include_str!("../shaders/overlays.wgsl");
@@ -39,6 +40,7 @@ pub const PASSES: &[(&str, &str)] = &[
     ("scene", SCENE),
     ("present", PRESENT),
     ("mipmap", MIPMAP),
+    ("depth_copy", DEPTH_COPY),
     ("shadow", SHADOW),
     ("shadow_projected", SHADOW_PROJECTED),
     ("overlays", OVERLAYS),

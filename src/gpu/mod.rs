@@ -1,6 +1,7 @@
-//! The thin wgpu layer: a device (headless, or for a window surface), textures, typed uniform
-//! buffers and readback. Nothing here knows about scenes or techniques.
+//! The thin wgpu layer: a device (headless, or for a window surface), textures, depth copies,
+//! typed uniform buffers and readback. Nothing here knows about scenes or techniques.
 
+pub mod depth_copy;
 pub mod layout;
 pub mod mipmap;
 pub mod readback;

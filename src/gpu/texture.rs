@@ -26,7 +26,8 @@ impl GpuTexture {
     }
 
     /// An image that receives copies of a target (`COPY_DST`) for shaders to read: a frame's
-    /// depth or colour as it was before a pass draws over it.
+    /// colour as it was before a pass draws over it. (Depth is copied by drawing,
+    /// [`super::depth_copy`]: wgpu's GL backend cannot copy a depth texture.)
     pub fn copy_target(
         device: &wgpu::Device,
         label: &str,

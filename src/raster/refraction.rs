@@ -7,7 +7,8 @@
 //! 1. **Back faces**: the glass's nearest back faces, their depth and outward normals
 //!    (`fs_refraction_back`, front faces culled).
 //! 2. **The scene behind** (`screen` only): copies of the view's colour and depth as the opaque
-//!    phase left them.
+//!    phase left them (the depth copied by drawing, [`DepthCopy`]: GL cannot copy a depth
+//!    texture).
 //! 3. **Front faces** (`fs_refraction`, back faces culled, depth tested and written): each
 //!    fragment refracts the view ray into the glass, marches it against the back faces to find
 //!    where it leaves, refracts it out, and reads what it then meets: the object's environment
@@ -41,6 +42,7 @@ use super::scene_gpu::{SceneLayouts, SceneShader};
 use super::scene_pass::scissor;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
 use super::view::FrameView;
+use crate::gpu::depth_copy::{DepthCopy, DepthImageCopy};
 use crate::gpu::layout;
 use crate::gpu::texture::GpuTexture;
 use crate::settings::{Refraction, RenderSettings};
@@ -70,6 +72,7 @@ pub struct RefractionPass {
     /// The images of each view's targets (by the targets' depth image), kept while those targets
     /// are drawn into.
     images: Vec<(wgpu::TextureView, RefractionImages)>,
+    depth_copy: DepthCopy,
 }
 
 /// One view's back faces and copies, and the group 3 that reads them.
@@ -77,7 +80,7 @@ struct RefractionImages {
     back_depth: GpuTexture,
     back_normal: GpuTexture,
     opaque: GpuTexture,
-    opaque_depth: GpuTexture,
+    opaque_depth: DepthImageCopy,
     group: wgpu::BindGroup,
 }
 
@@ -96,7 +99,14 @@ impl RefractionPass {
             entries: &[depth(0), depth(8), colour(9), colour(10)],
         });
         let layout = shader.layout_with(device, layouts, "refraction::layout", &group_layout);
-        RefractionPass { group_layout, layout, back: HashMap::new(), front: HashMap::new(), images: Vec::new() }
+        RefractionPass {
+            group_layout,
+            layout,
+            back: HashMap::new(),
+            front: HashMap::new(),
+            images: Vec::new(),
+            depth_copy: DepthCopy::new(device, DEPTH_FORMAT),
+        }
     }
 
     /// The glass this pass draws, by its index in the draw list's transparent objects.
@@ -129,7 +139,7 @@ impl RefractionPass {
                 self.front.entry(front).or_insert_with(|| front_pipeline(ctx, layout, front));
             }
             if !self.images.iter().any(|(depth, _)| *depth == targets.depth.view) {
-                let images = RefractionImages::new(ctx.device(), &self.group_layout, targets.size);
+                let images = RefractionImages::new(ctx.device(), (&self.group_layout, &self.depth_copy), targets);
                 self.images.push((targets.depth.view.clone(), images));
             }
         }
@@ -210,11 +220,7 @@ impl PreparedRefraction<'_> {
                 images.opaque.texture.as_image_copy(),
                 size,
             );
-            frame.encoder.copy_texture_to_texture(
-                targets.depth.texture.as_image_copy(),
-                images.opaque_depth.texture.as_image_copy(),
-                size,
-            );
+            self.pass.depth_copy.record(&mut frame.encoder, &images.opaque_depth);
         }
         {
             let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -242,18 +248,23 @@ impl PreparedRefraction<'_> {
 }
 
 impl RefractionImages {
-    fn new(device: &wgpu::Device, group_layout: &wgpu::BindGroupLayout, size: (u32, u32)) -> RefractionImages {
+    fn new(
+        device: &wgpu::Device,
+        (group_layout, depth_copy): (&wgpu::BindGroupLayout, &DepthCopy),
+        targets: &FrameTargets,
+    ) -> RefractionImages {
+        let size = targets.size;
         let back_depth = GpuTexture::target(device, "refraction::back_depth", size, DEPTH_FORMAT);
         let back_normal = GpuTexture::target(device, "refraction::back_normal", size, NORMAL_FORMAT);
         let opaque = GpuTexture::copy_target(device, "refraction::opaque", size, HDR_FORMAT);
-        let opaque_depth = GpuTexture::copy_target(device, "refraction::opaque_depth", size, DEPTH_FORMAT);
+        let opaque_depth = depth_copy.image_for(device, "refraction::opaque_depth", &targets.depth.view, size);
         let entry =
             |binding, view| wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(view) };
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("refraction::group"),
             layout: group_layout,
             entries: &[
-                entry(0, &opaque_depth.view),
+                entry(0, &opaque_depth.image.view),
                 entry(8, &back_depth.view),
                 entry(9, &back_normal.view),
                 entry(10, &opaque.view),

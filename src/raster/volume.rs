@@ -6,8 +6,9 @@
 //! table ([`VolumePass::load`]). In every view (the main camera, mirrored cameras, cube faces),
 //! each volume's box is drawn, back faces only, so a camera inside the box still marches it:
 //! - **isosurfaces** with the opaque surfaces ([`PreparedVolumes::record_isosurfaces`]): the
-//!   view's depth is copied, rays end at it, and each crossing writes its colour and depth like
-//!   any surface, so what lies behind it is hidden;
+//!   view's depth is copied (by drawing, [`DepthCopy`]: GL cannot copy a depth texture), rays end
+//!   at the copy, and each crossing writes its colour and depth like any surface, so what lies
+//!   behind it is hidden;
 //! - **composited volumes** in the transparency pass's order ([`PreparedVolumes::composite`]):
 //!   each ray is marched over the span the order gives it (between two peeled transparent layers,
 //!   or whole) and blended `C + (1 − α)·L_behind` (One, OneMinusSrcAlpha).
@@ -35,8 +36,8 @@ use super::scene_pass::scissor;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
 use super::view::FrameView;
 use crate::gpu::Gpu;
+use crate::gpu::depth_copy::{DepthCopy, DepthImageCopy};
 use crate::gpu::layout;
-use crate::gpu::texture::GpuTexture;
 use crate::gpu::uniform::UniformBuffer;
 use crate::scene::Scene;
 use crate::settings::{VOLUME_SAMPLES_WHITE, VolumeGradient, VolumeReconstruction, VolumeSettings, VolumeView};
@@ -221,7 +222,8 @@ pub struct VolumePass {
     volumes: Vec<VolumeGpu>,
     /// A copy of each view's depth (by the view's depth image), which isosurfaces read while
     /// they write the depth itself; kept while those targets are drawn into.
-    depth_copies: Vec<(wgpu::TextureView, GpuTexture)>,
+    depth_copies: Vec<(wgpu::TextureView, DepthImageCopy)>,
+    depth_copy: DepthCopy,
 }
 
 impl VolumePass {
@@ -260,6 +262,7 @@ impl VolumePass {
             trilinear: sampler("volume::trilinear", wgpu::FilterMode::Linear),
             volumes: Vec::new(),
             depth_copies: Vec::new(),
+            depth_copy: DepthCopy::new(device, DEPTH_FORMAT),
         }
     }
 
@@ -352,9 +355,9 @@ impl VolumePass {
                 if isosurfaces {
                     self.pipeline(ctx, key(true, (false, false)));
                     if !self.depth_copies.iter().any(|(depth, _)| *depth == targets.depth.view) {
-                        let copy =
-                            GpuTexture::copy_target(ctx.device(), "volume::depth_copy", targets.size, DEPTH_FORMAT);
-                        self.depth_copies.push((targets.depth.view.clone(), copy));
+                        let source = &targets.depth.view;
+                        let copy = self.depth_copy.image_for(ctx.device(), "volume::depth_copy", source, targets.size);
+                        self.depth_copies.push((source.clone(), copy));
                     }
                 }
                 if renderings.contains(&Rendering::Composite) {
@@ -430,13 +433,10 @@ impl PreparedVolumes<'_> {
         }
         let copy = self.pass.depth_copies.iter().find(|(depth, _)| *depth == targets.depth.view);
         let copy = &copy.expect("VolumePass::prepare made a copy for every view").1;
-        frame.encoder.copy_texture_to_texture(
-            targets.depth.texture.as_image_copy(),
-            copy.texture.as_image_copy(),
-            targets.depth.texture.size(),
-        );
+        self.pass.depth_copy.record(&mut frame.encoder, copy);
+        let copy = &copy.image.view;
         let groups: Vec<wgpu::BindGroup> =
-            isosurfaces.iter().map(|&i| self.group(ctx, i, &copy.view, (&copy.view, &copy.view))).collect();
+            isosurfaces.iter().map(|&i| self.group(ctx, i, copy, (copy, copy))).collect();
         let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("volume::isosurfaces"),
             color_attachments: &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
