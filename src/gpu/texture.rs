@@ -9,20 +9,10 @@ pub struct GpuTexture {
 impl GpuTexture {
     /// A 2D texture to render into (and read back or sample from).
     pub fn target(device: &wgpu::Device, label: &str, size: (u32, u32), format: wgpu::TextureFormat) -> GpuTexture {
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
-        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        GpuTexture { texture, view }
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        Self::image(device, label, size, format, usage)
     }
 
     /// An image that receives copies of a target (`COPY_DST`) for shaders to read: a frame's
@@ -34,6 +24,18 @@ impl GpuTexture {
         size: (u32, u32),
         format: wgpu::TextureFormat,
     ) -> GpuTexture {
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+        Self::image(device, label, size, format, usage)
+    }
+
+    /// One 2D image of one level, with `usage`.
+    fn image(
+        device: &wgpu::Device,
+        label: &str,
+        size: (u32, u32),
+        format: wgpu::TextureFormat,
+        usage: wgpu::TextureUsages,
+    ) -> GpuTexture {
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
             size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
@@ -41,7 +43,7 @@ impl GpuTexture {
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            usage,
             view_formats: &[],
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
