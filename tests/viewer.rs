@@ -106,22 +106,28 @@ fn flip(reference: &image::RgbaImage, test: &image::RgbaImage, what: &str, dir: 
 
 /// The window's 3D view is the headless render, whichever way it reaches the window: copied into
 /// the surface (what lavapipe's surface allows), or drawn by egui as a texture (what surfaces
-/// that take no copies get, forced here by `MIRADOR_COMPOSITION`).
+/// that take no copies get, forced here by `MIRADOR_COMPOSITION`), and on wgpu's GL backend too
+/// (no view formats there: the texture path; its images are Vulkan's, tests/gl_backend.rs).
 #[test]
 fn the_showcase_in_the_window_is_the_headless_render() {
-    showcase_in_the_window(None);
+    showcase_in_the_window("copied", None);
 }
 
 #[test]
 fn the_showcase_drawn_by_egui_as_a_texture_is_the_headless_render() {
-    showcase_in_the_window(Some("textured"));
+    showcase_in_the_window("textured", Some(("MIRADOR_COMPOSITION", "textured")));
 }
 
-fn showcase_in_the_window(composition: Option<&str>) {
-    let dir = scratch(&format!("raster-{}", composition.unwrap_or("copied")));
+#[test]
+fn the_showcase_in_the_window_on_the_gl_backend_is_the_headless_render() {
+    showcase_in_the_window("gl", Some(("WGPU_BACKEND", "gl")));
+}
+
+fn showcase_in_the_window(name: &str, variable: Option<(&str, &str)>) {
+    let dir = scratch(&format!("raster-{name}"));
     let shot = dir.join("raster.png");
     let args = ["--size", "1000x600", "--frames", "3", "--step", "overlay off", "--screenshot", shot.to_str().unwrap()];
-    let output = viewer_with(&args, &dir, composition.map(|c| ("MIRADOR_COMPOSITION", c)));
+    let output = viewer_with(&args, &dir, variable);
     succeeded(&output);
     let views = views(&output);
     let [(path, view)] = &views[..] else { panic!("one screenshot line expected: {output:?}") };

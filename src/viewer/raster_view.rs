@@ -61,8 +61,9 @@ struct SizedTargets {
     size: (u32, u32),
     targets: FrameTargets,
     image: GpuTexture,
-    /// The image's bytes through the plain (not sRGB) twin of its format.
-    plain: wgpu::TextureView,
+    /// The image's bytes through the plain (not sRGB) twin of its format
+    /// ([`Composition::Copied`]).
+    plain: Option<wgpu::TextureView>,
     /// The twin egui samples ([`Composition::Textured`]).
     display: Option<(wgpu::Texture, wgpu::TextureView)>,
 }
@@ -110,7 +111,7 @@ impl RasterView {
     /// is drawn.
     pub fn image(&self) -> Option<(&wgpu::Texture, &wgpu::TextureView)> {
         let frame = self.frame.as_ref().filter(|_| self.drawn.is_some())?;
-        Some((&frame.image.texture, &frame.plain))
+        Some((&frame.image.texture, frame.plain.as_ref()?))
     }
 
     /// Renders `scene` (whose camera has the image's size) with `settings` unless the image
@@ -167,7 +168,9 @@ impl RasterView {
 
     fn sized_targets(&self, gpu: &Gpu, size: (u32, u32), settings: &RenderSettings) -> SizedTargets {
         let targets = FrameTargets::new(&gpu.device, drawn_size(size, settings.raster.render_scale));
+        let copied = self.composition == Composition::Copied;
         let plain_format = self.format.remove_srgb_suffix();
+        let plain_formats = [plain_format];
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("viewer::raster::image"),
             size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
@@ -178,16 +181,18 @@ impl RasterView {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[plain_format],
+            view_formats: if copied { &plain_formats } else { &[] },
         });
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        let plain = texture.create_view(&wgpu::TextureViewDescriptor {
-            label: Some("viewer::raster::plain_view"),
-            format: Some(plain_format),
-            ..Default::default()
+        let plain = copied.then(|| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("viewer::raster::plain_view"),
+                format: Some(plain_format),
+                ..Default::default()
+            })
         });
         let image = GpuTexture { texture, view };
-        let display = (self.composition == Composition::Textured).then(|| {
+        let display = (!copied).then(|| {
             let display = display_texture(&gpu.device, size);
             let view = display.create_view(&wgpu::TextureViewDescriptor {
                 label: Some("viewer::raster::display_view"),

@@ -111,9 +111,13 @@ impl Screen {
             .or_else(|| capabilities.formats.first().copied())
             .context("the window's surface offers no format")?;
         // The raster image is drawn in the sRGB twin of the surface's format and copied in: the
-        // same bytes, which only formats that differ in their sRGB-ness alone can exchange.
+        // same bytes, which only formats that differ in their sRGB-ness alone can exchange. A
+        // moving frame is stretched through a plain view of those bytes, which needs view formats
+        // (wgpu's GL backend has none).
+        let view_formats = gpu.adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::VIEW_FORMATS);
         let copyable = matches!(format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Rgba8Unorm)
-            && capabilities.usages.contains(wgpu::TextureUsages::COPY_DST);
+            && capabilities.usages.contains(wgpu::TextureUsages::COPY_DST)
+            && view_formats;
         // `MIRADOR_COMPOSITION=textured` takes the other surfaces' path on any surface: to test it
         // and to measure what the copies save (benches/viewer.sh).
         let forced = std::env::var("MIRADOR_COMPOSITION").is_ok_and(|v| v == "textured");
