@@ -88,14 +88,11 @@ impl DepthCopy {
     /// Copies the source's depth as it is now into `copy`'s image. Every texel is drawn, so the
     /// image's old contents are not loaded.
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder, copy: &DepthImageCopy) {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("depth_copy::pass"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(layout::depth_attachment(&copy.image.view, wgpu::LoadOp::Clear(1.0))),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = encoder.begin_render_pass(&layout::pass(
+            "depth_copy::pass",
+            &[],
+            Some(layout::depth_attachment(&copy.image.view, wgpu::LoadOp::Clear(1.0))),
+        ));
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &copy.group, &[]);
         pass.draw(0..3, 0..1);

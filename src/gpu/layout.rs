@@ -107,6 +107,23 @@ pub fn depth_attachment(
     }
 }
 
+/// A render pass's description: its attachments, and none of the timestamps, occlusion queries
+/// or multiview that Mirador never uses.
+pub fn pass<'a>(
+    label: &'a str,
+    color_attachments: &'a [Option<wgpu::RenderPassColorAttachment<'a>>],
+    depth_stencil_attachment: Option<wgpu::RenderPassDepthStencilAttachment<'a>>,
+) -> wgpu::RenderPassDescriptor<'a> {
+    wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments,
+        depth_stencil_attachment,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    }
+}
+
 /// The pipeline of a pass that runs its fragment shader once per pixel of its targets: one
 /// triangle covering them, no vertex buffers, no depth (the vertex entry point returns
 /// `fullscreen_position(vertex_index)` from `shaders/common/types.wgsl`).

@@ -308,14 +308,7 @@ fn draw(
         .iter()
         .map(|view| Some(layout::color_attachment(view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT))))
         .collect();
-    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some(label),
-        color_attachments: &attachments,
-        depth_stencil_attachment: None,
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
+    let mut pass = encoder.begin_render_pass(&layout::pass(label, &attachments, None));
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, group, &[]);
     pass.draw(0..3, instance..instance + 1);

@@ -153,14 +153,11 @@ impl MapView {
             ],
         });
         let hdr = &targets.hdr.view;
-        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("overlays::map_view_pass"),
-            color_attachments: &[Some(layout::color_attachment(hdr, wgpu::LoadOp::Load))],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+            "overlays::map_view_pass",
+            &[Some(layout::color_attachment(hdr, wgpu::LoadOp::Load))],
+            None,
+        ));
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &group, &[]);
         pass.draw(0..3, 0..1);
@@ -228,14 +225,11 @@ impl Lines {
         };
         let vertices = buffer("overlays::lines_vertices", lines);
         let colour = buffer("overlays::lines_colour", &[colour]);
-        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("overlays::lines_pass"),
-            color_attachments: &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
-            depth_stencil_attachment: Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+            "overlays::lines_pass",
+            &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
+            Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
+        ));
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view.slot)]);
         pass.set_vertex_buffer(0, vertices.slice(..));

@@ -79,14 +79,11 @@ impl PresentPass {
         let scale = [input.width as f32 / out.width as f32, input.height as f32 / out.height as f32];
         let tone_map = tone_map_code(transform.tone_map);
         self.uniform.write(&gpu.queue, &GpuPresent { exposure: transform.exposure, tone_map, scale });
-        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("present::pass"),
-            color_attachments: &[Some(layout::color_attachment(output, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+            "present::pass",
+            &[Some(layout::color_attachment(output, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))],
+            None,
+        ));
         pass.push_debug_group("present");
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, group, &[]);

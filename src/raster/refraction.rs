@@ -189,20 +189,14 @@ impl PreparedRefraction<'_> {
         let images = &images.expect("RefractionPass::prepare made images for every view").1;
         let view_offset = [scene_gpu.views.offset(view.slot)];
         {
-            let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("refraction::back_faces"),
-                color_attachments: &[Some(layout::color_attachment(
+            let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+                "refraction::back_faces",
+                &[Some(layout::color_attachment(
                     &images.back_normal.view,
                     wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
                 ))],
-                depth_stencil_attachment: Some(layout::depth_attachment(
-                    &images.back_depth.view,
-                    wgpu::LoadOp::Clear(1.0),
-                )),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+                Some(layout::depth_attachment(&images.back_depth.view, wgpu::LoadOp::Clear(1.0))),
+            ));
             scissor(&mut pass, view);
             pass.set_bind_group(0, scene_gpu.frame_group(), &view_offset);
             pass.set_bind_group(2, ctx.lighting, &[]);
@@ -223,14 +217,11 @@ impl PreparedRefraction<'_> {
             self.pass.depth_copy.record(&mut frame.encoder, &images.opaque_depth);
         }
         {
-            let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("refraction::front_faces"),
-                color_attachments: &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
-                depth_stencil_attachment: Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+                "refraction::front_faces",
+                &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
+                Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
+            ));
             scissor(&mut pass, view);
             pass.set_bind_group(0, scene_gpu.frame_group(), &view_offset);
             pass.set_bind_group(2, ctx.lighting, &[]);

@@ -270,14 +270,11 @@ impl PreparedScene<'_> {
         opaque_only: bool,
     ) {
         let scene = ctx.scene_gpu;
-        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("scene::prepass"),
-            color_attachments: &[],
-            depth_stencil_attachment: Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Clear(1.0))),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+            "scene::prepass",
+            &[],
+            Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Clear(1.0))),
+        ));
         pass.push_debug_group("depth prepass");
         scissor(&mut pass, view);
         pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view.slot)]);
@@ -309,17 +306,14 @@ impl PreparedScene<'_> {
         let scene: &SceneGpu = ctx.scene_gpu;
         let bg = ctx.scene.background.as_dvec3();
         let depth_load = if view.prepass { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(1.0) };
-        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("scene::opaque"),
-            color_attachments: &[Some(layout::color_attachment(
+        let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+            "scene::opaque",
+            &[Some(layout::color_attachment(
                 &targets.hdr.view,
                 wgpu::LoadOp::Clear(wgpu::Color { r: bg.x, g: bg.y, b: bg.z, a: 1.0 }),
             ))],
-            depth_stencil_attachment: Some(layout::depth_attachment(&targets.depth.view, depth_load)),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+            Some(layout::depth_attachment(&targets.depth.view, depth_load)),
+        ));
         pass.push_debug_group("opaque");
         scissor(&mut pass, view);
         pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view.slot)]);

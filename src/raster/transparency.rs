@@ -455,14 +455,11 @@ impl PreparedTransparency<'_> {
         for layer in 0..layers {
             let depth = &peel.depth[layer % 2].view;
             {
-                let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("transparency::peel"),
-                    color_attachments: &[],
-                    depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Clear(0.0))),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
+                let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+                    "transparency::peel",
+                    &[],
+                    Some(layout::depth_attachment(depth, wgpu::LoadOp::Clear(0.0))),
+                ));
                 scissor(&mut pass, view);
                 pass.set_bind_group(0, scene_gpu.frame_group(), &view_offset);
                 pass.set_bind_group(2, ctx.lighting, &[]);
@@ -514,14 +511,11 @@ fn begin<'e>(
     targets: &FrameTargets,
     depth: &wgpu::TextureView,
 ) -> wgpu::RenderPass<'e> {
-    let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some(label),
-        color_attachments: &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
-        depth_stencil_attachment: Some(layout::depth_attachment(depth, wgpu::LoadOp::Load)),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
+    let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+        label,
+        &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
+        Some(layout::depth_attachment(depth, wgpu::LoadOp::Load)),
+    ));
     scissor(&mut pass, view);
     pass
 }

@@ -437,14 +437,11 @@ impl PreparedVolumes<'_> {
         let copy = &copy.image.view;
         let groups: Vec<wgpu::BindGroup> =
             isosurfaces.iter().map(|&i| self.group(ctx, i, copy, (copy, copy))).collect();
-        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("volume::isosurfaces"),
-            color_attachments: &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
-            depth_stencil_attachment: Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+            "volume::isosurfaces",
+            &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
+            Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
+        ));
         scissor(&mut pass, view);
         pass.set_pipeline(&self.pass.pipelines[&self.key(ctx, view, true, (false, false))]);
         self.draw(ctx, &mut pass, view, isosurfaces.iter().copied().zip(groups));
@@ -475,14 +472,11 @@ impl PreparedVolumes<'_> {
         let limits = (span.far.is_some(), span.near.is_some());
         let bounds = (span.far.unwrap_or(depth), span.near.unwrap_or(depth));
         let groups: Vec<wgpu::BindGroup> = volumes.iter().map(|&i| self.group(ctx, i, depth, bounds)).collect();
-        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("volume::composite"),
-            color_attachments: &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+            "volume::composite",
+            &[Some(layout::color_attachment(&targets.hdr.view, wgpu::LoadOp::Load))],
+            None,
+        ));
         scissor(&mut pass, view);
         pass.set_pipeline(&self.pass.pipelines[&self.key(ctx, view, false, limits)]);
         self.draw(ctx, &mut pass, view, volumes.iter().copied().zip(groups));

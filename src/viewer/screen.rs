@@ -29,7 +29,7 @@ use winit::event_loop::ActiveEventLoop;
 use winit::window::Window;
 
 use super::upscale::Upscale;
-use crate::gpu::{Gpu, readback};
+use crate::gpu::{Gpu, layout, readback};
 
 pub struct Screen {
     pub window: Arc<Window>,
@@ -399,17 +399,11 @@ impl Screen {
         let extra = self.painter.update_buffers(device, queue, &mut encoder, &jobs, screen);
         let view = texture
             .create_view(&wgpu::TextureViewDescriptor { label: Some("viewer::panel_view"), ..Default::default() });
-        let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("viewer::panel_pass"),
-            color_attachments: &[Some(crate::gpu::layout::color_attachment(
-                &view,
-                wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-            ))],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let pass = encoder.begin_render_pass(&layout::pass(
+            "viewer::panel_pass",
+            &[Some(layout::color_attachment(&view, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))],
+            None,
+        ));
         self.painter.render(&mut pass.forget_lifetime(), &jobs, screen);
         queue.submit(extra.into_iter().chain([encoder.finish()]));
         self.panel = Some(PanelCache { texture, width, pixels_per_point: screen.pixels_per_point, shapes });
@@ -442,14 +436,7 @@ impl Composer<'_> {
             .create_view(&wgpu::TextureViewDescriptor { label: Some("viewer::window_view"), ..Default::default() });
         let pass = |encoder: &mut wgpu::CommandEncoder, label, load| {
             encoder
-                .begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some(label),
-                    color_attachments: &[Some(crate::gpu::layout::color_attachment(&target_view, load))],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                })
+                .begin_render_pass(&layout::pass(label, &[Some(layout::color_attachment(&target_view, load))], None))
                 .forget_lifetime()
         };
         let (width, height) = (target.width(), target.height());

@@ -39,27 +39,14 @@ impl Upscale {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("upscale::pipeline"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_upscale"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleStrip, ..Default::default() },
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_upscale"),
-                compilation_options: Default::default(),
-                targets: &[Some(format.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = layout::fullscreen_pipeline(
+            device,
+            "upscale::pipeline",
+            &pipeline_layout,
+            &module,
+            ("vs_upscale", "fs_upscale"),
+            &[Some(format.into())],
+        );
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("upscale::sampler"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -90,20 +77,17 @@ impl Upscale {
             self.input = Some((image.clone(), group));
         }
         let (_, group) = self.input.as_ref().expect("made just above");
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("upscale::pass"),
-            color_attachments: &[Some(layout::color_attachment(target, wgpu::LoadOp::Load))],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = encoder.begin_render_pass(&layout::pass(
+            "upscale::pass",
+            &[Some(layout::color_attachment(target, wgpu::LoadOp::Load))],
+            None,
+        ));
         pass.push_debug_group("upscale");
         pass.set_viewport(x as f32, y as f32, width as f32, height as f32, 0.0, 1.0);
         pass.set_scissor_rect(x, y, width, height);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, group, &[]);
-        pass.draw(0..4, 0..1);
+        pass.draw(0..3, 0..1);
         pass.pop_debug_group();
     }
 }

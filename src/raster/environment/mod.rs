@@ -268,14 +268,11 @@ impl Converter {
         viewport: Option<[f32; 4]>,
     ) {
         let load = if viewport.is_some() { wgpu::LoadOp::Load } else { wgpu::LoadOp::Clear(wgpu::Color::BLACK) };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("environment::pass"),
-            color_attachments: &[Some(layout::color_attachment(target, load))],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = encoder.begin_render_pass(&layout::pass(
+            "environment::pass",
+            &[Some(layout::color_attachment(target, load))],
+            None,
+        ));
         if let Some([x, y, w, h]) = viewport {
             pass.set_viewport(x, y, w, h, 0.0, 1.0);
         }

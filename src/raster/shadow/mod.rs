@@ -363,14 +363,11 @@ impl ShadowPass {
         let depth_view = &targets.depth_layers[layer];
         let view_offset = [scene.views.offset(slot)];
         {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shadow::depth_pass"),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(layout::depth_attachment(depth_view, wgpu::LoadOp::Clear(1.0))),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = encoder.begin_render_pass(&layout::pass(
+                "shadow::depth_pass",
+                &[],
+                Some(layout::depth_attachment(depth_view, wgpu::LoadOp::Clear(1.0))),
+            ));
             pass.set_bind_group(0, scene.frame_group(), &view_offset);
             for batch in scene.geometry.batches.iter().filter(|b| !b.transparent) {
                 let masked = scene.material_keys[batch.material].alpha_mode == ALPHA_MASK;
@@ -380,17 +377,14 @@ impl ShadowPass {
             }
         }
         if targets.with_transmission {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shadow::transmission_pass"),
-                color_attachments: &[Some(layout::color_attachment(
+            let mut pass = encoder.begin_render_pass(&layout::pass(
+                "shadow::transmission_pass",
+                &[Some(layout::color_attachment(
                     &targets.transmission_layers[layer],
                     wgpu::LoadOp::Clear(wgpu::Color::WHITE),
                 ))],
-                depth_stencil_attachment: Some(layout::depth_attachment(depth_view, wgpu::LoadOp::Load)),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+                Some(layout::depth_attachment(depth_view, wgpu::LoadOp::Load)),
+            ));
             pass.set_pipeline(&self.transmission_pipeline);
             pass.set_bind_group(0, scene.frame_group(), &view_offset);
             for batch in scene.geometry.batches.iter().filter(|b| b.transparent) {

@@ -260,17 +260,11 @@ impl ProjectedPass {
     /// the opaque pass reads it whenever this method is chosen.
     pub fn record(&self, ctx: &FrameContext, frame: &mut FrameEncoder, view: &FrameView, targets: &FrameTargets) {
         let scene_gpu = ctx.scene_gpu;
-        let mut pass = frame.encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("shadow_projected::pass"),
-            color_attachments: &[Some(layout::color_attachment(
-                &targets.shadow_mask.view,
-                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-            ))],
-            depth_stencil_attachment: Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = frame.encoder.begin_render_pass(&layout::pass(
+            "shadow_projected::pass",
+            &[Some(layout::color_attachment(&targets.shadow_mask.view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)))],
+            Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
+        ));
         let polygons = self.polygons.as_ref().filter(|p| p.vertices.is_some());
         if let Some(Polygons { vertices: Some(vertices), count, .. }) = polygons {
             pass.push_debug_group("projected shadows");
