@@ -76,7 +76,11 @@ fn fs_transparent_transmit(in: VertexOut) -> @location(0) vec4f {
 fn fs_peel(in: VertexOut) {
     let pixel = vec2i(in.clip.xy);
     let limit = min(textureLoad(opaque_depth, pixel, 0).x, textureLoad(peeled_depth, pixel, 0).x);
-    if in.clip.z >= limit || masked_out(in.uv) {
+    // The mask is sampled before the depth test, not behind `||`: a texture sampled with implicit
+    // derivatives must be in uniform control flow, and WebGPU compilers (Tint) refuse the module
+    // otherwise.
+    let masked = masked_out(in.uv);
+    if in.clip.z >= limit || masked {
         discard;
     }
 }

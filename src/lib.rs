@@ -10,6 +10,8 @@
 //! - [`compare`]: image metrics for golden images and raster-vs-trace comparisons.
 //! - [`viewer`]: the interactive window (winit + egui) over both renderers.
 //! - [`volume`]: scalar fields on voxel grids, classified and ray-cast by both renderers.
+//! - [`files`]: where the files a scene names are read from (the disk, or the page's files).
+//! - `web` (built for `wasm32` only): the viewer in the browser (web/README.md).
 
 // Checks like `!(x > 0.0)` are written that way on purpose: unlike `x <= 0.0` they also reject
 // NaN, which user input can carry.
@@ -17,6 +19,7 @@
 
 pub mod compare;
 pub mod explain;
+pub mod files;
 pub mod gpu;
 pub mod linear_output;
 pub mod output;
@@ -29,6 +32,8 @@ pub mod texture;
 pub mod trace;
 pub mod viewer;
 pub mod volume;
+#[cfg(target_arch = "wasm32")]
+pub mod web;
 
 pub use scene::Scene;
 pub use settings::RenderSettings;

@@ -21,6 +21,7 @@ use std::path::Path;
 const LAYERS: &[(&str, u32)] = &[
     ("settings", 0),
     ("shaders", 0),
+    ("files", 0),
     ("output", 1),
     ("compare", 1),
     ("settings_doc", 1),
@@ -33,6 +34,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("raster", 5),
     ("explain", 6),
     ("viewer", 7),
+    ("web", 8),
 ];
 
 /// Modules of one layer that may import each other (never in a circle: that is checked too).

@@ -297,12 +297,38 @@ fn progressive_refinement_ends_at_the_centre_sampled_image() {
     let (full, _) = tracer.render(&RenderControl::default()).unwrap();
     let mut progressive = Progressive::new(&tracer, 16);
     let mut levels = Vec::new();
-    while let Some(block) = progressive.refine() {
+    while let Some(block) = progressive.refine(&tracer) {
         levels.push(block);
     }
     assert_eq!(levels, vec![16, 8, 4, 2, 1]);
     assert_eq!(progressive.image(), &full);
     assert_eq!(progressive.rays().primary, 96 * 54, "each pixel is traced exactly once over all levels");
+}
+
+/// The browser traces a few rows between frames (`Tracer::render_rows`); joined, the slices must
+/// be the image `render` gives, in every anti-aliasing mode (the corner modes compute a corner
+/// grid for each slice).
+#[test]
+fn an_image_traced_in_slices_of_rows_is_the_whole_render() {
+    for mode in [
+        AntiAliasing::Center,
+        AntiAliasing::Regular,
+        AntiAliasing::Jittered,
+        AntiAliasing::Corners,
+        AntiAliasing::Adaptive,
+    ] {
+        let mut scene = small_showcase();
+        scene.settings.trace.anti_aliasing = mode;
+        scene.settings.trace.samples = 2;
+        let tracer = Tracer::new(&scene, &scene.settings);
+        let (full, _) = tracer.render(&RenderControl::default()).unwrap();
+        let mut sliced = Vec::new();
+        for first in (0..54).step_by(7) {
+            sliced.extend(tracer.render_rows(first..(first + 7).min(54)).0);
+        }
+        assert_eq!(sliced.len(), full.pixels.len(), "{mode:?}");
+        assert!(sliced == full.pixels, "{mode:?}: the slices differ from the whole render");
+    }
 }
 
 #[test]

@@ -1,8 +1,18 @@
 //! Image metrics: FLIP (NVIDIA's perceptual difference, the metric wgpu's own image tests use),
 //! PSNR, and a false-colour error map. Used by the golden-image tests and, with the ray tracer,
 //! by `mirador compare`.
+//!
+//! FLIP is NVIDIA's C++ library, which does not build for the browser: there the difference view
+//! shows the largest channel difference of each pixel instead ([`METRIC`] names which).
 
+#[cfg(not(target_arch = "wasm32"))]
 pub mod sheet;
+
+/// The metric [`Difference::flip_mean`] and the error map hold, as the viewer labels it.
+#[cfg(not(target_arch = "wasm32"))]
+pub const METRIC: &str = "FLIP";
+#[cfg(target_arch = "wasm32")]
+pub const METRIC: &str = "largest channel difference";
 
 use image::RgbaImage;
 
@@ -59,16 +69,47 @@ pub fn difference_beyond(reference: &RgbaImage, test: &RgbaImage, levels: u8) ->
             if within { [r[0], r[1], r[2]] } else { [t[0], t[1], t[2]] }
         })
         .collect();
-    let error = nv_flip::flip(
-        nv_flip::FlipImageRgb8::with_data(w, h, &a),
-        nv_flip::FlipImageRgb8::with_data(w, h, &seen),
-        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
-    );
-    let flip_mean = nv_flip::FlipPool::from_image(&error).mean();
-    let colored = error.apply_color_lut(&nv_flip::magma_lut()).to_vec();
+    let (flip_errors, flip_mean, colored) = per_pixel_error(w, h, &a, &seen);
     let error_map = RgbaImage::from_raw(w, h, colored.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 255]).collect())
         .expect("the error map has one RGB triple per pixel");
-    Ok(Difference { flip_mean, flip_errors: error.to_vec(), psnr_db: psnr(&a, &b), error_map })
+    Ok(Difference { flip_mean, flip_errors, psnr_db: psnr(&a, &b), error_map })
+}
+
+/// The FLIP error of each pixel of `test` against `reference` (RGB bytes), their mean, and the
+/// errors through the magma colour map.
+#[cfg(not(target_arch = "wasm32"))]
+fn per_pixel_error(w: u32, h: u32, reference: &[u8], test: &[u8]) -> (Vec<f32>, f32, Vec<u8>) {
+    let error = nv_flip::flip(
+        nv_flip::FlipImageRgb8::with_data(w, h, reference),
+        nv_flip::FlipImageRgb8::with_data(w, h, test),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    let mean = nv_flip::FlipPool::from_image(&error).mean();
+    (error.to_vec(), mean, error.apply_color_lut(&nv_flip::magma_lut()).to_vec())
+}
+
+/// In the browser: [`channel_difference`].
+#[cfg(target_arch = "wasm32")]
+fn per_pixel_error(_: u32, _: u32, reference: &[u8], test: &[u8]) -> (Vec<f32>, f32, Vec<u8>) {
+    channel_difference(reference, test)
+}
+
+/// The largest channel difference of each pixel of two RGB byte buffers, in [0, 1], their mean,
+/// and the differences coloured black through red to yellow: the browser's difference view, where
+/// FLIP does not build (`web/test.sh` checks the page's map against this one).
+pub fn channel_difference(reference: &[u8], test: &[u8]) -> (Vec<f32>, f32, Vec<u8>) {
+    let errors: Vec<f32> = reference
+        .chunks_exact(3)
+        .zip(test.chunks_exact(3))
+        .map(|(r, t)| r.iter().zip(t).map(|(&r, &t)| r.abs_diff(t)).max().unwrap_or(0) as f32 / 255.0)
+        .collect();
+    let ramp = |e: f32| {
+        [(3.0 * e).min(1.0), (3.0 * e - 1.0).clamp(0.0, 1.0), (3.0 * e - 2.0).clamp(0.0, 1.0)]
+            .map(|c| (c * 255.0) as u8)
+    };
+    let mean = errors.iter().sum::<f32>() / errors.len().max(1) as f32;
+    let colored = errors.iter().flat_map(|&e| ramp(e)).collect();
+    (errors, mean, colored)
 }
 
 /// PSNR of two equally long byte buffers with peak 255.

@@ -9,7 +9,7 @@ pub mod texture;
 pub mod uniform;
 
 use std::sync::Arc;
-use std::time::Instant;
+use web_time::Instant;
 
 /// A wgpu device and the instance and adapter it came from.
 pub struct Gpu {
@@ -60,7 +60,11 @@ impl Gpu {
     }
 
     fn first_headless(order: Vec<wgpu::Backends>) -> Result<Gpu, GpuError> {
-        let (gpu, ()) = Gpu::first_adapter(order, wgpu::InstanceDescriptor::new_without_display_handle, |_| Some(()))?;
+        let (gpu, ()) = pollster::block_on(Gpu::first_adapter(
+            order,
+            wgpu::InstanceDescriptor::new_without_display_handle,
+            |_| Some(()),
+        ))?;
         Ok(gpu)
     }
 
@@ -71,19 +75,29 @@ impl Gpu {
     where
         W: wgpu::rwh::HasWindowHandle + wgpu::rwh::HasDisplayHandle + std::fmt::Debug + Send + Sync + 'static,
     {
+        pollster::block_on(Gpu::for_window_async(window))
+    }
+
+    /// [`Gpu::for_window`] as a future: the browser answers its WebGPU requests asynchronously,
+    /// and a page must not block waiting for them (`src/web/`).
+    pub async fn for_window_async<W>(window: Arc<W>) -> Result<(Gpu, wgpu::Surface<'static>), GpuError>
+    where
+        W: wgpu::rwh::HasWindowHandle + wgpu::rwh::HasDisplayHandle + std::fmt::Debug + Send + Sync + 'static,
+    {
         let descriptor = || wgpu::InstanceDescriptor::new_with_display_handle(Box::new(window.clone()));
-        Gpu::first_adapter(backend_order(), descriptor, |instance| match instance.create_surface(window.clone()) {
+        let attach = |instance: &wgpu::Instance| match instance.create_surface(window.clone()) {
             Ok(surface) => Some(surface),
             Err(e) => {
                 log::info!("no surface for the window: {e}");
                 None
             }
-        })
+        };
+        Gpu::first_adapter(backend_order(), descriptor, attach).await
     }
 
     /// Tries the backends of `order` in turn; for each, `attach` may make something the adapter
     /// must be compatible with (a window's surface), and the first adapter found wins.
-    fn first_adapter<T: SurfaceLike>(
+    async fn first_adapter<T: SurfaceLike>(
         order: Vec<wgpu::Backends>,
         descriptor: impl Fn() -> wgpu::InstanceDescriptor,
         attach: impl Fn(&wgpu::Instance) -> Option<T>,
@@ -96,8 +110,8 @@ impl Gpu {
             tried.push(format!("{backends:?}"));
             let Some(attached) = attach(&instance) else { continue };
             let options = wgpu::RequestAdapterOptions { compatible_surface: attached.surface(), ..Default::default() };
-            match pollster::block_on(instance.request_adapter(&options)) {
-                Ok(adapter) => return Ok((Gpu::with_adapter(instance, adapter)?, attached)),
+            match instance.request_adapter(&options).await {
+                Ok(adapter) => return Ok((Gpu::with_adapter_async(instance, adapter).await?, attached)),
                 Err(e) => log::info!("no {backends:?} adapter: {e}"),
             }
         }
@@ -111,6 +125,11 @@ impl Gpu {
     /// validation error when the first frame binds its environment maps: desktop GL and Vulkan
     /// have them, WebGL2 does not.
     pub fn with_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, GpuError> {
+        pollster::block_on(Gpu::with_adapter_async(instance, adapter))
+    }
+
+    /// [`Gpu::with_adapter`] as a future.
+    pub async fn with_adapter_async(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, GpuError> {
         let info = adapter.get_info();
         log::info!("adapter: {} ({:?})", info.name, info.backend);
         if !adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::CUBE_ARRAY_TEXTURES) {
@@ -121,14 +140,19 @@ impl Gpu {
             Ok(value) => return Err(GpuError::UnknownLimits(value)),
             Err(_) => wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
         };
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("mirador::device"),
-            required_features: wgpu::Features::empty(),
-            required_limits,
-            ..Default::default()
-        }))
-        .map_err(|source| GpuError::Device { adapter: info.name.clone(), source })?;
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("mirador::device"),
+                required_features: wgpu::Features::empty(),
+                required_limits,
+                ..Default::default()
+            })
+            .await
+            .map_err(|source| GpuError::Device { adapter: info.name.clone(), source })?;
         seamless_cubes_on_desktop_gl(&device);
+        // The browser's errors are not captured ([`Gpu::checked`]): the console shows them.
+        #[cfg(target_arch = "wasm32")]
+        device.on_uncaptured_error(Arc::new(|error| log::error!("{}", reported(&error))));
         Ok(Gpu { instance, adapter, device, queue })
     }
 
@@ -154,12 +178,21 @@ impl Gpu {
         })
     }
 
+    /// [`Gpu::checked`] in the browser, where error scopes answer only after the page returns to
+    /// its event loop: `work` runs unchecked, and its errors reach the device's handler, which
+    /// logs them to the console.
+    #[cfg(target_arch = "wasm32")]
+    pub fn checked<T>(&self, work: impl FnOnce() -> T) -> Result<T, GpuError> {
+        Ok(work())
+    }
+
     /// Runs `work` with its GPU errors captured: an out-of-memory, internal or validation error
     /// raised by any wgpu call `work` makes on this thread becomes `Err(GpuError::Reported)`
     /// instead of reaching wgpu's default handler, which panics. Each scope keeps its first
     /// error; out of memory is reported before the others, which usually follow from it (a
     /// texture that could not be allocated is invalid wherever it is used next). `work`'s own
     /// result is returned when the GPU reported nothing.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn checked<T>(&self, work: impl FnOnce() -> T) -> Result<T, GpuError> {
         let out_of_memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let internal = self.device.push_error_scope(wgpu::ErrorFilter::Internal);
@@ -181,6 +214,7 @@ impl Gpu {
 /// as Vulkan and OpenGL ES 3 always do; without it, a lookup near an edge clamps to its own face,
 /// and every mirror ball showed its cube's seams as faint lines (FLIP 0.02 over the worst
 /// region of the environment stage against Vulkan; none with it, `tests/gl_backend.rs`).
+#[cfg_attr(target_arch = "wasm32", allow(unused_variables))]
 fn seamless_cubes_on_desktop_gl(device: &wgpu::Device) {
     #[cfg(any(windows, target_os = "linux", target_os = "android", target_os = "freebsd"))]
     {
@@ -201,6 +235,9 @@ fn seamless_cubes_on_desktop_gl(device: &wgpu::Device) {
 
 /// The backends to try, in order: the ones `WGPU_BACKEND` names, else Vulkan, then GL.
 fn backend_order() -> Vec<wgpu::Backends> {
+    if cfg!(target_arch = "wasm32") {
+        return vec![wgpu::Backends::BROWSER_WEBGPU];
+    }
     match wgpu::Backends::from_env() {
         Some(chosen) => vec![chosen],
         None => vec![wgpu::Backends::VULKAN, wgpu::Backends::GL],

@@ -9,6 +9,11 @@
 //! of whole rows, each band into the same buffer sized to fit, and the bands are joined on the
 //! CPU: every size the texture limits allow can be read back, and the buffer never holds more
 //! than one band.
+//!
+//! [`Pending`] reads a texture back without waiting: the copy is submitted and the mapping asked
+//! for, and a later call takes the texels once the GPU is done. The browser cannot wait for the
+//! GPU (its mappings complete only after the page returns to its event loop), so the viewer reads
+//! its images back this way everywhere; natively it waits for the device right after asking.
 
 /// Why a texture could not be read back.
 #[derive(Debug, thiserror::Error)]
@@ -24,6 +29,109 @@ pub enum ReadbackError {
     View(#[from] wgpu::MapRangeError),
     #[error("waiting for the readback copy failed: {0}")]
     Poll(#[from] wgpu::PollError),
+    #[error(
+        "a {width}×{height} image needs {bytes} bytes to read back at once, more than the device's max_buffer_size of {limit}"
+    )]
+    TooLarge { width: u32, height: u32, bytes: u64, limit: u64 },
+}
+
+/// A readback under way (see the module's header): one buffer, the whole image.
+pub struct Pending {
+    buffer: wgpu::Buffer,
+    mapped: std::sync::mpsc::Receiver<Result<(), wgpu::BufferAsyncError>>,
+    width: u32,
+    height: u32,
+    row: u64,
+    padded_row: u64,
+}
+
+impl Pending {
+    /// Copies mip level 0 of a 2D texture of `bytes_per_texel` bytes per texel into a buffer and
+    /// asks for its mapping.
+    pub fn start(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        texture: &wgpu::Texture,
+        bytes_per_texel: u32,
+    ) -> Result<Pending, ReadbackError> {
+        let (width, height) = (texture.width(), texture.height());
+        let row = u64::from(width) * u64::from(bytes_per_texel);
+        let padded_row = row.next_multiple_of(u64::from(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT));
+        let bytes = padded_row * u64::from(height);
+        let limit = device.limits().max_buffer_size;
+        if bytes > limit {
+            return Err(ReadbackError::TooLarge { width, height, bytes, limit });
+        }
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback::pending"),
+            size: bytes.max(4),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback::pending") });
+        copy_rows(&mut encoder, texture, &buffer, 0..height, padded_row);
+        queue.submit([encoder.finish()]);
+        let (sender, mapped) = std::sync::mpsc::channel();
+        buffer.slice(..).map_async(wgpu::MapMode::Read, move |result| {
+            // The receiver is gone only if the readback was dropped unread.
+            let _ = sender.send(result);
+        });
+        Ok(Pending { buffer, mapped, width, height, row, padded_row })
+    }
+
+    /// The texels, tightly packed, rows from the top, once the GPU has copied them; `None` before.
+    pub fn take(&self, device: &wgpu::Device) -> Option<Result<Vec<u8>, ReadbackError>> {
+        if let Err(e) = device.poll(wgpu::PollType::Poll) {
+            return Some(Err(e.into()));
+        }
+        let result = match self.mapped.try_recv() {
+            Ok(result) => result,
+            Err(std::sync::mpsc::TryRecvError::Empty) => return None,
+            // A callback dropped uncalled (the device was lost) counts as a failed mapping.
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => Err(wgpu::BufferAsyncError),
+        };
+        Some(result.map_err(ReadbackError::from).and_then(|()| {
+            let mapped = self.buffer.slice(..).get_mapped_range()?;
+            let mut packed = Vec::with_capacity((self.row * u64::from(self.height)) as usize);
+            for padded in mapped.chunks_exact(self.padded_row as usize).take(self.height as usize) {
+                packed.extend_from_slice(&padded[..self.row as usize]);
+            }
+            Ok(packed)
+        }))
+    }
+
+    /// The image's size in texels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+}
+
+/// Records the copy of rows `rows` of mip level 0 into `buffer`, `padded_row` bytes a row.
+fn copy_rows(
+    encoder: &mut wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+    buffer: &wgpu::Buffer,
+    rows: std::ops::Range<u32>,
+    padded_row: u64,
+) {
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d { x: 0, y: rows.start, z: 0 },
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded_row as u32),
+                rows_per_image: Some(rows.len() as u32),
+            },
+        },
+        wgpu::Extent3d { width: texture.width(), height: rows.len() as u32, depth_or_array_layers: 1 },
+    );
 }
 
 /// Copies mip level 0 of a 2D texture with 4 bytes per texel into a tightly packed `Vec<u8>`,
@@ -90,23 +198,7 @@ pub fn read_texels_in_bands(
         let rows = band_rows.min(height - first_row);
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("readback::encoder") });
-        encoder.copy_texture_to_buffer(
-            wgpu::TexelCopyTextureInfo {
-                texture,
-                mip_level: 0,
-                origin: wgpu::Origin3d { x: 0, y: first_row, z: 0 },
-                aspect: wgpu::TextureAspect::All,
-            },
-            wgpu::TexelCopyBufferInfo {
-                buffer: &buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded_row as u32),
-                    rows_per_image: Some(rows),
-                },
-            },
-            wgpu::Extent3d { width, height: rows, depth_or_array_layers: 1 },
-        );
+        copy_rows(&mut encoder, texture, &buffer, first_row..first_row + rows, padded_row);
         queue.submit([encoder.finish()]);
         let slice = buffer.slice(..padded_row * u64::from(rows));
         let (sender, receiver) = std::sync::mpsc::channel();

@@ -4,7 +4,9 @@
 //! print a new technique's figures without knowing it.
 
 use std::fmt;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use web_time::Instant;
 
 use super::scene_gpu::{SceneGpu, SceneShader};
 use crate::gpu::Gpu;

@@ -53,7 +53,9 @@
 
 use std::collections::HashMap;
 use std::ops::Range;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use web_time::Instant;
 
 use glam::{Mat3, Mat4, Vec3};
 use wgpu::util::DeviceExt;

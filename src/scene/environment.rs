@@ -366,10 +366,7 @@ pub fn fold_cross(image: &EnvImage) -> Result<Box<[EnvImage; 6]>, String> {
 pub fn load_image(path: &Path) -> Result<EnvImage, SceneError> {
     let error = |message: String| SceneError::Texture { path: path.to_path_buf(), message };
     super::check_regular_file(path).map_err(|e| error(format!("cannot open: {e}")))?;
-    let reader = image::ImageReader::open(path)
-        .map_err(|e| error(format!("cannot open: {e}")))?
-        .with_guessed_format()
-        .map_err(|e| error(format!("cannot read: {e}")))?;
+    let reader = crate::files::image_reader(path).map_err(|e| error(format!("cannot read: {e}")))?;
     Ok(from_image(path, super::texture::decode(reader).map_err(error)?))
 }
 

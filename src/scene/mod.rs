@@ -251,25 +251,19 @@ fn without_panics<T>(read: impl FnOnce() -> Result<T, String>) -> Result<T, Stri
 }
 
 /// Reads a whole file that a scene or model names (a model, a glTF buffer or image, an MTL
-/// library). Only regular files are read: a device or a pipe (`/dev/zero`, a FIFO) has no end a
-/// reader could wait for, so a file naming one would never load, or fill memory while trying.
+/// library): a regular file (see [`crate::files`]).
 fn read_file(path: &Path) -> std::io::Result<Vec<u8>> {
-    check_regular_file(path)?;
-    std::fs::read(path)
+    crate::files::read(path)
 }
 
-/// An error unless `path` is a regular file (or a link to one); see [`read_file`].
+/// An error unless `path` is a regular file (or a link to one); see [`crate::files`].
 pub(crate) fn check_regular_file(path: &Path) -> std::io::Result<()> {
-    if std::fs::metadata(path)?.is_file() {
-        return Ok(());
-    }
-    Err(std::io::Error::new(
-        std::io::ErrorKind::InvalidInput,
-        "not a regular file (a folder, a device or a pipe); Mirador reads files",
-    ))
+    crate::files::check_regular(path)
 }
 
-/// Where the built-in scenes live: `assets/scenes/` of the source tree this binary was built from.
+/// Where the built-in scenes live: `assets/scenes/` of the source tree this binary was built from
+/// (in the browser, of the assets built into the page: [`crate::files`]).
 pub fn builtin_path(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets").join("scenes").join(name)
+    let root = if cfg!(target_arch = "wasm32") { "" } else { env!("CARGO_MANIFEST_DIR") };
+    Path::new(root).join("assets").join("scenes").join(name)
 }

@@ -34,10 +34,7 @@ use crate::scene::camera::Camera;
 pub fn load(path: &Path, color_space: ColorSpace) -> Result<Texture, SceneError> {
     let error = |message: String| SceneError::Texture { path: path.to_path_buf(), message };
     super::check_regular_file(path).map_err(|e| error(format!("cannot open: {e}")))?;
-    let reader = ImageReader::open(path)
-        .map_err(|e| error(format!("cannot open: {e}")))?
-        .with_guessed_format()
-        .map_err(|e| error(format!("cannot read: {e}")))?;
+    let reader = crate::files::image_reader(path).map_err(|e| error(format!("cannot read: {e}")))?;
     Ok(from_image(path, decode(reader).map_err(error)?, color_space))
 }
 

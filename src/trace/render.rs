@@ -1,8 +1,11 @@
 //! The image loop: pixels in tiles over rayon's threads, with a progress bar, cancellation and
 //! ray statistics; and progressive refinement (docs/course/10-anti-aliasing.md#progressive-refinement), which shows a coarse image first.
 
+use std::ops::Range;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use web_time::Instant;
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -134,6 +137,25 @@ impl Tracer<'_> {
         Ok((image, TraceStats { rays: counts, elapsed: start.elapsed() }))
     }
 
+    /// Rows `rows` of the image, top to bottom, with the configured anti-aliasing: the same values
+    /// [`Tracer::render`] gives them. How the browser, which has one thread, traces between frames
+    /// (`src/viewer/traced.rs`).
+    pub fn render_rows(&self, rows: Range<u32>) -> (Vec<Vec3>, RayCounts) {
+        let width = self.scene.camera.width;
+        let mut counts = RayCounts::default();
+        let corners = uses_corner_grid(self.settings.anti_aliasing).then(|| {
+            self.corner_rows(rows.start..rows.end + 1, &mut counts, &RenderControl::default())
+                .expect("no cancellation flag, no cancellation")
+        });
+        let mut pixels = Vec::with_capacity((width * rows.len() as u32) as usize);
+        for j in rows {
+            for i in 0..width {
+                pixels.push(self.pixel(i, j, corners.as_ref(), &mut counts));
+            }
+        }
+        (pixels, counts)
+    }
+
     /// One pixel's radiance under the configured anti-aliasing.
     fn pixel(&self, i: u32, j: u32, corners: Option<&CornerGrid>, counts: &mut RayCounts) -> Vec3 {
         let corner = Vec2::new(i as f32, j as f32);
@@ -160,8 +182,18 @@ impl Tracer<'_> {
 
     /// Radiance at every pixel corner, `(width + 1) × (height + 1)` rays, rows in parallel.
     fn corner_grid(&self, counts: &mut RayCounts, control: &RenderControl) -> Result<CornerGrid, Cancelled> {
-        let (width, height) = (self.scene.camera.width + 1, self.scene.camera.height + 1);
-        let rows: Vec<Option<(Vec<Vec3>, RayCounts)>> = (0..height)
+        self.corner_rows(0..self.scene.camera.height + 1, counts, control)
+    }
+
+    /// Radiance at the pixel corners of corner rows `rows`, rows in parallel.
+    fn corner_rows(
+        &self,
+        rows: Range<u32>,
+        counts: &mut RayCounts,
+        control: &RenderControl,
+    ) -> Result<CornerGrid, Cancelled> {
+        let (width, first_row) = (self.scene.camera.width + 1, rows.start);
+        let rows: Vec<Option<(Vec<Vec3>, RayCounts)>> = rows
             .into_par_iter()
             .map(|j| {
                 if control.cancel.is_some_and(|flag| flag.load(Ordering::Relaxed)) {
@@ -172,28 +204,30 @@ impl Tracer<'_> {
                 Some((row, row_counts))
             })
             .collect();
-        let mut values = Vec::with_capacity((width * height) as usize);
+        let mut values = Vec::with_capacity(width as usize * rows.len());
         for row in rows {
             let (row, row_counts) = row.ok_or(Cancelled)?;
             values.extend(row);
             *counts += row_counts;
         }
-        Ok(CornerGrid { width, values })
+        Ok(CornerGrid { width, first_row, values })
     }
 }
 
 /// A finished tile: its top-left pixel, its pixels row by row, and the rays it took.
 type TracedTile = (u32, u32, Vec<Vec3>, RayCounts);
 
-/// Radiance at pixel corners: `(width + 1) × (height + 1)` values.
+/// Radiance at pixel corners: `width` (the image's + 1) values a row, corner rows from
+/// `first_row` on.
 struct CornerGrid {
     width: u32,
+    first_row: u32,
     values: Vec<Vec3>,
 }
 
 impl CornerGrid {
     fn at(&self, i: u32, j: u32) -> Vec3 {
-        self.values[(j * self.width + i) as usize]
+        self.values[((j - self.first_row) * self.width + i) as usize]
     }
 }
 
@@ -214,22 +248,22 @@ fn progress_bar(show: bool, length: u64, message: &'static str) -> indicatif::Pr
 /// Progressive refinement (docs/course/10-anti-aliasing.md#progressive-refinement): the image is first traced one ray per `start × start`
 /// block and each block filled with it, then each level halves the blocks, tracing only the
 /// pixels not traced before, until every pixel has its own centre ray. The final image equals a
-/// `center` render exactly; the viewer polls [`Progressive::refine`] between frames.
-pub struct Progressive<'t, 's> {
-    tracer: &'t Tracer<'s>,
+/// `center` render exactly; the viewer calls [`Progressive::refine`] between frames, with the
+/// tracer of the image's scene.
+pub struct Progressive {
     block: u32,
     traced: Vec<Option<Vec3>>,
     image: RadianceImage,
     counts: RayCounts,
 }
 
-impl<'t, 's> Progressive<'t, 's> {
-    /// `start` is rounded up to a power of two.
-    pub fn new(tracer: &'t Tracer<'s>, start: u32) -> Progressive<'t, 's> {
+impl Progressive {
+    /// The image `tracer` renders, from blocks of `start` (rounded up to a power of two) pixels a
+    /// side.
+    pub fn new(tracer: &Tracer, start: u32) -> Progressive {
         let (width, height) = (tracer.scene.camera.width, tracer.scene.camera.height);
         let pixels = (width * height) as usize;
         Progressive {
-            tracer,
             block: start.max(1).next_power_of_two() * 2,
             traced: vec![None; pixels],
             image: RadianceImage { width, height, pixels: vec![Vec3::ZERO; pixels] },
@@ -237,14 +271,14 @@ impl<'t, 's> Progressive<'t, 's> {
         }
     }
 
-    /// Traces the next level and returns its block size, or `None` once the image is complete.
-    pub fn refine(&mut self) -> Option<u32> {
+    /// Traces the next level with `tracer` (the one the image was made for) and returns its block
+    /// size, or `None` once the image is complete.
+    pub fn refine(&mut self, tracer: &Tracer) -> Option<u32> {
         if self.block == 1 {
             return None;
         }
         self.block /= 2;
         let (b, width, height) = (self.block, self.image.width, self.image.height);
-        let tracer = self.tracer;
         let traced = &self.traced;
         let new: Vec<(u32, Vec3, RayCounts)> = (0..height.div_ceil(b))
             .into_par_iter()

@@ -11,7 +11,9 @@
 
 use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use web_time::Instant;
 
 use anyhow::{Context as _, bail};
 use glam::Vec2;
@@ -148,6 +150,12 @@ impl Viewer {
             && self.screenshot.is_none()
     }
 
+    /// Queues more steps, run one a frame after those already queued (the browser's page sends
+    /// them, `src/web/`).
+    pub fn push_steps(&mut self, steps: impl IntoIterator<Item = Step>) {
+        self.script.steps.extend(steps);
+    }
+
     /// Whether a `measure` step said where the stats start.
     pub fn measured(&self) -> bool {
         self.script.measured
@@ -203,6 +211,7 @@ impl Viewer {
         let mut times = FrameTimes { interval, ..Default::default() };
         let camera_before = self.scene.scene.camera.clone();
         let mut input = CameraInput::default();
+        screen.write_screenshots()?;
         self.run_script(&mut input)?;
         self.poll_file();
         self.traced.poll(&screen.egui);
@@ -315,7 +324,11 @@ impl Viewer {
         let settle = (scale < 1.0).then(|| self.moving_until.map_or(now, |t| t.max(now)));
         let animation = repaint.filter(|d| *d < Duration::from_secs(3600)).map(|d| now + d);
         let retry = (presented == Presented::Skipped).then(|| now + RETRY);
-        let next = [moved.then_some(now), settle, animation, retry].into_iter().flatten().min();
+        // In the browser the tracer works between frames ([`super::traced`]), and readbacks
+        // arrive a frame or two after they are asked for.
+        let busy = self.traced.worker.busy() || self.raster.reading_back() || screen.screenshots_pending();
+        let working = busy.then_some(now);
+        let next = [moved.then_some(now), settle, animation, retry, working].into_iter().flatten().min();
         let at_once = self.scripted || next.is_some_and(|t| t <= now);
         self.last_frame = Some((start, at_once));
         Ok(FrameEnd { next })
@@ -369,7 +382,7 @@ impl Viewer {
                 Action::Reset => self.reset_camera(),
                 Action::Screenshot => {
                     let seconds =
-                        std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
+                        web_time::SystemTime::now().duration_since(web_time::UNIX_EPOCH).map_or(0, |d| d.as_secs());
                     self.screenshot = Some(PathBuf::from(format!("mirador-{seconds}.png")));
                 }
                 Action::DismissError => self.scene.error = None,

@@ -45,7 +45,7 @@ pub mod view_mode;
 pub mod volume_probe;
 
 use std::path::PathBuf;
-use std::time::Instant;
+use web_time::Instant;
 
 use anyhow::Context as _;
 use winit::application::ApplicationHandler;

@@ -14,9 +14,11 @@
 //! already drawn is not drawn again: the window shows the kept image. Hovering, the panel and the
 //! overlays then cost only the window's composition.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use super::screen::{Composition, Screen};
+use web_time::Instant;
+
+use super::screen::{Composition, PendingImage, Screen};
 use crate::gpu::Gpu;
 use crate::gpu::texture::GpuTexture;
 use crate::raster::{FrameReport, FrameTargets, Renderer, drawn_size};
@@ -46,6 +48,8 @@ pub struct RasterView {
     /// What the last frame drawn did: its passes' times (when profiled), the shadow layers it
     /// redrew.
     pub report: FrameReport,
+    /// The image on its way back to the CPU ([`RasterView::read_back`]).
+    readback: Option<PendingImage>,
 }
 
 /// Everything a raster image depends on.
@@ -97,6 +101,7 @@ impl RasterView {
             drawn: None,
             texture_id,
             _placeholder: placeholder,
+            readback: None,
             bound: None,
             report: FrameReport::default(),
         }
@@ -163,6 +168,7 @@ impl RasterView {
             self.bound = Some((size, filter));
         }
         self.drawn = Some(inputs);
+        self.readback = None;
         Drawn::New(elapsed)
     }
 
@@ -203,10 +209,23 @@ impl RasterView {
         SizedTargets { size, targets, image, plain, display }
     }
 
-    /// The last rendered image, read back (sRGB RGBA8, as `mirador render` writes it).
-    pub fn read_back(&self, gpu: &Gpu) -> Option<image::RgbaImage> {
+    /// The last rendered image, read back (sRGB RGBA8, as `mirador render` writes it): asked for
+    /// by the first call after a frame is drawn and handed over by a later one once the GPU has
+    /// copied it (natively by the same call, which waits; in the browser a frame or two later).
+    pub fn read_back(&mut self, gpu: &Gpu) -> Option<image::RgbaImage> {
         let frame = self.frame.as_ref()?;
-        super::screen::read_image(gpu, &frame.image.texture).ok()
+        if self.readback.is_none() {
+            self.readback = Some(PendingImage::start(gpu, &frame.image.texture).ok()?);
+            gpu.wait();
+        }
+        let image = self.readback.as_ref()?.take(gpu)?;
+        self.readback = None;
+        image.ok()
+    }
+
+    /// Whether a readback is under way: the next frame is asked for, to take it.
+    pub fn reading_back(&self) -> bool {
+        self.readback.is_some()
     }
 }
 

@@ -4,7 +4,9 @@
 //! the previous one in place and its error on screen.
 
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant, SystemTime};
+use std::time::{Duration, SystemTime};
+
+use web_time::Instant;
 
 use super::picking::{Picked, Picker, SeenDirection};
 use crate::scene::Camera;

@@ -20,9 +20,11 @@
 //! asked its size. Errors of the surface itself (it may fail before the `Destroyed` event
 //! arrives) skip frames too and are reported only if they last ([`Screen::surface_failing`]).
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use web_time::Instant;
 
 use anyhow::Context as _;
 use winit::event_loop::ActiveEventLoop;
@@ -49,6 +51,10 @@ pub struct Screen {
     /// The side panel as egui last drew it ([`Composition::Copied`]).
     panel: Option<PanelCache>,
     upscale: Option<Upscale>,
+    /// Screenshots on their way back from the GPU, and where they go.
+    screenshots: Vec<(PathBuf, PendingImage)>,
+    /// Where screenshots go instead of PNG files (the browser's page hands them to its script).
+    pub screenshot_sink: Option<Box<dyn Fn(&Path, &image::RgbaImage)>>,
 }
 
 /// The side panel's pixels and the shapes they were drawn from.
@@ -101,6 +107,12 @@ impl Screen {
             .with_min_inner_size(winit::dpi::LogicalSize::new(320, 240));
         let window = Arc::new(event_loop.create_window(attributes).context("cannot open a window")?);
         let (gpu, surface) = Gpu::for_window(window.clone())?;
+        Screen::new(window, gpu, surface, vsync)
+    }
+
+    /// The screen of `window`, given a device and the window's surface (the browser makes them
+    /// asynchronously, `src/web/`).
+    pub fn new(window: Arc<Window>, gpu: Gpu, surface: wgpu::Surface<'static>, vsync: bool) -> anyhow::Result<Screen> {
         let capabilities = surface.get_capabilities(&gpu.adapter);
         // egui blends in sRGB-encoded values, so a plain 8-bit format is its natural target.
         let format = capabilities
@@ -170,6 +182,8 @@ impl Screen {
             failing: None,
             panel: None,
             upscale,
+            screenshots: Vec::new(),
+            screenshot_sink: None,
         })
     }
 
@@ -361,7 +375,12 @@ impl Screen {
             self.configure();
         }
         if let (Some(path), Some(texture)) = (screenshot, shot) {
-            self.write_screenshot(&texture, path)?;
+            let pending = PendingImage::start(&self.gpu, &texture).context("reading the screenshot back")?;
+            self.screenshots.push((path.to_path_buf(), pending));
+            // Natively the screenshot is written before this returns; the browser's arrives later
+            // ([`Screen::write_screenshots`]).
+            self.gpu.wait();
+            self.write_screenshots()?;
         }
         Ok(Presented::Shown)
     }
@@ -409,10 +428,30 @@ impl Screen {
         self.panel = Some(PanelCache { texture, width, pixels_per_point: screen.pixels_per_point, shapes });
     }
 
-    fn write_screenshot(&self, texture: &wgpu::Texture, path: &Path) -> anyhow::Result<()> {
-        let pixels = read_image(&self.gpu, texture).context("reading the screenshot back")?;
-        crate::output::write_png_atomically(&pixels, path)
-            .with_context(|| format!("{}: cannot write the screenshot", path.display()))
+    /// Writes the screenshots whose pixels have arrived: as PNG files (atomically), or to the
+    /// [`Screen::screenshot_sink`] when one is set.
+    pub fn write_screenshots(&mut self) -> anyhow::Result<()> {
+        let mut waiting = Vec::new();
+        for (path, pending) in std::mem::take(&mut self.screenshots) {
+            match pending.take(&self.gpu) {
+                None => waiting.push((path, pending)),
+                Some(image) => {
+                    let image = image.context("reading the screenshot back")?;
+                    match &self.screenshot_sink {
+                        Some(sink) => sink(&path, &image),
+                        None => crate::output::write_png_atomically(&image, &path)
+                            .with_context(|| format!("{}: cannot write the screenshot", path.display()))?,
+                    }
+                }
+            }
+        }
+        self.screenshots = waiting;
+        Ok(())
+    }
+
+    /// Whether a screenshot waits for its pixels (the browser's): the next frame is asked for.
+    pub fn screenshots_pending(&self) -> bool {
+        !self.screenshots.is_empty()
     }
 }
 
@@ -504,20 +543,41 @@ pub fn panel_shapes(shapes: &[egui::epaint::ClippedShape], edge: f32) -> usize {
 }
 
 /// An 8-bit RGBA or BGRA texture (sRGB or not: the bytes are the encoded values) as an opaque
-/// RGBA image.
-pub fn read_image(gpu: &Gpu, texture: &wgpu::Texture) -> anyhow::Result<image::RgbaImage> {
-    let format = texture.format();
-    if format.block_copy_size(None) != Some(4) {
-        anyhow::bail!("reading back a {format:?} texture is not supported");
-    }
-    let mut pixels = readback::read_rgba8(&gpu.device, &gpu.queue, texture)?;
-    let bgra = matches!(format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
-    for texel in pixels.chunks_exact_mut(4) {
-        if bgra {
-            texel.swap(0, 2);
+/// RGBA image, read back without waiting ([`readback::Pending`]).
+pub struct PendingImage {
+    pending: readback::Pending,
+    bgra: bool,
+}
+
+impl PendingImage {
+    pub fn start(gpu: &Gpu, texture: &wgpu::Texture) -> anyhow::Result<PendingImage> {
+        let format = texture.format();
+        if format.block_copy_size(None) != Some(4) {
+            anyhow::bail!("reading back a {format:?} texture is not supported");
         }
-        texel[3] = 255;
+        let bgra = matches!(format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
+        Ok(PendingImage { pending: readback::Pending::start(&gpu.device, &gpu.queue, texture, 4)?, bgra })
     }
-    let (width, height) = (texture.width(), texture.height());
-    Ok(image::RgbaImage::from_raw(width, height, pixels).expect("one RGBA8 texel per pixel"))
+
+    /// The image once the GPU has copied it; `None` before.
+    pub fn take(&self, gpu: &Gpu) -> Option<anyhow::Result<image::RgbaImage>> {
+        let taken = self.pending.take(&gpu.device)?;
+        Some(taken.map_err(anyhow::Error::from).map(|mut pixels| {
+            for texel in pixels.chunks_exact_mut(4) {
+                if self.bgra {
+                    texel.swap(0, 2);
+                }
+                texel[3] = 255;
+            }
+            let (width, height) = self.pending.size();
+            image::RgbaImage::from_raw(width, height, pixels).expect("one RGBA8 texel per pixel")
+        }))
+    }
+}
+
+/// [`PendingImage`], waited for: natively only (the browser cannot wait for the GPU).
+pub fn read_image(gpu: &Gpu, texture: &wgpu::Texture) -> anyhow::Result<image::RgbaImage> {
+    let pending = PendingImage::start(gpu, texture)?;
+    gpu.wait();
+    pending.take(gpu).unwrap_or_else(|| Err(anyhow::anyhow!("the readback was not done after waiting for the GPU")))
 }

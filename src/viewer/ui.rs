@@ -151,7 +151,13 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
                 ViewMode::Raster => "The z-buffer rasterizer, every frame.",
                 ViewMode::Traced => "The Whitted ray tracer, refined in the background.",
                 ViewMode::Split => "Raster left, ray traced right of a divider you can drag: the same pixels.",
-                ViewMode::Difference => "The FLIP error map between the two (black: identical).",
+                ViewMode::Difference => {
+                    if cfg!(target_arch = "wasm32") {
+                        "The largest channel difference of each pixel between the two (black: identical)."
+                    } else {
+                        "The FLIP error map between the two (black: identical)."
+                    }
+                }
             });
         }
     });
@@ -459,8 +465,8 @@ fn overlay(ui: &egui::Ui, model: &UiModel, rect: Rect) {
     }
     if model.view.mode == ViewMode::Difference {
         text += &match &model.traced.difference {
-            Some(d) if d.key == model.key => format!("\nFLIP mean {:.4}", d.flip_mean),
-            _ => "\nFLIP: waiting for the complete traced image".to_string(),
+            Some(d) if d.key == model.key => format!("\n{} mean {:.4}", crate::compare::METRIC, d.flip_mean),
+            _ => format!("\n{}: waiting for the complete traced image", crate::compare::METRIC),
         };
     }
     // Shadowed text, no panel behind it: a filled panel costs egui about 3 ms a frame on a

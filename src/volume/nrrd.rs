@@ -59,7 +59,6 @@
 //! notice extra data), so a lying header or a compression bomb cannot exhaust memory.
 
 use std::fmt;
-use std::fs::File;
 use std::io::{self, BufRead, BufReader, Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
@@ -67,6 +66,7 @@ use std::str::FromStr;
 use glam::{UVec3, Vec3};
 
 use super::grid::{Grid, MAX_DIM, MAX_VOXELS, voxel_count};
+use crate::files::Opened;
 
 /// The type of the samples in a file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -284,9 +284,8 @@ pub fn read_nrrd(path: &Path) -> Result<Grid, String> {
 
 /// Opens a volume file, which must be a regular file: a pipe or a device has no size to check the
 /// header's against, and might never end.
-fn open_regular(path: &Path) -> io::Result<File> {
-    crate::scene::check_regular_file(path)?;
-    File::open(path)
+fn open_regular(path: &Path) -> io::Result<Opened> {
+    crate::files::open(path)
 }
 
 /// What the header says about the samples.
@@ -745,7 +744,11 @@ impl Header {
 }
 
 /// The samples, from the start of the data (after the header, or at the start of the data file).
-fn read_samples(mut source: BufReader<File>, header: &Header, warnings: &mut Vec<String>) -> Result<Vec<f32>, String> {
+fn read_samples(
+    mut source: BufReader<Opened>,
+    header: &Header,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<f32>, String> {
     for skipped in 0..header.line_skip {
         let read = source.skip_until(b'\n').map_err(|e| format!("cannot read the data: {e}"))?;
         if read == 0 {
@@ -763,13 +766,13 @@ fn read_samples(mut source: BufReader<File>, header: &Header, warnings: &mut Vec
 }
 
 fn read_raw_samples(
-    mut source: BufReader<File>,
+    mut source: BufReader<Opened>,
     header: &Header,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<f32>, String> {
     let read_error = |e: io::Error| format!("cannot read the data: {e}");
     let position = source.stream_position().map_err(read_error)?;
-    let end = source.get_ref().metadata().map_err(read_error)?.len();
+    let end = crate::files::length(source.get_ref()).map_err(read_error)?;
     let needed = header.byte_count();
     let after_position = end.saturating_sub(position);
     let start = match header.byte_skip {
@@ -795,7 +798,11 @@ fn read_raw_samples(
     )
 }
 
-fn read_gzip_samples(source: BufReader<File>, header: &Header, warnings: &mut Vec<String>) -> Result<Vec<f32>, String> {
+fn read_gzip_samples(
+    source: BufReader<Opened>,
+    header: &Header,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<f32>, String> {
     let skip = header.bytes_to_skip();
     let needed = header.byte_count();
     // Never more than the bytes the header asks for, and one more to notice extra data.
@@ -832,7 +839,7 @@ fn gzip_error(e: io::Error, cut_short: impl FnOnce() -> String) -> String {
 
 /// Numbers as text, separated by white space (or commas).
 fn read_ascii_samples(
-    mut source: BufReader<File>,
+    mut source: BufReader<Opened>,
     header: &Header,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<f32>, String> {
@@ -956,7 +963,7 @@ pub fn read_raw(path: &Path, desc: &RawDesc) -> Result<Grid, String> {
     let count = voxel_count(dims);
     let needed = count * desc.scalar.size() as u64;
     let file = open_regular(path).map_err(|e| format!("cannot open the file: {e}"))?;
-    let held = file.metadata().map_err(|e| format!("cannot read the file: {e}"))?.len();
+    let held = crate::files::length(&file).map_err(|e| format!("cannot read the file: {e}"))?;
     let total = desc.header_bytes.saturating_add(needed);
     if held != total {
         let grid = format!("{} × {} × {} {} grid", dims.x, dims.y, dims.z, desc.scalar);

@@ -34,7 +34,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         Some("ply") => return load_bare_model(path, super::ply::import(path)?),
         _ => {}
     }
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+    let text = crate::files::read_to_string(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
     parse(&text, path)
 }
 

@@ -40,7 +40,7 @@
 //! Limits: the build is single-threaded and uses object splits only (no spatial splits), so
 //! long thin triangles crossing each other's boxes make deeper trees than necessary.
 
-use std::time::Instant;
+use web_time::Instant;
 
 use glam::{BVec3A, Vec3A, Vec4};
 

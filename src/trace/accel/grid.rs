@@ -23,7 +23,7 @@
 //! Limits: one resolution for the whole scene ("teapot in a stadium"): a small detailed object
 //! in a large empty scene falls into a few cells, and large primitives are listed many times.
 
-use std::time::Instant;
+use web_time::Instant;
 
 use glam::{UVec3, Vec3};
 

@@ -19,7 +19,9 @@ pub mod grid;
 pub mod octree;
 
 use std::fmt;
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use web_time::Instant;
 
 use crate::scene::Ray;
 use crate::trace::geometry::{PreparedRay, Primitive};

@@ -19,7 +19,7 @@
 //! clustered geometry needs depth a BVH would not; memory grows with primitives that straddle
 //! many octants.
 
-use std::time::Instant;
+use web_time::Instant;
 
 use glam::Vec3;
 

@@ -1,0 +1,194 @@
+//! Mirador in the browser: the viewer of [`crate::viewer`] on the page's canvas, WebGPU through
+//! wgpu, built by `web/build.sh` for `wasm32-unknown-unknown` (web/README.md).
+//!
+//! The viewer's frame, panel, techniques and view modes are the native ones. What the browser
+//! changes, and where:
+//! - The device is asked for asynchronously ([`crate::gpu::Gpu::for_window_async`]): the page
+//!   opens its canvas, and the viewer starts when the device arrives ([`App::user_event`]).
+//! - Readbacks arrive a frame or two later ([`crate::gpu::readback::Pending`]): the difference
+//!   view's raster image and screenshots.
+//! - The tracer works in slices between frames on the page's one thread
+//!   (`crate::viewer::traced`).
+//! - Files come from memory ([`crate::files`]): the built-in assets, and the files the page hands
+//!   over ([`page`]). The difference view shows the largest channel difference, not FLIP
+//!   ([`crate::compare::METRIC`]).
+//! - No configuration file is remembered, and the scene is not watched for changes.
+
+mod page;
+
+use std::cell::RefCell;
+use std::rc::Rc;
+use std::sync::Arc;
+
+use wasm_bindgen::prelude::*;
+use web_time::Instant;
+use winit::application::ApplicationHandler;
+use winit::event::{StartCause, WindowEvent};
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::platform::web::{EventLoopExtWebSys, WindowAttributesExtWebSys};
+use winit::window::{Window, WindowId};
+
+use crate::gpu::{Gpu, GpuError};
+use crate::viewer::config::ViewerConfig;
+use crate::viewer::frame::Viewer;
+use crate::viewer::screen::Screen;
+
+/// What wakes the page's event loop besides input.
+#[derive(Clone, Copy, Debug)]
+enum Wake {
+    /// The device asked for at start has answered.
+    Device,
+    /// The page queued steps ([`page::step`]).
+    Steps,
+}
+
+/// The device and the canvas's surface, or why there is none, once the browser answers.
+type DeviceAnswer = Rc<RefCell<Option<Result<(Gpu, wgpu::Surface<'static>), GpuError>>>>;
+
+/// Starts the viewer on the page's `<canvas id="mirador">`; called once the module is loaded.
+#[wasm_bindgen(start)]
+pub fn start() {
+    std::panic::set_hook(Box::new(|info| {
+        let message = format!("Mirador stopped: {info}");
+        web_sys::console::error_1(&message.as_str().into());
+        page::show_error(&message);
+    }));
+    let _ = log::set_logger(&page::CONSOLE).map(|()| log::set_max_level(log::LevelFilter::Info));
+    for (path, bytes) in crate::files::builtin_bytes() {
+        crate::files::add(std::path::Path::new(path), bytes.to_vec());
+    }
+    let event_loop = match EventLoop::<Wake>::with_user_event().build() {
+        Ok(event_loop) => event_loop,
+        Err(e) => return page::show_error(&format!("Mirador cannot start: {e}")),
+    };
+    page::set_proxy(event_loop.create_proxy());
+    let scene = match crate::viewer::scene_state::load(None) {
+        Ok(scene) => scene,
+        Err(e) => return page::show_error(&format!("the built-in scene does not load: {e}")),
+    };
+    event_loop.spawn_app(App {
+        scene: Some(scene),
+        window: None,
+        device: Rc::default(),
+        running: None,
+        next_frame: None,
+    });
+}
+
+struct App {
+    /// The scene, until the viewer starts.
+    scene: Option<crate::Scene>,
+    window: Option<Arc<Window>>,
+    device: DeviceAnswer,
+    running: Option<(Screen, Viewer)>,
+    /// When the last frame asked for the next one.
+    next_frame: Option<Instant>,
+}
+
+impl App {
+    /// Takes the device the browser answered with and starts the viewer on it.
+    fn start_viewer(&mut self) -> anyhow::Result<()> {
+        let answer = self.device.borrow_mut().take();
+        let (Some(answer), Some(window)) = (answer, self.window.clone()) else { return Ok(()) };
+        let (gpu, surface) = answer.map_err(|e| match e {
+            GpuError::NoAdapter { .. } => anyhow::anyhow!(
+                "this browser offers no WebGPU adapter. Mirador's page needs WebGPU: Chrome or Edge 113 or newer, \
+                 Firefox 141 or newer on Windows, Safari 26; on Linux, Chrome with \
+                 chrome://flags/#enable-unsafe-webgpu turned on"
+            ),
+            other => other.into(),
+        })?;
+        let mut screen = Screen::new(window, gpu, surface, true)?;
+        screen.screenshot_sink = Some(Box::new(page::screenshot_taken));
+        let scene = self.scene.take().ok_or_else(|| anyhow::anyhow!("the viewer starts once"))?;
+        let viewer = Viewer::new(&mut screen, scene, &ViewerConfig::default(), Vec::new(), || {});
+        log::info!("adapter: {}", screen.gpu.describe());
+        screen.window.request_redraw();
+        self.running = Some((screen, viewer));
+        Ok(())
+    }
+
+    fn redraw(&mut self) {
+        let Some((screen, viewer)) = &mut self.running else { return };
+        if screen.is_minimised() {
+            return;
+        }
+        viewer.push_steps(page::take_steps());
+        match viewer.frame(screen) {
+            Ok(end) => self.next_frame = end.next,
+            Err(e) => {
+                page::show_error(&format!("{e:#}"));
+                self.next_frame = None;
+            }
+        }
+        page::frame_drawn(viewer.view_pixels, viewer.script_done());
+        // Steps run one a frame, as a scripted native run does.
+        if !viewer.script_done() {
+            screen.window.request_redraw();
+        }
+    }
+}
+
+impl ApplicationHandler<Wake> for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.window.is_some() {
+            return;
+        }
+        let attributes = Window::default_attributes()
+            .with_title("Mirador")
+            .with_canvas(page::canvas())
+            .with_append(page::canvas().is_none())
+            .with_prevent_default(true)
+            .with_focusable(true);
+        let window = match event_loop.create_window(attributes) {
+            Ok(window) => Arc::new(window),
+            Err(e) => return page::show_error(&format!("Mirador cannot use the page's canvas: {e}")),
+        };
+        self.window = Some(window.clone());
+        let answer = self.device.clone();
+        wasm_bindgen_futures::spawn_local(async move {
+            *answer.borrow_mut() = Some(Gpu::for_window_async(window).await);
+            page::wake(Wake::Device);
+        });
+    }
+
+    fn user_event(&mut self, _: &ActiveEventLoop, wake: Wake) {
+        if let Wake::Device = wake
+            && let Err(e) = self.start_viewer()
+        {
+            page::show_error(&format!("{e:#}"));
+        }
+        if let Some((screen, _)) = &self.running {
+            screen.window.request_redraw();
+        }
+    }
+
+    fn window_event(&mut self, _: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let Some((screen, _)) = &mut self.running else { return };
+        let response = screen.input.on_window_event(&screen.window, &event);
+        match event {
+            WindowEvent::Resized(size) => screen.resize(size),
+            WindowEvent::RedrawRequested => return self.redraw(),
+            _ => {}
+        }
+        if response.repaint {
+            screen.window.request_redraw();
+        }
+    }
+
+    fn new_events(&mut self, _: &ActiveEventLoop, cause: StartCause) {
+        if !matches!(cause, StartCause::ResumeTimeReached { .. }) {
+            return;
+        }
+        if self.next_frame.is_some_and(|t| t <= Instant::now())
+            && let Some((screen, _)) = &self.running
+        {
+            self.next_frame = None;
+            screen.window.request_redraw();
+        }
+    }
+
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        event_loop.set_control_flow(self.next_frame.map_or(ControlFlow::Wait, ControlFlow::WaitUntil));
+    }
+}

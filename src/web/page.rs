@@ -1,0 +1,136 @@
+//! The page around the canvas (web/index.html): what its script may call — hand over files,
+//! queue steps, list the built-in scenes — and what Mirador tells it: errors, frames drawn and
+//! screenshots taken.
+//!
+//! The script's calls are the viewer's scripted steps (`crate::viewer::script`): the page's scene
+//! menu and file picker send `load PATH`, its test sends `set …` and `screenshot NAME`. They are
+//! queued here and run one a frame, as `--step` runs them natively.
+
+use std::cell::RefCell;
+use std::collections::VecDeque;
+use std::path::Path;
+
+use wasm_bindgen::prelude::*;
+use winit::event_loop::EventLoopProxy;
+
+use super::Wake;
+use crate::viewer::script::{self, Step};
+
+thread_local! {
+    static PROXY: RefCell<Option<EventLoopProxy<Wake>>> = const { RefCell::new(None) };
+    static STEPS: RefCell<VecDeque<Step>> = const { RefCell::new(VecDeque::new()) };
+    /// The 3D view's rectangle in the canvas at the last frame: `x, y, width, height` pixels.
+    static VIEW: RefCell<Option<[u32; 4]>> = const { RefCell::new(None) };
+}
+
+pub(super) fn set_proxy(proxy: EventLoopProxy<Wake>) {
+    PROXY.with(|p| *p.borrow_mut() = Some(proxy));
+}
+
+pub(super) fn wake(wake: Wake) {
+    PROXY.with(|p| {
+        if let Some(proxy) = p.borrow().as_ref() {
+            let _ = proxy.send_event(wake);
+        }
+    });
+}
+
+pub(super) fn take_steps() -> Vec<Step> {
+    STEPS.with(|s| s.borrow_mut().drain(..).collect())
+}
+
+/// Adds a file the person opened (picked or dropped) under `opened/NAME`, where scenes that name
+/// it by a relative path find it when they are opened from the same folder.
+#[wasm_bindgen]
+pub fn add_file(name: &str, bytes: Vec<u8>) {
+    crate::files::add(&Path::new("opened").join(name), bytes);
+}
+
+/// Queues one scripted step (`load opened/scene.toml`, `set shadows.enabled=false`, `view split`,
+/// `screenshot NAME`); an error names what is wrong with it.
+#[wasm_bindgen]
+pub fn step(line: &str) -> Result<(), JsError> {
+    let step = script::parse(line).map_err(|e| JsError::new(&e.to_string()))?;
+    STEPS.with(|s| s.borrow_mut().push_back(step));
+    wake(Wake::Steps);
+    Ok(())
+}
+
+/// The built-in scenes' paths, for the page's menu.
+#[wasm_bindgen]
+pub fn builtin_scenes() -> Vec<String> {
+    crate::files::BUILTIN
+        .iter()
+        .filter(|path| path.starts_with("assets/scenes/") && path.ends_with(".toml"))
+        .map(|path| path.to_string())
+        .collect()
+}
+
+/// The page's canvas, `<canvas id="mirador">`; `None` if it has none (one is appended).
+pub(super) fn canvas() -> Option<web_sys::HtmlCanvasElement> {
+    let element = web_sys::window()?.document()?.get_element_by_id("mirador")?;
+    element.dyn_into().ok()
+}
+
+/// Calls the page's `window.NAME(...)`, if it defines one.
+fn call_page(name: &str, arguments: &[JsValue]) {
+    let Some(window) = web_sys::window() else { return };
+    let Ok(function) = js_sys::Reflect::get(&window, &name.into()) else { return };
+    let Some(function) = function.dyn_ref::<js_sys::Function>() else { return };
+    let arguments: js_sys::Array = arguments.iter().collect();
+    if let Err(e) = function.apply(&JsValue::NULL, &arguments) {
+        web_sys::console::error_2(&format!("window.{name} failed:").into(), &e);
+    }
+}
+
+/// Shows an error on the page (`window.miradorError(message)`) and in the console.
+pub(super) fn show_error(message: &str) {
+    log::error!("{message}");
+    call_page("miradorError", &[message.into()]);
+}
+
+/// After each frame: remembers where the 3D view is and tells the page
+/// (`window.miradorFrame(steps_done)`).
+pub(super) fn frame_drawn(view: Option<(u32, u32, u32, u32)>, steps_done: bool) {
+    VIEW.with(|v| *v.borrow_mut() = view.map(|(x, y, w, h)| [x, y, w, h]));
+    call_page("miradorFrame", &[steps_done.into()]);
+}
+
+/// Hands a screenshot to the page as PNG bytes: `window.miradorScreenshot(name, png, [x, y,
+/// width, height])`, the last the 3D view's rectangle in it.
+pub(super) fn screenshot_taken(path: &Path, image: &image::RgbaImage) {
+    let mut png = Vec::new();
+    let encoded = image.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png);
+    if let Err(e) = encoded {
+        return show_error(&format!("cannot encode the screenshot: {e}"));
+    }
+    let view = VIEW.with(|v| *v.borrow()).unwrap_or_default();
+    let view: js_sys::Array = view.iter().map(|&n| JsValue::from(n)).collect();
+    let bytes = js_sys::Uint8Array::from(png.as_slice());
+    call_page("miradorScreenshot", &[path.display().to_string().into(), bytes.into(), view.into()]);
+}
+
+/// `log` to the browser's console.
+pub(super) struct Console;
+pub(super) static CONSOLE: Console = Console;
+
+impl log::Log for Console {
+    fn enabled(&self, metadata: &log::Metadata) -> bool {
+        metadata.level() <= log::Level::Info && metadata.target().starts_with("mirador")
+            || metadata.level() <= log::Level::Warn
+    }
+
+    fn log(&self, record: &log::Record) {
+        if !self.enabled(record.metadata()) {
+            return;
+        }
+        let line = format!("{}: {}", record.target(), record.args());
+        match record.level() {
+            log::Level::Error => web_sys::console::error_1(&line.into()),
+            log::Level::Warn => web_sys::console::warn_1(&line.into()),
+            _ => web_sys::console::log_1(&line.into()),
+        }
+    }
+
+    fn flush(&self) {}
+}

@@ -1,0 +1,127 @@
+//! The browser build's page, checked against the native renderers: `web/test.sh` builds the page,
+//! loads it in headless Chromium (WebGPU on SwiftShader), lets the page's test (`web/test.js`)
+//! take four screenshots through the page's own interface, and then runs this file with
+//! `MIRADOR_WEB_CAPTURE` naming the folder they were posted to. It needs a browser and the web
+//! build, more than CI's time allows, so it is `#[ignore]`d in `cargo test`; `tests/web.rs` keeps
+//! the web build compiling there.
+//!
+//! What must hold: the page's 3D view is `mirador render` of the showcase at the view's size
+//! (another GPU draws it: SwiftShader, not lavapipe, so within that GPU difference), toggling
+//! shadows in the page gives the headless image without shadows, the split view's halves are the raster and the traced
+//! images (the tracer ran in the page, in slices: exactly the native image), and the difference view is the browser's
+//! per-pixel map of the two.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use mirador::Scene;
+
+/// The greatest mean FLIP between the page's raster images and lavapipe's: another GPU draws them
+/// (SwiftShader), whose texture filtering differs along the checkerboard's edges and whose
+/// rounding bands the bump map's shading. Measured 0.031–0.034 (web/README.md); a technique
+/// missing costs more (shadows: 0.068).
+const MAX_CROSS_GPU_FLIP: f32 = 0.05;
+/// The page's difference map against the map of the native images: the raster half carries the
+/// cross-GPU differences above into it. Measured 0.048.
+const MAX_DIFFERENCE_MAP_FLIP: f32 = 0.07;
+/// The tracer is the same code on the same CPU, in WebAssembly: measured 0.00000.
+const MAX_TRACED_FLIP: f32 = 0.01;
+/// Shadows off in the page must be this many times nearer `render` with shadows off than with
+/// them on (measured 0.068 / 0.034 = 2.0).
+const MIN_TOGGLE_RATIO: f32 = 1.5;
+
+fn capture() -> PathBuf {
+    let dir = std::env::var_os("MIRADOR_WEB_CAPTURE")
+        .expect("MIRADOR_WEB_CAPTURE names the page's screenshots: run this test through `bash web/test.sh`");
+    PathBuf::from(dir)
+}
+
+/// A screenshot the page posted, and the 3D view's rectangle in it.
+fn shot(dir: &Path, name: &str) -> (image::RgbaImage, [u32; 4]) {
+    let path = dir.join(name);
+    let image = image::open(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).into_rgba8();
+    let view = std::fs::read_to_string(dir.join(format!("{name}.view"))).expect("the view's rectangle");
+    let view: Vec<u32> = view.split_whitespace().map(|n| n.parse().expect("four numbers")).collect();
+    (image, view.try_into().expect("x y width height"))
+}
+
+fn crop(image: &image::RgbaImage, [x, y, w, h]: [u32; 4]) -> image::RgbaImage {
+    image::imageops::crop_imm(image, x, y, w, h).to_image()
+}
+
+fn showcase(w: u32, h: u32, shadows: bool) -> Scene {
+    let mut scene = Scene::showcase().expect("the showcase loads");
+    (scene.camera.width, scene.camera.height) = (w, h);
+    scene.settings.shadows.enabled = shadows;
+    scene
+}
+
+/// Mean FLIP beyond the CPU levels (tests/README.md); the images are kept when it is too large.
+fn flip(reference: &image::RgbaImage, test: &image::RgbaImage, what: &str, dir: &Path) -> f32 {
+    let d = common::difference(reference, test);
+    println!("{what}: mean FLIP {:.5}", d.flip_mean);
+    if d.flip_mean > MAX_TRACED_FLIP {
+        let _ = reference.save(dir.join(format!("{what}-expected.png")));
+        let _ = d.error_map.save(dir.join(format!("{what}-diff.png")));
+    }
+    d.flip_mean
+}
+
+#[test]
+#[ignore = "needs the web build and Chromium: bash web/test.sh"]
+fn the_page_draws_what_the_native_renderers_draw() {
+    let dir = capture();
+    assert!(!dir.join("failed").exists(), "the page failed: {}", std::fs::read_to_string(dir.join("failed")).unwrap());
+
+    let (image, view) = shot(&dir, "raster.png");
+    assert!(view[0] > 100 && view[2] > 100 && view[3] > 100, "a side panel and a 3D view: {view:?}");
+    let scene = showcase(view[2], view[3], true);
+    let raster = common::raster(&scene, &scene.settings);
+    let error = flip(&raster, &crop(&image, view), "raster", &dir);
+    assert!(error <= MAX_CROSS_GPU_FLIP, "the page's 3D view differs from `render`: mean FLIP {error}");
+
+    let (toggled, toggled_view) = shot(&dir, "no-shadows.png");
+    assert_eq!(toggled_view, view);
+    let without = showcase(view[2], view[3], false);
+    let expected = common::raster(&without, &without.settings);
+    let error = flip(&expected, &crop(&toggled, view), "no-shadows", &dir);
+    assert!(
+        error <= MAX_CROSS_GPU_FLIP,
+        "shadows off in the page differ from `render --set shadows.enabled=false`: {error}"
+    );
+    let against_on = flip(&raster, &crop(&toggled, view), "no-shadows-against-shadows", &dir);
+    assert!(
+        against_on >= MIN_TOGGLE_RATIO * error,
+        "turning shadows off in the page did not give the image without shadows: mean FLIP {error} against it, \
+         {against_on} against the image with them"
+    );
+
+    // The split view: raster left of the divider, traced right, clear of the divider and its labels.
+    let (split, split_view) = shot(&dir, "split.png");
+    assert_eq!(split_view, view);
+    let traced = mirador::trace::render_image(&scene, &scene.settings);
+    let half = view[2] / 2;
+    let left = [view[0], view[1], half - 4, view[3] - 30];
+    let right = [view[0] + half + 4, view[1], view[2] - half - 4, view[3] - 30];
+    let in_view = |[x, y, w, h]: [u32; 4]| [x - view[0], y - view[1], w, h];
+    let error = flip(&crop(&raster, in_view(left)), &crop(&split, left), "split-left", &dir);
+    assert!(error <= MAX_CROSS_GPU_FLIP, "split, left half: mean FLIP {error} against `render`");
+    let error = flip(&crop(&traced, in_view(right)), &crop(&split, right), "split-right", &dir);
+    assert!(error <= MAX_TRACED_FLIP, "split, right half: mean FLIP {error} against `trace` (traced in the page)");
+
+    // The difference view: the browser's map (largest channel difference) of the page's two
+    // images, which are the native ones above.
+    let (difference, difference_view) = shot(&dir, "difference.png");
+    assert_eq!(difference_view, view);
+    let rgb = |image: &image::RgbaImage| image.pixels().flat_map(|p| [p[0], p[1], p[2]]).collect::<Vec<u8>>();
+    let (_, _, colored) = mirador::compare::channel_difference(&rgb(&traced), &rgb(&raster));
+    let map = image::RgbaImage::from_raw(
+        view[2],
+        view[3],
+        colored.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 255]).collect(),
+    )
+    .unwrap();
+    let error = flip(&map, &crop(&difference, view), "difference", &dir);
+    assert!(error <= MAX_DIFFERENCE_MAP_FLIP, "the difference view is not the map of traced and raster: {error}");
+}
