@@ -54,8 +54,11 @@ pub struct Screen {
     /// Screenshots on their way back from the GPU, and where they go.
     screenshots: Vec<(PathBuf, PendingImage)>,
     /// Where screenshots go instead of PNG files (the browser's page hands them to its script).
-    pub screenshot_sink: Option<Box<dyn Fn(&Path, &image::RgbaImage)>>,
+    pub screenshot_sink: Option<ScreenshotSink>,
 }
+
+/// Where a screenshot goes instead of a PNG file: given the name it was asked for and its pixels.
+pub type ScreenshotSink = Box<dyn Fn(&Path, &image::RgbaImage)>;
 
 /// The side panel's pixels and the shapes they were drawn from.
 struct PanelCache {
