@@ -577,10 +577,3 @@ impl PendingImage {
         }))
     }
 }
-
-/// [`PendingImage`], waited for: natively only (the browser cannot wait for the GPU).
-pub fn read_image(gpu: &Gpu, texture: &wgpu::Texture) -> anyhow::Result<image::RgbaImage> {
-    let pending = PendingImage::start(gpu, texture)?;
-    gpu.wait();
-    pending.take(gpu).unwrap_or_else(|| Err(anyhow::anyhow!("the readback was not done after waiting for the GPU")))
-}

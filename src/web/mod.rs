@@ -121,7 +121,7 @@ impl App {
                 self.next_frame = None;
             }
         }
-        page::frame_drawn(viewer.view_pixels, viewer.script_done());
+        page::remember_view(viewer.view_pixels);
         // Steps run one a frame, as a scripted native run does.
         if !viewer.script_done() {
             screen.window.request_redraw();

@@ -1,6 +1,5 @@
 //! The page around the canvas (web/index.html): what its script may call — hand over files,
-//! queue steps, list the built-in scenes — and what Mirador tells it: errors, frames drawn and
-//! screenshots taken.
+//! queue steps, list the built-in scenes — and what Mirador tells it: errors and screenshots.
 //!
 //! The script's calls are the viewer's scripted steps (`crate::viewer::script`): the page's scene
 //! menu and file picker send `load PATH`, its test sends `set …` and `screenshot NAME`. They are
@@ -89,11 +88,9 @@ pub(super) fn show_error(message: &str) {
     call_page("miradorError", &[message.into()]);
 }
 
-/// After each frame: remembers where the 3D view is and tells the page
-/// (`window.miradorFrame(steps_done)`).
-pub(super) fn frame_drawn(view: Option<(u32, u32, u32, u32)>, steps_done: bool) {
+/// After each frame: remembers where the 3D view is, for the screenshots' rectangle.
+pub(super) fn remember_view(view: Option<(u32, u32, u32, u32)>) {
     VIEW.with(|v| *v.borrow_mut() = view.map(|(x, y, w, h)| [x, y, w, h]));
-    call_page("miradorFrame", &[steps_done.into()]);
 }
 
 /// Hands a screenshot to the page as PNG bytes: `window.miradorScreenshot(name, png, [x, y,
