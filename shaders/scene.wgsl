@@ -58,22 +58,7 @@ const ENV_MAP_DYNAMIC: u32 = 4u;
 @group(1) @binding(3) var normal_texture: texture_2d<f32>;
 // The chosen texture filter (docs/course/03-mipmaps.md) with the material's wrap modes.
 @group(1) @binding(4) var color_sampler: sampler;
-// Group 2: the shadow pass's outputs and how to read them.
-@group(2) @binding(0) var<uniform> shadows: Shadows;
-@group(2) @binding(1) var shadow_maps: texture_depth_2d_array;
-// One comparison sampler for every filter: GL binds a texture to a single sampler.
-@group(2) @binding(2) var shadow_sampler: sampler_comparison;
-@group(2) @binding(3) var transmission_maps: texture_2d_array<f32>;
-@group(2) @binding(4) var projected_mask: texture_2d<f32>;
-// The environment (shaders/common/environment.wgsl; src/raster/environment): the world's, as a
-// cube, a sphere map and a lat–long map, and the cubes drawn from reflective objects' centres.
-@group(2) @binding(5) var<uniform> environment: Environment;
-// Trilinear; u repeats (the lat–long map's wrap), v clamps. Cube lookups ignore both.
-@group(2) @binding(6) var env_sampler: sampler;
-@group(2) @binding(7) var env_cube: texture_cube<f32>;
-@group(2) @binding(8) var env_cubes: texture_cube_array<f32>;
-@group(2) @binding(9) var env_sphere: texture_2d<f32>;
-@group(2) @binding(10) var env_latlong: texture_2d<f32>;
+// Group 2, what this view's shading reads: shaders/view_group.wgsl.
 // Group 3 (mirror variants only): the reflection, drawn by the camera mirrored about this mirror's
 // plane at the same size as this view, so the mirror's own pixel is where its reflection is
 // (the projective lookup of docs/course/07-planar-mirrors.md reduces to the fragment's pixel).

@@ -14,7 +14,10 @@ pub const COMMON: &[(&str, &str)] = &[
 /// The scene pass and the transparent surfaces' entry points: one module, so that every variant
 /// computes exactly the same vertex positions (depth peeling tests `Equal` against them). The
 /// volumes' ray marching joins them to share the illumination model and the shadow lookups.
+/// The view group's declarations (group 2, what a view's shading reads) come first.
 pub const SCENE: &str = concat!(
+    include_str!("../shaders/view_group.wgsl"),
+    "\n// ---- scene.wgsl\n",
     include_str!("../shaders/scene.wgsl"),
     "\n// ---- transparency.wgsl\n",
     include_str!("../shaders/transparency.wgsl"),

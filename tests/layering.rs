@@ -6,7 +6,7 @@
 //!   ← `texture` ← `trace | gpu` ← `raster` ← `explain` ← `viewer` (← `main.rs`), where modules of one layer
 //!   do not import each other (except `scene` and `volume`, the two halves of the scene);
 //! - inside `raster`: data (`context`, `geometry`, `keys`, `scene_gpu`, `targets`, `uniforms`,
-//!   `view`) ← passes (every technique's module) ← frame (`frame`, and `raster` itself);
+//!   `view`, `view_group`) ← passes (every technique's module) ← frame (`frame`, and `raster` itself);
 //! - `gpu` knows nothing of scenes;
 //! - no two modules importing each other, directly or in a circle.
 //!
@@ -44,7 +44,7 @@ const PARTNERS: &[(&str, &str)] = &[("scene", "volume"), ("volume", "scene")];
 const FORBIDDEN: &[(&str, &str)] = &[("gpu", "scene"), ("gpu", "volume")];
 
 /// The layers inside `raster`.
-const RASTER_DATA: &[&str] = &["context", "geometry", "keys", "scene_gpu", "targets", "uniforms", "view"];
+const RASTER_DATA: &[&str] = &["context", "geometry", "keys", "scene_gpu", "targets", "uniforms", "view", "view_group"];
 const RASTER_FRAME: &[&str] = &["frame"];
 
 /// A module path without the crate, `raster::shadow::views`; `""` is the crate root.

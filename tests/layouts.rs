@@ -6,7 +6,7 @@
 
 use std::mem::{offset_of, size_of};
 
-use mirador::raster::keys::{self, CONSTANT_NAMES, SHADOW_FILTER_NAMES, shadow_filter_code};
+use mirador::raster::keys::{self, FrameKey, MaterialKey, SHADOW_FILTER_NAMES, shadow_filter_code};
 use mirador::raster::shadow::views::MAX_LAYERS;
 use mirador::raster::shadow::{GpuShadowLayer, GpuShadows};
 use mirador::raster::uniforms::{
@@ -298,16 +298,20 @@ fn codes_shared_by_rust_and_wgsl_agree() {
 fn every_pipeline_constant_is_an_override_of_the_scene_shader() {
     let module = parse(&shaders::compose(shaders::SCENE));
     let overrides: Vec<String> = module.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect();
-    let volume_names = mirador::raster::volume::VOLUME_CONSTANT_NAMES;
-    let refraction_names = mirador::raster::refraction::REFRACTION_CONSTANT_NAMES;
-    for name in CONSTANT_NAMES.iter().chain(&volume_names).chain(&refraction_names) {
-        assert!(overrides.iter().any(|o| o == name), "{name} is set by scene_pass.rs but is no override of scene.wgsl");
+    let keys = [
+        FrameKey::NAMES,
+        MaterialKey::NAMES,
+        mirador::raster::volume::VolumeKey::NAMES,
+        mirador::raster::refraction::RefractionKey::NAMES,
+    ];
+    let names: Vec<&str> = keys.concat();
+    for name in &names {
+        assert!(
+            overrides.iter().any(|o| o == name),
+            "{name} is set by a pipeline key but is no override of scene.wgsl"
+        );
     }
-    assert_eq!(
-        overrides.len(),
-        CONSTANT_NAMES.len() + volume_names.len() + refraction_names.len(),
-        "scene.wgsl has overrides scene_pass.rs never sets: {overrides:?}"
-    );
+    assert_eq!(overrides.len(), names.len(), "scene.wgsl has overrides no key sets: {overrides:?}");
 }
 
 #[test]
@@ -319,5 +323,93 @@ fn every_pass_shader_validates() {
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
             .validate(&module)
             .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    }
+}
+
+/// What a WGSL resource variable must be to take a binding of type `ty`, and `None` if it is.
+fn binding_mismatch(module: &naga::Module, var: &naga::GlobalVariable, ty: &wgpu::BindingType) -> Option<String> {
+    use naga::{AddressSpace, ImageClass, ImageDimension, ScalarKind, TypeInner};
+    let inner = &module.types[var.ty].inner;
+    let fits = match (ty, inner) {
+        (wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, .. }, _) => {
+            var.space == AddressSpace::Uniform
+        }
+        (wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Storage { read_only }, .. }, _) => {
+            matches!(var.space, AddressSpace::Storage { access } if access.contains(naga::StorageAccess::STORE) != *read_only)
+        }
+        (wgpu::BindingType::Sampler(kind), TypeInner::Sampler { comparison }) => {
+            *comparison == (*kind == wgpu::SamplerBindingType::Comparison)
+        }
+        (wgpu::BindingType::Texture { sample_type, view_dimension, .. }, TypeInner::Image { dim, arrayed, class }) => {
+            use wgpu::TextureViewDimension as D;
+            let dimension = match view_dimension {
+                D::D1 => (ImageDimension::D1, false),
+                D::D2 => (ImageDimension::D2, false),
+                D::D2Array => (ImageDimension::D2, true),
+                D::Cube => (ImageDimension::Cube, false),
+                D::CubeArray => (ImageDimension::Cube, true),
+                D::D3 => (ImageDimension::D3, false),
+            };
+            let class_fits = matches!(
+                (sample_type, class),
+                (wgpu::TextureSampleType::Depth, ImageClass::Depth { .. })
+                    | (wgpu::TextureSampleType::Float { .. }, ImageClass::Sampled { kind: ScalarKind::Float, .. })
+            );
+            dimension == (*dim, *arrayed) && class_fits
+        }
+        _ => false,
+    };
+    (!fits).then(|| format!("{inner:?} in {:?}, the table says {ty:?}", var.space))
+}
+
+/// Every difference between the view group's table and the group-2 variables of `source`.
+fn view_group_differences(source: &str) -> Vec<String> {
+    use mirador::raster::view_group::VIEW_GROUP;
+    let module = parse(&shaders::compose(source));
+    let mut differences = Vec::new();
+    let mut declared = Vec::new();
+    for (_, var) in module.global_variables.iter() {
+        let Some(binding) = var.binding.as_ref().filter(|b| b.group == 2) else { continue };
+        let name = var.name.clone().unwrap_or_default();
+        declared.push(binding.binding);
+        match VIEW_GROUP.iter().find(|b| b.binding == binding.binding) {
+            None => differences.push(format!("WGSL {name} (binding {}) is not in VIEW_GROUP", binding.binding)),
+            Some(row) if row.name != name => {
+                differences.push(format!("binding {}: WGSL names it {name}, VIEW_GROUP {}", row.binding, row.name))
+            }
+            Some(row) => {
+                if let Some(mismatch) = binding_mismatch(&module, var, &row.ty) {
+                    differences.push(format!("{name}: {mismatch}"));
+                }
+            }
+        }
+    }
+    for row in VIEW_GROUP.iter().filter(|row| !declared.contains(&row.binding)) {
+        differences.push(format!("VIEW_GROUP's {} (binding {}) is not declared in the WGSL", row.name, row.binding));
+    }
+    differences
+}
+
+#[test]
+fn the_view_group_table_is_the_wgsl_binding_by_binding() {
+    let differences = view_group_differences(shaders::SCENE);
+    assert!(differences.is_empty(), "the view group's table against its WGSL:\n{}", differences.join("\n"));
+    // The check can fail: a view image renamed, retyped, or left out of the table.
+    let renamed = shaders::SCENE
+        .replace("var projected_mask:", "var shadow_mask:")
+        .replace("textureLoad(projected_mask", "textureLoad(shadow_mask");
+    let found = view_group_differences(&renamed);
+    assert!(found.iter().any(|d| d.contains("WGSL names it shadow_mask")), "{found:?}");
+    let retyped = parse("@group(2) @binding(4) var projected_mask: texture_2d_array<f32>;");
+    let (_, var) = retyped.global_variables.iter().next().unwrap();
+    let row = mirador::raster::view_group::VIEW_GROUP.iter().find(|row| row.binding == 4).unwrap();
+    assert!(binding_mismatch(&retyped, var, &row.ty).is_some(), "a 2D array where the table has a 2D image");
+    assert!(binding_mismatch(&retyped, var, &mirador::raster::view_group::VIEW_GROUP[3].ty).is_none());
+    let extra = format!("{}\n@group(2) @binding(20) var stray: texture_2d<f32>;", shaders::SCENE);
+    assert!(view_group_differences(&extra).iter().any(|d| d.contains("stray")));
+    // Every view image has its row.
+    for image in mirador::raster::targets::ViewImage::ALL {
+        let resource = mirador::raster::view_group::Resource::View(image);
+        assert!(mirador::raster::view_group::VIEW_GROUP.iter().any(|row| row.resource == resource), "{image:?}");
     }
 }

@@ -9,20 +9,22 @@ use std::time::Duration;
 use web_time::Instant;
 
 use super::scene_gpu::{SceneGpu, SceneShader};
+use super::view::FrameView;
+use super::view_group::ViewGroups;
 use crate::gpu::Gpu;
 use crate::scene::Scene;
 use crate::settings::RenderSettings;
 
 /// What every pass of one frame reads: the device, the scene on both sides, the settings, the
-/// scene shader every scene-module pass compiles from, and the lighting inputs (group 2).
+/// scene shader every scene-module pass compiles from, and every view's view group (group 2).
 pub struct FrameContext<'a> {
     pub gpu: &'a Gpu,
     pub scene: &'a Scene,
     pub scene_gpu: &'a SceneGpu,
     pub settings: &'a RenderSettings,
     pub shader: &'a SceneShader,
-    /// Group 2: the shadow maps, the projected-shadow mask and the environment maps.
-    pub lighting: &'a wgpu::BindGroup,
+    /// Group 2 of each view: the shadow maps, the environment maps and the view's own images.
+    pub view_groups: &'a ViewGroups,
 }
 
 impl FrameContext<'_> {
@@ -32,6 +34,11 @@ impl FrameContext<'_> {
 
     pub fn queue(&self) -> &wgpu::Queue {
         &self.gpu.queue
+    }
+
+    /// What `view`'s shading reads (group 2 of the scene module).
+    pub fn view_group(&self, view: &FrameView) -> &wgpu::BindGroup {
+        self.view_groups.get(view)
     }
 }
 

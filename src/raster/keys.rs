@@ -2,6 +2,11 @@
 //! or off in the scene module (`shaders/scene.wgsl`'s `override`s). Each pass that draws with the
 //! scene module compiles one pipeline per key it meets; toggles are pipeline constants rather
 //! than uniform flags because a software GPU runs both sides of a branch on a uniform value.
+//!
+//! A toggle is declared once, in a [`pipeline_constants!`] key: its field, the `override` it
+//! sets and how it is derived from the key's inputs, on one line. The struct, its constructor,
+//! its constants' names (checked against the WGSL by `tests/layouts.rs`) and their values are
+//! generated from that line.
 
 use super::uniforms::alpha_mode_code;
 use crate::scene::{Material, ProceduralHeight};
@@ -10,25 +15,79 @@ use crate::settings::{
     TangentSource, TextureFilter,
 };
 
-/// The frame's toggles that switch shader code on or off (the `override`s of
-/// `shaders/scene.wgsl`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct FrameKey {
-    pub shadow_method: u32,
-    pub shadow_filter: u32,
-    pub shadow_transmission: bool,
-    pub shadow_texels_view: bool,
-    pub level_colour: bool,
-    pub bump: bool,
-    pub bump_view: u32,
-    pub tangents_per_vertex: bool,
-    pub bump_analytic: bool,
-    pub flat_colour: bool,
-    /// `ENV_MAP_*`: where curved mirrors look their reflection up; 0: nowhere.
-    pub environment: u32,
-    /// Record what the shading computes at the inspected pixel (`shaders/inspect.wgsl`): the
-    /// main view of an inspected frame only.
-    pub inspect: bool,
+/// A value a pipeline constant takes (WGSL's `override`s are set as `f64`).
+pub trait ConstantValue: Copy {
+    fn constant(self) -> f64;
+}
+
+impl ConstantValue for bool {
+    fn constant(self) -> f64 {
+        f64::from(u8::from(self))
+    }
+}
+
+impl ConstantValue for u32 {
+    fn constant(self) -> f64 {
+        f64::from(self)
+    }
+}
+
+/// Declares a key of pipeline constants, one line a toggle:
+/// `field: type = "OVERRIDE" <- how it is derived from the arguments of new`. Generates the
+/// struct, `new(arguments)`, `NAMES` (every `override` it sets) and `constants()` (each name
+/// with this key's value).
+macro_rules! pipeline_constants {
+    (
+        $(#[$meta:meta])*
+        pub struct $name:ident ($($arg:ident: $arg_type:ty),* $(,)?) {
+            $($(#[$field_meta:meta])* $field:ident: $type:ty = $constant:literal <- $value:expr),* $(,)?
+        }
+    ) => {
+        $(#[$meta])*
+        pub struct $name {
+            $($(#[$field_meta])* pub $field: $type,)*
+        }
+
+        impl $name {
+            /// The `override`s this key sets, in the order of [`Self::constants`].
+            pub const NAMES: &'static [&'static str] = &[$($constant),*];
+
+            #[allow(unused_variables)]
+            pub fn new($($arg: $arg_type),*) -> $name {
+                $name { $($field: $value),* }
+            }
+
+            /// Each `override`'s name and its value under this key.
+            pub fn constants(&self) -> Vec<(&'static str, f64)> {
+                vec![$(($constant, $crate::raster::keys::ConstantValue::constant(self.$field))),*]
+            }
+        }
+    };
+}
+pub(crate) use pipeline_constants;
+
+pipeline_constants! {
+    /// The frame's toggles that switch shader code on or off (the `override`s of
+    /// `shaders/scene.wgsl`). `shadowed`: some light casts a shadow this frame; `transmission`:
+    /// transparent occluders were drawn into the transmission maps.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    pub struct FrameKey(settings: &RenderSettings, shadowed: bool, transmission: bool) {
+        shadow_method: u32 = "SHADOW_METHOD" <- shadow_method_code(settings, shadowed),
+        shadow_filter: u32 = "SHADOW_FILTER" <- shadow_filter_code(settings.shadows.filter),
+        shadow_transmission: bool = "SHADOW_TRANSMISSION" <- transmission,
+        shadow_texels_view: bool = "SHADOW_TEXELS_VIEW" <- settings.shadows.view == ShadowView::Texels,
+        level_colour: bool = "LEVEL_COLOUR" <- settings.textures.filter == TextureFilter::LevelColour,
+        bump: bool = "BUMP" <- settings.bump.enabled,
+        bump_view: u32 = "BUMP_VIEW" <- bump_view_code(settings.bump.view),
+        tangents_per_vertex: bool = "TANGENTS_PER_VERTEX" <- settings.bump.tangents == TangentSource::PerVertex,
+        bump_analytic: bool = "BUMP_ANALYTIC" <- settings.bump.analytic,
+        flat_colour: bool = "FLAT_COLOUR" <- settings.raster.flat_colour,
+        /// `ENV_MAP_*`: where curved mirrors look their reflection up; 0: nowhere.
+        environment: u32 = "ENVIRONMENT" <- environment_code(&settings.environment),
+        /// Record what the shading computes at the inspected pixel (`shaders/inspect.wgsl`): the
+        /// main view of an inspected frame only.
+        inspect: bool = "INSPECT" <- false,
+    }
 }
 
 /// `ENVIRONMENT` codes: the world's cube, its sphere map, its lat–long map, or each reflective
@@ -43,33 +102,21 @@ pub const SHADOWS_OFF: u32 = 0;
 pub const SHADOWS_MAP: u32 = 1;
 pub const SHADOWS_PROJECTED: u32 = 2;
 
-impl FrameKey {
-    /// `shadowed`: some light casts a shadow this frame; `transmission`: transparent occluders
-    /// were drawn into the transmission maps.
-    pub fn new(settings: &RenderSettings, shadowed: bool, transmission: bool) -> FrameKey {
-        let shadows = &settings.shadows;
-        FrameKey {
-            shadow_method: match (shadowed && shadows.enabled, shadows.method) {
-                (false, _) => SHADOWS_OFF,
-                (true, ShadowMethod::Map) => SHADOWS_MAP,
-                (true, ShadowMethod::Projected) => SHADOWS_PROJECTED,
-            },
-            shadow_filter: shadow_filter_code(shadows.filter),
-            shadow_transmission: transmission,
-            shadow_texels_view: shadows.view == ShadowView::Texels,
-            level_colour: settings.textures.filter == TextureFilter::LevelColour,
-            bump: settings.bump.enabled,
-            bump_view: match settings.bump.view {
-                BumpView::Off => 0,
-                BumpView::Normals => BUMP_VIEW_NORMALS,
-                BumpView::Tangents => BUMP_VIEW_TANGENTS,
-            },
-            tangents_per_vertex: settings.bump.tangents == TangentSource::PerVertex,
-            bump_analytic: settings.bump.analytic,
-            flat_colour: settings.raster.flat_colour,
-            environment: environment_code(&settings.environment),
-            inspect: false,
-        }
+/// The `SHADOW_METHOD` code: none when no light casts a shadow or shadows are off.
+fn shadow_method_code(settings: &RenderSettings, shadowed: bool) -> u32 {
+    match (shadowed && settings.shadows.enabled, settings.shadows.method) {
+        (false, _) => SHADOWS_OFF,
+        (true, ShadowMethod::Map) => SHADOWS_MAP,
+        (true, ShadowMethod::Projected) => SHADOWS_PROJECTED,
+    }
+}
+
+/// The `BUMP_VIEW` code.
+fn bump_view_code(view: BumpView) -> u32 {
+    match view {
+        BumpView::Off => 0,
+        BumpView::Normals => BUMP_VIEW_NORMALS,
+        BumpView::Tangents => BUMP_VIEW_TANGENTS,
     }
 }
 
@@ -104,30 +151,26 @@ pub const SHADOW_FILTER_NAMES: [(&str, ShadowFilter); 5] = [
     ("SHADOW_FILTER_POISSON", ShadowFilter::Poisson),
 ];
 
-/// What a material brings to the shader: which textures and which height field.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct MaterialKey {
-    pub color_texture: bool,
-    /// `HEIGHT_*` of `shaders/scene.wgsl`: 0 none, 1 a height map, 2 a sine field, 3 value noise.
-    pub height_kind: u32,
-    pub normal_map: bool,
-    /// `ALPHA_*` of `shaders/common/types.wgsl`.
-    pub alpha_mode: u32,
+pipeline_constants! {
+    /// What a material brings to the shader: which textures and which height field.
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    pub struct MaterialKey(material: &Material) {
+        color_texture: bool = "COLOR_TEXTURE" <- material.texture.is_some(),
+        /// `HEIGHT_*` of `shaders/scene.wgsl`: 0 none, 1 a height map, 2 a sine field, 3 value noise.
+        height_kind: u32 = "HEIGHT_KIND" <- height_kind(material),
+        normal_map: bool = "NORMAL_MAP" <- material.normal_map.is_some(),
+        /// `ALPHA_*` of `shaders/common/types.wgsl`.
+        alpha_mode: u32 = "ALPHA_MODE" <- alpha_mode_code(material.alpha_mode),
+    }
 }
 
-impl MaterialKey {
-    pub fn of(material: &Material) -> MaterialKey {
-        MaterialKey {
-            color_texture: material.texture.is_some(),
-            height_kind: match (&material.height_field, &material.height_map) {
-                (Some(ProceduralHeight::Sine { .. }), _) => HEIGHT_SINE,
-                (Some(ProceduralHeight::Noise { .. }), _) => HEIGHT_NOISE,
-                (None, Some(_)) => HEIGHT_TEXTURE,
-                (None, None) => HEIGHT_NONE,
-            },
-            normal_map: material.normal_map.is_some(),
-            alpha_mode: alpha_mode_code(material.alpha_mode),
-        }
+/// The `HEIGHT_*` code of where a material's bump heights come from.
+fn height_kind(material: &Material) -> u32 {
+    match (&material.height_field, &material.height_map) {
+        (Some(ProceduralHeight::Sine { .. }), _) => HEIGHT_SINE,
+        (Some(ProceduralHeight::Noise { .. }), _) => HEIGHT_NOISE,
+        (None, Some(_)) => HEIGHT_TEXTURE,
+        (None, None) => HEIGHT_NONE,
     }
 }
 
@@ -140,46 +183,9 @@ pub const HEIGHT_TEXTURE: u32 = 1;
 pub const HEIGHT_SINE: u32 = 2;
 pub const HEIGHT_NOISE: u32 = 3;
 
-/// The names of the pipeline constants, in the order [`constants`] gives their values.
-pub const CONSTANT_NAMES: [&str; 16] = [
-    "SHADOW_METHOD",
-    "SHADOW_FILTER",
-    "SHADOW_TRANSMISSION",
-    "SHADOW_TEXELS_VIEW",
-    "LEVEL_COLOUR",
-    "BUMP",
-    "BUMP_VIEW",
-    "TANGENTS_PER_VERTEX",
-    "BUMP_ANALYTIC",
-    "FLAT_COLOUR",
-    "ENVIRONMENT",
-    "COLOR_TEXTURE",
-    "HEIGHT_KIND",
-    "NORMAL_MAP",
-    "ALPHA_MODE",
-    "INSPECT",
-];
-
-/// The pipeline constants of one variant.
-pub fn constants(frame: &FrameKey, material: &MaterialKey) -> [(&'static str, f64); 16] {
-    let flag = |b: bool| f64::from(u8::from(b));
-    let values = [
-        f64::from(frame.shadow_method),
-        f64::from(frame.shadow_filter),
-        flag(frame.shadow_transmission),
-        flag(frame.shadow_texels_view),
-        flag(frame.level_colour),
-        flag(frame.bump),
-        f64::from(frame.bump_view),
-        flag(frame.tangents_per_vertex),
-        flag(frame.bump_analytic),
-        flag(frame.flat_colour),
-        f64::from(frame.environment),
-        flag(material.color_texture),
-        f64::from(material.height_kind),
-        flag(material.normal_map),
-        f64::from(material.alpha_mode),
-        flag(frame.inspect),
-    ];
-    std::array::from_fn(|i| (CONSTANT_NAMES[i], values[i]))
+/// The pipeline constants of one scene-module variant: the frame's toggles and the material's.
+pub fn constants(frame: &FrameKey, material: &MaterialKey) -> Vec<(&'static str, f64)> {
+    let mut constants = frame.constants();
+    constants.extend(material.constants());
+    constants
 }

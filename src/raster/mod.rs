@@ -3,8 +3,9 @@
 //! with the same phases. Three layers, each importing only from those before it:
 //!
 //! - **data**: what the passes read and share: [`targets`], [`keys`], [`uniforms`], [`view`],
-//!   [`geometry`], [`scene_gpu`] (the scene's buffers, textures, bind groups and the scene
-//!   shader), [`context`] (the frame context, encoder and report);
+//!   [`view_group`] (what a view's shading reads), [`geometry`], [`scene_gpu`] (the scene's
+//!   buffers, textures, bind groups and the scene shader), [`context`] (the frame context,
+//!   encoder and report);
 //! - **passes**: [`shadow`], [`scene_pass`], [`refraction`], [`transparency`], [`volume`],
 //!   [`mirror`], [`environment`], [`overlays`], [`present`], [`inspect`], each owning what it
 //!   keeps per scene and per target, with a `prepare` that hands out what can record;
@@ -27,6 +28,7 @@ pub mod targets;
 pub mod transparency;
 pub mod uniforms;
 pub mod view;
+pub mod view_group;
 pub mod volume;
 
 pub use context::{Figure, FrameReport, PassReport};

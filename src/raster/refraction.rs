@@ -37,7 +37,7 @@ use std::collections::HashMap;
 
 use super::context::{Figure, FrameContext, FrameEncoder};
 use super::geometry::TransparentObject;
-use super::keys::{FrameKey, MaterialKey, constants};
+use super::keys::{FrameKey, MaterialKey, constants, pipeline_constants};
 use super::scene_gpu::{SceneLayouts, SceneShader};
 use super::scene_pass::scissor;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
@@ -52,8 +52,22 @@ use crate::settings::{Refraction, RenderSettings};
 pub const REFRACTION_ENVIRONMENT: u32 = 1;
 pub const REFRACTION_SCREEN: u32 = 2;
 
-/// The pipeline constants the refraction pass sets besides the scene module's.
-pub const REFRACTION_CONSTANT_NAMES: [&str; 1] = ["REFRACTION"];
+pipeline_constants! {
+    /// The pipeline constant the refraction pass sets besides the scene module's: where the
+    /// refracted ray is read (`REFRACTION_*` of `shaders/refraction.wgsl`).
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    pub struct RefractionKey(mode: Refraction) {
+        source: u32 = "REFRACTION" <- refraction_source(mode),
+    }
+}
+
+/// The `REFRACTION_*` code of where a refraction mode reads the refracted ray.
+fn refraction_source(mode: Refraction) -> u32 {
+    match mode {
+        Refraction::Screen => REFRACTION_SCREEN,
+        Refraction::Environment | Refraction::None => REFRACTION_ENVIRONMENT,
+    }
+}
 
 /// The image the back faces' normals are drawn into.
 const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -199,7 +213,7 @@ impl PreparedRefraction<'_> {
             ));
             scissor(&mut pass, view);
             pass.set_bind_group(0, scene_gpu.frame_group(), &view_offset);
-            pass.set_bind_group(2, ctx.lighting, &[]);
+            pass.set_bind_group(2, ctx.view_group(view), &[]);
             for object in &objects {
                 let key = (culled(object, view, wgpu::Face::Front), view.key, scene_gpu.material_keys[object.material]);
                 pass.set_pipeline(&self.pass.back[&key]);
@@ -224,7 +238,7 @@ impl PreparedRefraction<'_> {
             ));
             scissor(&mut pass, view);
             pass.set_bind_group(0, scene_gpu.frame_group(), &view_offset);
-            pass.set_bind_group(2, ctx.lighting, &[]);
+            pass.set_bind_group(2, ctx.view_group(view), &[]);
             pass.set_bind_group(3, &images.group, &[]);
             for object in &objects {
                 let material = scene_gpu.material_keys[object.material];
@@ -293,12 +307,8 @@ fn front_pipeline(
     layout: &wgpu::PipelineLayout,
     (cull, mode, frame, material): FrontKey,
 ) -> wgpu::RenderPipeline {
-    let source = match mode {
-        Refraction::Screen => REFRACTION_SCREEN,
-        Refraction::Environment | Refraction::None => REFRACTION_ENVIRONMENT,
-    };
-    let refraction = [(REFRACTION_CONSTANT_NAMES[0], f64::from(source))];
-    let constants: Vec<(&str, f64)> = constants(&frame, &material).into_iter().chain(refraction).collect();
+    let mut constants = constants(&frame, &material);
+    constants.extend(RefractionKey::new(mode).constants());
     ctx.device().create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("refraction::front_pipeline"),
         layout: Some(layout),

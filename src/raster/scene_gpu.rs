@@ -1,7 +1,7 @@
 //! The scene on the GPU: its geometry ([`SceneGeometry`]), textures, and bind groups by how often
 //! they change: 0 per view (the view's slot, chosen by a dynamic offset) and per frame (lights,
-//! numeric settings), 1 per material, 2 the lighting inputs the renderer builds from the shadow
-//! pass's outputs. Built once per scene; a frame rewrites the uniforms and, when tessellations
+//! numeric settings), 1 per material, 2 per view (the view group of `super::view_group`: what
+//! the view's shading reads). Built once per scene; a frame rewrites the uniforms and, when tessellations
 //! change, the draw list. What a technique keeps per scene (a volume's 3D texture, the
 //! environment maps, the planar mirrors) belongs to its pass.
 //!
@@ -29,13 +29,14 @@ pub struct SceneLayouts {
     pub frame: wgpu::BindGroupLayout,
     /// Group 1: a material's uniform, textures and colour sampler.
     pub material: wgpu::BindGroupLayout,
-    /// Group 2: the shadow pass's outputs and how to read them, and the environment maps.
-    pub lighting: wgpu::BindGroupLayout,
+    /// Group 2, the view group (`super::view_group`): the shadow maps and how to read them, the
+    /// environment maps, and the images the view's earlier phases made.
+    pub view: wgpu::BindGroupLayout,
 }
 
 impl SceneLayouts {
     /// The layouts; `inspect` adds the inspection buffer and the shadow maps read as floats to
-    /// the lighting group (bindings 11 and 12, `shaders/inspect.wgsl`), for a renderer that
+    /// the view group (bindings 11 and 12, `shaders/inspect.wgsl`), for a renderer that
     /// inspects pixels.
     pub fn new(device: &wgpu::Device, inspect: bool) -> SceneLayouts {
         let both = wgpu::ShaderStages::VERTEX_FRAGMENT;
@@ -57,39 +58,8 @@ impl SceneLayouts {
                 layout::sampler(4, wgpu::SamplerBindingType::Filtering),
             ],
         });
-        let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
-        let filterable = wgpu::TextureSampleType::Float { filterable: true };
-        let mut lighting_entries = vec![
-            layout::uniform(0, wgpu::ShaderStages::FRAGMENT),
-            layout::texture(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
-            layout::sampler(2, wgpu::SamplerBindingType::Comparison),
-            layout::texture(3, unfilterable, wgpu::TextureViewDimension::D2Array),
-            layout::texture(4, unfilterable, wgpu::TextureViewDimension::D2),
-            layout::uniform(5, wgpu::ShaderStages::FRAGMENT),
-            layout::sampler(6, wgpu::SamplerBindingType::Filtering),
-            layout::texture(7, filterable, wgpu::TextureViewDimension::Cube),
-            layout::texture(8, filterable, wgpu::TextureViewDimension::CubeArray),
-            layout::texture(9, filterable, wgpu::TextureViewDimension::D2),
-            layout::texture(10, filterable, wgpu::TextureViewDimension::D2),
-        ];
-        if inspect {
-            lighting_entries.push(wgpu::BindGroupLayoutEntry {
-                binding: 11,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: false },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            });
-            lighting_entries.push(layout::depth_texels(12, wgpu::TextureViewDimension::D2Array));
-        }
-        let lighting = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("scene::lighting_layout"),
-            entries: &lighting_entries,
-        });
-        SceneLayouts { frame, material, lighting }
+        let view = super::view_group::layout(device, inspect);
+        SceneLayouts { frame, material, view }
     }
 }
 
@@ -109,7 +79,7 @@ impl SceneShader {
         let module = shaders::module(device, "scene::shader", shaders::SCENE);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("scene::layout"),
-            bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.material), Some(&layouts.lighting)],
+            bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.material), Some(&layouts.view)],
             immediate_size: 0,
         });
         SceneShader { module, layout }
@@ -125,7 +95,7 @@ impl SceneShader {
     ) -> wgpu::PipelineLayout {
         device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(label),
-            bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.material), Some(&layouts.lighting), Some(group3)],
+            bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.material), Some(&layouts.view), Some(group3)],
             immediate_size: 0,
         })
     }
@@ -252,7 +222,7 @@ impl SceneGpu {
             material_inputs,
             material_groups: Vec::new(),
             active: 0,
-            material_keys: scene.materials.iter().map(MaterialKey::of).collect(),
+            material_keys: scene.materials.iter().map(MaterialKey::new).collect(),
             transmittance: scene.materials.iter().map(super::uniforms::transmittance).collect(),
             geometry: SceneGeometry::new(scene, alone.mirrors, alone.env_objects),
         }

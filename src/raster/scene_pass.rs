@@ -126,7 +126,7 @@ impl ScenePass {
         });
         let background_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("scene::background_layout"),
-            bind_group_layouts: &[Some(&layouts.frame), Some(&empty_layout), Some(&layouts.lighting)],
+            bind_group_layouts: &[Some(&layouts.frame), Some(&empty_layout), Some(&layouts.view)],
             immediate_size: 0,
         });
         let background = background_pipeline(device, shader, &background_layout, "fs_background");
@@ -278,7 +278,7 @@ impl PreparedScene<'_> {
         pass.push_debug_group("depth prepass");
         scissor(&mut pass, view);
         pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view.slot)]);
-        pass.set_bind_group(2, ctx.lighting, &[]);
+        pass.set_bind_group(2, ctx.view_group(view), &[]);
         for batch in scene.geometry.batches.iter().filter(|b| !(opaque_only && b.transparent)) {
             if batch.alone.is_some() && batch.alone == view.skip {
                 continue;
@@ -317,7 +317,7 @@ impl PreparedScene<'_> {
         pass.push_debug_group("opaque");
         scissor(&mut pass, view);
         pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view.slot)]);
-        pass.set_bind_group(2, ctx.lighting, &[]);
+        pass.set_bind_group(2, ctx.view_group(view), &[]);
         // Batches come sorted by material: the pipeline changes only where the variant does.
         let mut current: Option<&wgpu::RenderPipeline> = None;
         for (batch, &(plain, mirror)) in scene.geometry.batches.iter().zip(self.batches(view)) {

@@ -388,7 +388,7 @@ impl PreparedTransparency<'_> {
                     }
                     let mut pass = begin(frame, "transparency::sorted", view, targets, &targets.depth.view);
                     pass.set_bind_group(0, ctx.scene_gpu.frame_group(), &[ctx.scene_gpu.views.offset(view.slot)]);
-                    pass.set_bind_group(2, ctx.lighting, &[]);
+                    pass.set_bind_group(2, ctx.view_group(view), &[]);
                     while let Some(Step::Draw(draw)) = steps.peek() {
                         self.record_draw(ctx, &mut pass, view, draw, Depth::Less);
                         draws += 1;
@@ -464,7 +464,7 @@ impl PreparedTransparency<'_> {
                 ));
                 scissor(&mut pass, view);
                 pass.set_bind_group(0, scene_gpu.frame_group(), &view_offset);
-                pass.set_bind_group(2, ctx.lighting, &[]);
+                pass.set_bind_group(2, ctx.view_group(view), &[]);
                 // Layer 0 peels below the opaque depth alone; layer k below layer k − 1 too.
                 let limits = if layer == 0 { &peel.first } else { &peel.below[(layer - 1) % 2] };
                 pass.set_bind_group(3, limits, &[]);
@@ -479,7 +479,7 @@ impl PreparedTransparency<'_> {
             composite(frame, RaySpan { volumes: VolumeSet::All, near: Some(depth), far });
             let mut pass = begin(frame, "transparency::peeled_layer", view, targets, depth);
             pass.set_bind_group(0, scene_gpu.frame_group(), &view_offset);
-            pass.set_bind_group(2, ctx.lighting, &[]);
+            pass.set_bind_group(2, ctx.view_group(view), &[]);
             for step in &prepared.steps {
                 if let Step::Draw(draw) = step {
                     self.record_draw(ctx, &mut pass, view, draw, Depth::Equal);

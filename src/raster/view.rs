@@ -101,8 +101,8 @@ pub struct FrameView {
     pub scissor: Option<[u32; 4]>,
     /// Draw a depth prepass first, then shade only the nearest surface.
     pub prepass: bool,
-    /// Draw object-precision shadows into the targets' mask (the main view of the projected
-    /// method: the mask holds that view's pixels).
+    /// Draw object-precision shadows into the view's mask (`ViewImage::ProjectedMask` of its
+    /// targets), which its shading then reads: every view of the projected method.
     pub projected: bool,
 }
 

@@ -30,7 +30,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, UVec3, Vec3};
 
 use super::context::{Figure, FrameContext, FrameEncoder};
-use super::keys::{FrameKey, MaterialKey, constants};
+use super::keys::{FrameKey, MaterialKey, constants, pipeline_constants};
 use super::scene_gpu::{SceneLayouts, SceneShader};
 use super::scene_pass::scissor;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
@@ -63,9 +63,18 @@ pub struct GpuVolume {
     pub samples_white: f32,
 }
 
-/// The volume pipelines' own `override`s in `shaders/volume.wgsl`, besides the scene's.
-pub const VOLUME_CONSTANT_NAMES: [&str; 4] =
-    ["VOLUME_GRADIENT", "VOLUME_SHADOWS", "VOLUME_FAR_LIMIT", "VOLUME_NEAR_LIMIT"];
+pipeline_constants! {
+    /// The volume pipelines' own `override`s in `shaders/volume.wgsl`, besides the scene's:
+    /// the gradient, shadowed samples, and whether transparent layers bound the rays behind
+    /// (`far`) and in front (`near`).
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+    pub struct VolumeKey(settings: &VolumeSettings, limits: (bool, bool)) {
+        gradient: u32 = "VOLUME_GRADIENT" <- gradient_code(settings.gradient),
+        shadows: bool = "VOLUME_SHADOWS" <- settings.shadows,
+        far_limit: bool = "VOLUME_FAR_LIMIT" <- limits.0,
+        near_limit: bool = "VOLUME_NEAR_LIMIT" <- limits.1,
+    }
+}
 
 /// `VOLUME_GRADIENT` codes.
 pub const VOLUME_GRADIENT_NAMES: [(&str, VolumeGradient); 3] = [
@@ -210,7 +219,7 @@ pub struct RaySpan<'a> {
 /// What tells the pass's pipelines apart: the view's toggles (shadows), the gradient, whether
 /// samples are shadowed, the rendering, whether the view is mirrored (its back faces are the
 /// other winding), and which limits bound the rays (far, near).
-type PipelineKey = (FrameKey, u32, bool, bool, bool, (bool, bool));
+type PipelineKey = (FrameKey, VolumeKey, bool, bool);
 
 pub struct VolumePass {
     group_layout: wgpu::BindGroupLayout,
@@ -274,15 +283,9 @@ impl VolumePass {
     fn pipeline(&mut self, ctx: &FrameContext, key: PipelineKey) {
         let layout = &self.layout;
         self.pipelines.entry(key).or_insert_with(|| {
-            let (frame, gradient, shadows, isosurface, mirrored, (far, near)) = key;
-            let flag = |b: bool| f64::from(u8::from(b));
-            let mut constants: Vec<(&str, f64)> = constants(&frame, &MaterialKey::default()).to_vec();
-            constants.extend(VOLUME_CONSTANT_NAMES.into_iter().zip([
-                f64::from(gradient),
-                flag(shadows),
-                flag(far),
-                flag(near),
-            ]));
+            let (frame, volume, isosurface, mirrored) = key;
+            let mut constants = constants(&frame, &MaterialKey::default());
+            constants.extend(volume.constants());
             let blend = (!isosurface).then_some(wgpu::BlendState {
                 color: wgpu::BlendComponent {
                     src_factor: wgpu::BlendFactor::One,
@@ -347,11 +350,10 @@ impl VolumePass {
             for (volume, gpu) in ctx.scene.volumes.iter().zip(&self.volumes) {
                 gpu.uniform.write(ctx.queue(), &gpu.uniform_of(volume, settings));
             }
-            let gradient = gradient_code(settings.gradient);
             let isosurfaces = renderings.contains(&Rendering::Isosurface);
             for &(view, targets) in views {
                 let key =
-                    |isosurface, limits| (view.key, gradient, settings.shadows, isosurface, view.view.mirrored, limits);
+                    |isosurface, limits| (view.key, VolumeKey::new(settings, limits), isosurface, view.view.mirrored);
                 if isosurfaces {
                     self.pipeline(ctx, key(true, (false, false)));
                     if !self.depth_copies.iter().any(|(depth, _)| *depth == targets.depth.view) {
@@ -383,8 +385,7 @@ pub struct PreparedVolumes<'p> {
 
 impl PreparedVolumes<'_> {
     fn key(&self, ctx: &FrameContext, view: &FrameView, isosurface: bool, limits: (bool, bool)) -> PipelineKey {
-        let settings = &ctx.settings.volume;
-        (view.key, gradient_code(settings.gradient), settings.shadows, isosurface, view.view.mirrored, limits)
+        (view.key, VolumeKey::new(&ctx.settings.volume, limits), isosurface, view.view.mirrored)
     }
 
     /// Group 3 of volume `index`: the depth its rays end at (`depth`), the transparent layers
@@ -493,7 +494,7 @@ impl PreparedVolumes<'_> {
     ) {
         let scene_gpu = ctx.scene_gpu;
         pass.set_bind_group(0, scene_gpu.frame_group(), &[scene_gpu.views.offset(view.slot)]);
-        pass.set_bind_group(2, ctx.lighting, &[]);
+        pass.set_bind_group(2, ctx.view_group(view), &[]);
         for (index, group) in volumes {
             pass.set_bind_group(1, &scene_gpu.materials()[ctx.scene.volumes[index].material.0], &[]);
             pass.set_bind_group(3, &group, &[]);

@@ -4,8 +4,9 @@
 //!
 //! ```text
 //! plan ──► shadow maps (pass 1 of §4; layers kept while their light and the casters stay)
-//!      ──► lighting inputs (group 2: maps, projected mask, environment maps)
-//!      ──► per view: [depth prepass → projected polygons] → opaque + mirrors + world
+//!      ──► every view's group (group 2: maps, environment maps, the view's own images)
+//!      ──► per view: [depth prepass → projected polygons into the view's mask]
+//!                    → opaque + mirrors + world
 //!                    → isosurfaces → refracting glass
 //!                    → transparent surfaces and composited volumes, in order
 //!          cube faces (copied into their cube) · mirrored cameras, deepest first · main camera
@@ -33,6 +34,7 @@ use super::shadow::{ShadowMaps, ShadowPass};
 use super::targets::{FrameTargets, drawn_size};
 use super::transparency::{PreparedTransparency, TransparencyPass};
 use super::view::{FrameView, ViewKind};
+use super::view_group::{FrameInputs, ViewGroups};
 use super::volume::{PreparedVolumes, RaySpan, VolumePass, VolumeSet};
 use crate::gpu::Gpu;
 use crate::gpu::mipmap::MipmapGenerator;
@@ -58,8 +60,9 @@ pub struct Renderer {
     environment: EnvironmentPass,
     overlays: Overlays,
     present: PresentPass,
-    /// The lighting inputs (group 2), kept while the images it reads are the same ones.
-    lighting: Option<([wgpu::TextureView; 7], wgpu::BindGroup)>,
+    /// Every view's group 2 (what its shading reads), kept while the images it reads are the
+    /// same ones.
+    view_groups: ViewGroups,
     /// Where an inspecting renderer records what its shaders computed at one pixel.
     inspector: Option<Inspector>,
     /// Submit and time each pass on its own (`render --stats`): slower, but it says where the
@@ -84,7 +87,7 @@ impl Renderer {
         Renderer::build(gpu, scene, output_format, false)
     }
 
-    /// A renderer that can inspect a pixel ([`Self::inspect`]): its lighting group carries the
+    /// A renderer that can inspect a pixel ([`Self::inspect`]): its view groups carry the
     /// inspection buffer, which needs storage buffers written by fragment shaders (every Vulkan
     /// device; not WebGL).
     pub fn inspecting(gpu: &Gpu, scene: &Scene, output_format: wgpu::TextureFormat) -> Renderer {
@@ -115,7 +118,7 @@ impl Renderer {
             mipmaps,
             shader,
             layouts,
-            lighting: None,
+            view_groups: ViewGroups::default(),
             inspector: inspect.then(|| Inspector::new(device)),
             profile: false,
         }
@@ -183,11 +186,6 @@ impl Renderer {
         let layers = (&plan.maps, plan.first_shadow_slot);
         self.shadow.record(gpu, &mut frame, &self.scene_gpu, layers, &settings.shadows);
         let maps = self.shadow.maps();
-        let inspection = self.inspector.as_ref().map(|i| &i.buffer);
-        let lighting =
-            lighting_group(&mut self.lighting, gpu, &self.layouts, (&maps, targets, inspection), &self.environment);
-        let lighting = &lighting.clone();
-        let ctx = FrameContext { gpu, scene, scene_gpu: &self.scene_gpu, settings, shader: &self.shader, lighting };
         let (mirrors, environment) = (&self.mirrors, &self.environment);
         let views: Vec<(&FrameView, &FrameTargets)> = plan
             .views()
@@ -197,6 +195,17 @@ impl Renderer {
                 ViewKind::CubeFace { .. } => (view, environment.capture_targets()),
             })
             .collect();
+        let inspection = self.inspector.as_ref().map(|i| &i.buffer);
+        let inputs = frame_inputs(&maps, environment, inspection);
+        self.view_groups.prepare(&gpu.device, &self.layouts.view, &inputs, &views);
+        let ctx = FrameContext {
+            gpu,
+            scene,
+            scene_gpu: &self.scene_gpu,
+            settings,
+            shader: &self.shader,
+            view_groups: &self.view_groups,
+        };
         let phases = Phases {
             scene: self.scene.prepare(&ctx, &views, !plan.mirror_nodes.is_empty()),
             projected: &self.projected,
@@ -341,54 +350,25 @@ fn load(
     SceneGpu::upload(gpu, layouts, mipmaps, scene, DrawnAlone { mirrors: &planar, env_objects: &curved })
 }
 
-/// Group 2 of the scene module: the shadow pass's outputs, the main view's projected-shadow
-/// mask and the environment maps; made again only when one of those images is a new one.
-fn lighting_group<'c>(
-    cache: &'c mut Option<([wgpu::TextureView; 7], wgpu::BindGroup)>,
-    gpu: &Gpu,
-    layouts: &SceneLayouts,
-    (maps, targets, inspection): (&ShadowMaps, &FrameTargets, Option<&wgpu::Buffer>),
-    environment: &EnvironmentPass,
-) -> &'c wgpu::BindGroup {
+/// The frame's inputs to every view's group (group 2): the shadow pass's maps and the
+/// environment maps.
+fn frame_inputs<'a>(
+    maps: &ShadowMaps<'a>,
+    environment: &'a EnvironmentPass,
+    inspection: Option<&'a wgpu::Buffer>,
+) -> FrameInputs<'a> {
     let env = environment.maps();
-    let images = [
-        maps.depth,
-        maps.transmission,
-        &targets.shadow_mask.view,
-        &env.cube.view,
-        &env.dynamic.view,
-        &env.sphere.view,
-        &env.latlong.view,
-    ];
-    if cache.as_ref().is_none_or(|(kept, _)| kept.iter().zip(images).any(|(a, b)| a != b)) {
-        let texture =
-            |binding, view| wgpu::BindGroupEntry { binding, resource: wgpu::BindingResource::TextureView(view) };
-        let mut entries = vec![
-            wgpu::BindGroupEntry { binding: 0, resource: maps.uniform.binding() },
-            texture(1, maps.depth),
-            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(maps.sampler) },
-            texture(3, maps.transmission),
-            texture(4, &targets.shadow_mask.view),
-            wgpu::BindGroupEntry { binding: 5, resource: env.params.binding() },
-            wgpu::BindGroupEntry {
-                binding: 6,
-                resource: wgpu::BindingResource::Sampler(&environment.converter.sampler),
-            },
-            texture(7, &env.cube.view),
-            texture(8, &env.dynamic.view),
-            texture(9, &env.sphere.view),
-            texture(10, &env.latlong.view),
-        ];
-        if let Some(buffer) = inspection {
-            entries.push(wgpu::BindGroupEntry { binding: 11, resource: buffer.as_entire_binding() });
-            entries.push(texture(12, maps.depth));
-        }
-        let group = gpu.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("frame::lighting_group"),
-            layout: &layouts.lighting,
-            entries: &entries,
-        });
-        *cache = Some((images.map(Clone::clone), group));
+    FrameInputs {
+        shadow_uniform: maps.uniform.binding(),
+        shadow_maps: maps.depth,
+        shadow_sampler: maps.sampler,
+        transmission_maps: maps.transmission,
+        environment_uniform: env.params.binding(),
+        environment_sampler: &environment.converter.sampler,
+        environment_cube: &env.cube.view,
+        dynamic_cubes: &env.dynamic.view,
+        sphere_map: &env.sphere.view,
+        latlong_map: &env.latlong.view,
+        inspection,
     }
-    &cache.as_ref().expect("made just above").1
 }

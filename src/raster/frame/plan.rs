@@ -3,7 +3,7 @@
 //! views whose shadow-map layers it may redraw; and which phases run.
 
 use super::super::environment::pass::CubeFace;
-use super::super::keys::{FrameKey, SHADOWS_OFF};
+use super::super::keys::FrameKey;
 use super::super::mirror::pass::{MAX_MIRROR_VIEWS, MirrorNode, plan as plan_mirrors, scissor};
 use super::super::shadow::views::{ShadowLayout, shadow_layout_in};
 use super::super::view::{FrameView, VIEW_SLOTS, View, ViewKind, ViewSlot};
@@ -30,7 +30,7 @@ pub struct FramePlan {
     pub maps: ShadowLayout,
     /// The view slot of shadow-map layer 0 (layer `k` is slot `first + k`).
     pub first_shadow_slot: u32,
-    /// Object-precision shadows: a mask of the main view's pixels.
+    /// Object-precision shadows: each view draws the polygons into a mask of its own pixels.
     pub projected: bool,
     /// Transparent surfaces are drawn after the opaque ones in their own pass (`false`: as
     /// opaque surfaces, or there are none).
@@ -64,8 +64,6 @@ pub fn plan(
     let maps = if projected { ShadowLayout::default() } else { lights.clone() };
     let transmission = shadows.transmission && geometry.has_transparent();
     let key = FrameKey::new(settings, !lights.views.is_empty(), transmission);
-    // Object-precision shadows are a mask of the main view's pixels: other views go without.
-    let secondary_key = if projected { FrameKey { shadow_method: SHADOWS_OFF, ..key } } else { key };
     let prepass = projected
         || match settings.raster.depth_prepass {
             Prepass::Always => true,
@@ -101,11 +99,12 @@ pub fn plan(
         kind,
         slot,
         view,
-        key: secondary_key,
+        key,
         skip,
         scissor,
-        prepass: false,
-        projected: false,
+        // The projected polygons are depth-tested against the view's own surfaces.
+        prepass: projected,
+        projected,
     };
     let mirror_views = mirror_nodes
         .iter()

@@ -25,7 +25,7 @@ use crate::gpu::layout;
 use crate::raster::context::{Figure, FrameContext, FrameEncoder};
 use crate::raster::geometry::DrawListId;
 use crate::raster::scene_gpu::SceneLayouts;
-use crate::raster::targets::{DEPTH_FORMAT, FrameTargets, MASK_FORMAT};
+use crate::raster::targets::{DEPTH_FORMAT, FrameTargets, ViewImage};
 use crate::raster::view::FrameView;
 use crate::scene::{Light, LightKind, Scene, Shape};
 use crate::shaders;
@@ -227,7 +227,7 @@ impl ProjectedPass {
                 entry_point: Some("fs_shadow_projected"),
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState {
-                    format: MASK_FORMAT,
+                    format: ViewImage::ProjectedMask.format(),
                     blend: Some(wgpu::BlendState { color: max, alpha: max }),
                     write_mask: wgpu::ColorWrites::ALL,
                 })],
@@ -262,7 +262,10 @@ impl ProjectedPass {
         let scene_gpu = ctx.scene_gpu;
         let mut pass = frame.encoder.begin_render_pass(&layout::pass(
             "shadow_projected::pass",
-            &[Some(layout::color_attachment(&targets.shadow_mask.view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)))],
+            &[Some(layout::color_attachment(
+                &targets.images.get(ViewImage::ProjectedMask).view,
+                wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+            ))],
             Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
         ));
         let polygons = self.polygons.as_ref().filter(|p| p.vertices.is_some());

@@ -1,0 +1,27 @@
+// The view group (group 2 of the scene module): what the shading of one view reads. One bind
+// group per view (src/raster/view_group.rs, whose VIEW_GROUP table tests/layouts.rs checks
+// against these declarations binding by binding): the frame's shadow and environment maps, the
+// same in every view, and the images earlier phases of this view made for its shading (the
+// projected-shadow mask), so a technique that makes one shows in the main camera, every mirrored
+// camera and every cube face alike. An inspecting renderer adds bindings 11 and 12
+// (shaders/inspect.wgsl).
+
+// The shadow pass's outputs and how to read them.
+@group(2) @binding(0) var<uniform> shadows: Shadows;
+@group(2) @binding(1) var shadow_maps: texture_depth_2d_array;
+// One comparison sampler for every filter: GL binds a texture to a single sampler.
+@group(2) @binding(2) var shadow_sampler: sampler_comparison;
+@group(2) @binding(3) var transmission_maps: texture_2d_array<f32>;
+// The environment (shaders/common/environment.wgsl; src/raster/environment): the world's, as a
+// cube, a sphere map and a lat–long map, and the cubes drawn from reflective objects' centres.
+@group(2) @binding(5) var<uniform> environment: Environment;
+// Trilinear; u repeats (the lat–long map's wrap), v clamps. Cube lookups ignore both.
+@group(2) @binding(6) var env_sampler: sampler;
+@group(2) @binding(7) var env_cube: texture_cube<f32>;
+@group(2) @binding(8) var env_cubes: texture_cube_array<f32>;
+@group(2) @binding(9) var env_sphere: texture_2d<f32>;
+@group(2) @binding(10) var env_latlong: texture_2d<f32>;
+// The view's own images (ViewImage in src/raster/targets.rs).
+// Object-precision shadows (src/raster/shadow/projected.rs): per shadowed light, a channel that
+// is 1 where the polygons cover this view's pixel.
+@group(2) @binding(4) var projected_mask: texture_2d<f32>;
