@@ -18,8 +18,9 @@ use glam::{Vec2, Vec3};
 
 use super::scene_state::SceneState;
 use crate::RenderSettings;
+use crate::base::Ray;
 use crate::output::OutputTransform;
-use crate::scene::{Ray, Scene};
+use crate::scene::Scene;
 use crate::trace::volume::{voxel_illumination, world_normal};
 use crate::volume::march::{self, LocalRay, Sample};
 use crate::volume::{March, Rendering, Volume};
