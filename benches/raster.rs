@@ -349,7 +349,7 @@ fn mirror_costs(gpu: &Gpu) {
     let mut one = scene.clone();
     let right = one.objects.iter().position(|o| o.name == "right mirror").expect("the right mirror");
     let matte = one.materials.iter().position(|m| m.name == "frame").expect("the frame material");
-    one.objects[right].material = mirador::scene::MaterialId(matte);
+    one.objects[right].material = mirador::base::MaterialId(matte);
     let with = |scene: &Scene, enabled: bool, depth: u32| {
         let mut settings = scene.settings.clone();
         settings.mirrors.enabled = enabled;

@@ -21,7 +21,7 @@
 use std::time::{Duration, Instant};
 
 use glam::{Vec2, Vec3, Vec3A};
-use mirador::scene::{MaterialId, Ray};
+use mirador::base::{MaterialId, Ray};
 use mirador::trace::accel::Accelerator;
 use mirador::trace::accel::bvh::Bvh;
 use mirador::trace::geometry::{Primitive, Triangle};

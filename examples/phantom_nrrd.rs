@@ -9,7 +9,7 @@
 use std::path::PathBuf;
 
 use glam::UVec3;
-use mirador::volume::nrrd::{ScalarType, write_nrrd};
+use mirador::scene::nrrd::{ScalarType, write_nrrd};
 use mirador::volume::{Grid, fields};
 
 /// Points per axis, and each edge's width in voxels (as the scene file's `phantom` field).

@@ -35,7 +35,7 @@ fn main() -> anyhow::Result<()> {
     let mut one_mirror = scene.clone();
     let right = one_mirror.objects.iter().position(|o| o.name == "right mirror").context("the right mirror")?;
     let matte = one_mirror.materials.iter().position(|m| m.name == "frame").context("the frame material")?;
-    one_mirror.objects[right].material = mirador::scene::MaterialId(matte);
+    one_mirror.objects[right].material = mirador::base::MaterialId(matte);
 
     let gpu = Gpu::headless()?;
     let base = scene.settings.clone();

@@ -2,6 +2,7 @@
 //! techniques. A wgpu z-buffer rasterizer adds the techniques one toggle at a time; a CPU Whitted
 //! ray tracer renders the same scene, pixel-aligned, as the reference.
 //!
+//! - [`base`]: the ray and the material and texture indices that `scene` and `volume` share.
 //! - [`scene`]: the CPU scene both renderers read (camera, lights, materials, shapes, files).
 //! - [`gpu`]: the thin wgpu layer.
 //! - [`raster`]: the z-buffer renderer, one pass per technique.
@@ -17,6 +18,7 @@
 // NaN, which user input can carry.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod base;
 pub mod compare;
 pub mod explain;
 pub mod files;

@@ -15,7 +15,8 @@ use std::f32::consts::PI;
 
 use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
 use mirador::Scene;
-use mirador::scene::{MaterialId, Mesh, Object, Ray, Shape};
+use mirador::base::{MaterialId, Ray};
+use mirador::scene::{Mesh, Object, Shape};
 use mirador::trace::accel::{AccelKind, Accelerator, build};
 use mirador::trace::geometry::{Aabb, Primitive, Triangle, scene_primitives};
 

@@ -6,8 +6,9 @@
 use std::path::{Path, PathBuf};
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
+use mirador::base::TextureId;
 use mirador::scene::gltf::{GltfImport, GltfProjection, import};
-use mirador::scene::{Attenuation, ColorSpace, LightKind, Material, SceneError, TextureId};
+use mirador::scene::{Attenuation, ColorSpace, LightKind, Material, SceneError};
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/gltf/")).join(name)

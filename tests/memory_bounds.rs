@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use mirador::scene::file::parse;
+use mirador::scene::nrrd::read_nrrd;
 use mirador::scene::{gltf, obj, ply};
-use mirador::volume::nrrd::read_nrrd;
 
 struct Largest;
 

@@ -38,7 +38,7 @@ fn one_mirror_agrees_with_the_tracers_reflected_rays() {
     // Make the right mirror matte: the left one is then the only mirror.
     let right = scene.objects.iter().position(|o| o.name == "right mirror").unwrap();
     let matte = scene.materials.iter().position(|m| m.name == "frame").unwrap();
-    scene.objects[right].material = mirador::scene::MaterialId(matte);
+    scene.objects[right].material = mirador::base::MaterialId(matte);
     let with = parity(&scene, 3, 3);
     assert!(with < 0.04, "one mirror vs traced: FLIP {with}");
     // The test can tell: without the reflection the mirror is black where the tracer's is not.

@@ -665,7 +665,7 @@ fn textures_are_read_relative_to_the_scene_file_colour_as_srgb_and_height_as_lin
     ]);
     let scene = parse(&text, &repo("assets/scenes/inline.toml")).unwrap_or_else(|e| panic!("{e}"));
     let (a, b, c) = (material(&scene, "a"), material(&scene, "b"), material(&scene, "c"));
-    let texture = |id: Option<mirador::scene::TextureId>| &scene.textures[id.expect("a texture").0];
+    let texture = |id: Option<mirador::base::TextureId>| &scene.textures[id.expect("a texture").0];
     assert!(texture(a.texture).path.ends_with("textures/checker.png"));
     assert_eq!(texture(a.texture).color_space, ColorSpace::Srgb);
     assert!(texture(a.height_map).path.ends_with("textures/cobbles-height.png"));

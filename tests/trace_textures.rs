@@ -7,8 +7,9 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use mirador::RenderSettings;
+use mirador::base::Ray;
+use mirador::scene::Scene;
 use mirador::scene::file::parse;
-use mirador::scene::{Ray, Scene};
 use mirador::settings::{AntiAliasing, BumpView, TextureFilter};
 use mirador::texture::mipmap::level_colour;
 use mirador::texture::{HeightField, LEVEL_PALETTE, MipChain, TextureHeight};

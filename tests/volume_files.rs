@@ -1,4 +1,4 @@
-//! Volume files (`src/volume/nrrd.rs`) given bad input: every problem is an error that says
+//! Volume files (`src/scene/nrrd.rs`) given bad input: every problem is an error that says
 //! what is wrong, header problems name their line, nothing panics, and a header that asks for a
 //! huge grid is refused before anything is allocated for it.
 
@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::{UVec3, Vec3};
+use mirador::scene::nrrd::{Endian, RawDesc, ScalarType, read_nrrd, read_raw, write_nrrd};
 use mirador::volume::Grid;
-use mirador::volume::nrrd::{Endian, RawDesc, ScalarType, read_nrrd, read_raw, write_nrrd};
 
 // ---------------------------------------------------------------------------------------------
 // Helpers.

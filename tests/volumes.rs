@@ -340,7 +340,7 @@ fn bad_volumes_in_scene_files_are_errors_with_their_line() {
 fn the_phantom_file_holds_the_procedural_phantom() {
     // assets/volumes/phantom.nrrd is `fields::phantom` on 96³ points with 2.5-voxel edges,
     // written as 16-bit integers: every voxel within rounding of the function.
-    let grid = mirador::volume::nrrd::read_nrrd(&common::asset("volumes/phantom.nrrd")).unwrap();
+    let grid = mirador::scene::nrrd::read_nrrd(&common::asset("volumes/phantom.nrrd")).unwrap();
     assert_eq!(grid.dims, UVec3::splat(96));
     let blur = 2.5 * 2.0 / 95.0;
     let procedural = Grid::from_function(grid.dims, |p| fields::phantom(p, blur)).unwrap();

@@ -45,10 +45,10 @@ use std::path::{Path, PathBuf};
 
 use glam::UVec3;
 use mirador::scene::file::parse;
+use mirador::scene::nrrd::{Endian, RawDesc, ScalarType, read_nrrd, read_raw};
 use mirador::scene::{ModelImport, PANIC_CAUGHT, Scene, Shape, Texture, environment, gltf, obj, ply, texture};
 use mirador::volume::Grid;
 use mirador::volume::grid::voxel_count;
-use mirador::volume::nrrd::{Endian, RawDesc, ScalarType, read_nrrd, read_raw};
 
 /// The line that separates a main file from its side file in one input.
 pub const SIDE: &[u8] = b"\n%%side%%\n";

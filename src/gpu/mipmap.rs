@@ -197,86 +197,19 @@ impl MipmapGenerator {
         if levels <= 1 || layers.is_empty() {
             return;
         }
-        assert!(
-            texture.dimension() == wgpu::TextureDimension::D2 && texture.sample_count() == 1,
-            "mipmaps are generated for single-sample 2D textures"
-        );
-        assert!(
-            texture.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT),
-            "a texture needs TEXTURE_BINDING | RENDER_ATTACHMENT usage to have its mipmaps generated"
-        );
-        let face_copy = match Layers::of(texture) {
-            Layers::Single => None,
-            Layers::Cube => Some(&self.face_of_cube),
-            Layers::Cubes(_) => Some(&self.face_of_cubes),
-            Layers::Array(_) => panic!("mipmaps are generated for 2D images and cubes, not for 2D arrays"),
-        };
-        let format = texture.format();
-        let pipeline = self.pipeline(device, format);
-        let level1 =
-            wgpu::Extent3d { depth_or_array_layers: 1, ..texture.size().mip_level_size(1, wgpu::TextureDimension::D2) };
-        // Scratch level i holds texture level i + 1 before rounding; the layers take turns in it.
-        let scratch = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("mipmap::scratch"),
-            size: level1,
-            mip_level_count: levels - 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: SCRATCH_FORMAT,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        });
-        let level_view = |texture: &wgpu::Texture, level: u32, layer: u32| {
-            texture.create_view(&wgpu::TextureViewDescriptor {
-                label: Some("mipmap::level_view"),
-                format: Some(texture.format()),
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                base_mip_level: level,
-                mip_level_count: Some(1),
-                base_array_layer: layer,
-                array_layer_count: Some(1),
-                ..Default::default()
-            })
-        };
-        // A cube's level 0, one face at a time, as the 2D image level 1 reads; and the group
-        // that reads the whole cube (its level 0) to draw it.
-        let face = face_copy.map(|copy| {
-            let image = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("mipmap::face"),
-                size: wgpu::Extent3d { depth_or_array_layers: 1, ..texture.size() },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: SCRATCH_FORMAT,
-                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
-                view_formats: &[],
-            });
-            let cube = texture.create_view(&wgpu::TextureViewDescriptor {
-                label: Some("mipmap::face_source"),
-                dimension: Some(Layers::of(texture).view_dimension()),
-                base_mip_level: 0,
-                mip_level_count: Some(1),
-                ..Default::default()
-            });
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("mipmap::face_group"),
-                layout: &copy.layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.face_sampler) },
-                    wgpu::BindGroupEntry { binding: copy.binding, resource: wgpu::BindingResource::TextureView(&cube) },
-                ],
-            });
-            (&copy.pipeline, group, level_view(&image, 0, 0))
-        });
+        let face_copy = self.face_copy(texture);
+        let pipeline = self.pipeline(device, texture.format());
+        let scratch = scratch_chain(device, texture);
+        let face = face_copy.map(|copy| self.face_source(device, texture, copy));
         encoder.push_debug_group("mipmap");
         for layer in layers {
-            if let Some((pipeline, group, image)) = &face {
-                draw(encoder, "mipmap::face_pass", (pipeline, group), &[image], layer);
+            if let Some(face) = &face {
+                draw(encoder, "mipmap::face_pass", (face.pipeline, &face.group), &[&face.image], layer);
             }
             for level in 1..levels {
                 let source = match &face {
                     _ if level > 1 => level_view(&scratch, level - 2, 0),
-                    Some((_, _, image)) => image.clone(),
+                    Some(face) => face.image.clone(),
                     None => level_view(texture, 0, layer),
                 };
                 let targets = [level_view(&scratch, level - 1, 0), level_view(texture, level, layer)];
@@ -293,6 +226,95 @@ impl MipmapGenerator {
         }
         encoder.pop_debug_group();
     }
+
+    /// The face copy a cube or cube array's levels start from (`None` for a 2D image), once
+    /// `texture` is known to be one the generator handles.
+    fn face_copy(&self, texture: &wgpu::Texture) -> Option<&FaceCopy> {
+        assert!(
+            texture.dimension() == wgpu::TextureDimension::D2 && texture.sample_count() == 1,
+            "mipmaps are generated for single-sample 2D textures"
+        );
+        assert!(
+            texture.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT),
+            "a texture needs TEXTURE_BINDING | RENDER_ATTACHMENT usage to have its mipmaps generated"
+        );
+        match Layers::of(texture) {
+            Layers::Single => None,
+            Layers::Cube => Some(&self.face_of_cube),
+            Layers::Cubes(_) => Some(&self.face_of_cubes),
+            Layers::Array(_) => panic!("mipmaps are generated for 2D images and cubes, not for 2D arrays"),
+        }
+    }
+
+    /// A cube's level 0, one face at a time, as the 2D image level 1 reads; and the group that
+    /// reads the whole cube (its level 0) to draw it.
+    fn face_source<'a>(&self, device: &wgpu::Device, texture: &wgpu::Texture, copy: &'a FaceCopy) -> FaceSource<'a> {
+        let image = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("mipmap::face"),
+            size: wgpu::Extent3d { depth_or_array_layers: 1, ..texture.size() },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: SCRATCH_FORMAT,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let cube = texture.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("mipmap::face_source"),
+            dimension: Some(Layers::of(texture).view_dimension()),
+            base_mip_level: 0,
+            mip_level_count: Some(1),
+            ..Default::default()
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("mipmap::face_group"),
+            layout: &copy.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.face_sampler) },
+                wgpu::BindGroupEntry { binding: copy.binding, resource: wgpu::BindingResource::TextureView(&cube) },
+            ],
+        });
+        FaceSource { pipeline: &copy.pipeline, group, image: level_view(&image, 0, 0) }
+    }
+}
+
+/// One face of a cube drawn into a 2D image for level 1 to read: the face copy's pipeline, the
+/// group that reads the cube, and the image.
+struct FaceSource<'a> {
+    pipeline: &'a wgpu::RenderPipeline,
+    group: wgpu::BindGroup,
+    image: wgpu::TextureView,
+}
+
+/// The chain `texture`'s levels are computed from before rounding: its level i holds the
+/// texture's level i + 1; the layers take turns in it.
+fn scratch_chain(device: &wgpu::Device, texture: &wgpu::Texture) -> wgpu::Texture {
+    let level1 =
+        wgpu::Extent3d { depth_or_array_layers: 1, ..texture.size().mip_level_size(1, wgpu::TextureDimension::D2) };
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("mipmap::scratch"),
+        size: level1,
+        mip_level_count: texture.mip_level_count() - 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: SCRATCH_FORMAT,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    })
+}
+
+/// The view of one level of one layer, as a 2D image in the texture's format.
+fn level_view(texture: &wgpu::Texture, level: u32, layer: u32) -> wgpu::TextureView {
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        label: Some("mipmap::level_view"),
+        format: Some(texture.format()),
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        base_mip_level: level,
+        mip_level_count: Some(1),
+        base_array_layer: layer,
+        array_layer_count: Some(1),
+        ..Default::default()
+    })
 }
 
 /// One fullscreen triangle of `pipeline` with `group` into `targets`, as instance `instance`.

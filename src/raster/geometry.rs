@@ -273,7 +273,39 @@ impl SceneGeometry {
         max_segments: u32,
         adaptive: bool,
     ) -> bool {
-        let segments: Vec<u32> = scene
+        let segments = self.segments_for(scene, camera, max_segments, adaptive);
+        if segments == self.segments && self.prepared {
+            return false;
+        }
+        let entries = self.entries(scene, &segments);
+        for (_, _, _, key, ..) in &entries {
+            if !self.meshes.contains_key(key) {
+                let mesh = build_mesh(scene, *key);
+                self.meshes.insert(*key, GpuMesh::upload(device, &format!("{key:?}"), &mesh));
+            }
+        }
+        self.batches = self.batches_of(&entries);
+        self.transparent = self.transparent_of(scene, &entries);
+        // A new buffer for every new list, never rewritten: the buffer names the list
+        // ([`Self::draw_list`]).
+        let data: Vec<GpuInstance> = entries.iter().map(|e| e.4).collect();
+        self.instances = (!data.is_empty()).then(|| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("geometry::instances"),
+                contents: bytemuck::cast_slice(&data),
+                usage: wgpu::BufferUsages::VERTEX,
+            })
+        });
+        self.segments = segments;
+        self.prepared = true;
+        true
+    }
+
+    /// The segments each object is tessellated with for `camera`: 0 for shapes that are not
+    /// curved, `max_segments` when `adaptive` is off, else by the size of its bounding sphere on
+    /// screen.
+    fn segments_for(&self, scene: &Scene, camera: &Camera, max_segments: u32, adaptive: bool) -> Vec<u32> {
+        scene
             .objects
             .iter()
             .zip(&self.objects)
@@ -285,15 +317,17 @@ impl SceneGeometry {
                     segments_for_pixels(screen_radius(camera, center, radius), max_segments)
                 }
             })
-            .collect();
-        if segments == self.segments && self.prepared {
-            return false;
-        }
+            .collect()
+    }
+
+    /// The draw list's entries, one per object tessellated with `segments`, sorted opaque first,
+    /// then by material, object drawn alone and mesh: runs of equal keys become one draw.
+    fn entries(&self, scene: &Scene, segments: &[u32]) -> Vec<Entry> {
         let mut entries: Vec<Entry> = scene
             .objects
             .iter()
             .zip(&self.objects)
-            .zip(&segments)
+            .zip(segments)
             .enumerate()
             .map(|(index, ((object, info), &n))| {
                 let (key, world_from_mesh) = instance_of(object, n);
@@ -309,22 +343,19 @@ impl SceneGeometry {
                 )
             })
             .collect();
-        // Opaque first, then by material, object drawn alone and mesh: runs of equal keys become
-        // one draw.
         entries.sort_by(|a, b| {
             (a.0, a.1, a.2).cmp(&(b.0, b.1, b.2)).then_with(|| mesh_order(&a.3).cmp(&mesh_order(&b.3)))
         });
-        for (_, _, _, key, ..) in &entries {
-            if !self.meshes.contains_key(key) {
-                let mesh = build_mesh(scene, *key);
-                self.meshes.insert(*key, GpuMesh::upload(device, &format!("{key:?}"), &mesh));
-            }
-        }
-        self.batches.clear();
-        self.transparent.clear();
+        entries
+    }
+
+    /// The sorted `entries` as instanced draws: each run of one transparency, material, object
+    /// drawn alone and mesh is one batch over its instances.
+    fn batches_of(&self, entries: &[Entry]) -> Vec<Batch> {
+        let mut batches: Vec<Batch> = Vec::new();
         for (index, (transparent, material, alone, key, ..)) in entries.iter().enumerate() {
             let index = index as u32;
-            match self.batches.last_mut() {
+            match batches.last_mut() {
                 Some(b)
                     if b.transparent == *transparent
                         && b.material == *material
@@ -333,7 +364,7 @@ impl SceneGeometry {
                 {
                     b.instances.end = index + 1;
                 }
-                _ => self.batches.push(Batch {
+                _ => batches.push(Batch {
                     mesh: *key,
                     material: *material,
                     transparent: *transparent,
@@ -343,9 +374,16 @@ impl SceneGeometry {
                 }),
             }
         }
+        batches
+    }
+
+    /// The transparent entries as the transparency pass draws them, in the scene's order (their
+    /// meshes uploaded).
+    fn transparent_of(&self, scene: &Scene, entries: &[Entry]) -> Vec<TransparentObject> {
+        let mut transparent = Vec::new();
         for (instance, &(_, material, _, mesh, _, object, world_from_mesh)) in entries.iter().enumerate() {
             if entries[instance].0 {
-                self.transparent.push(TransparentObject {
+                transparent.push(TransparentObject {
                     object,
                     mesh,
                     material,
@@ -357,20 +395,8 @@ impl SceneGeometry {
                 });
             }
         }
-        self.transparent.sort_by_key(|t| t.object);
-        // A new buffer for every new list, never rewritten: the buffer names the list
-        // ([`Self::draw_list`]).
-        let data: Vec<GpuInstance> = entries.iter().map(|e| e.4).collect();
-        self.instances = (!data.is_empty()).then(|| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("geometry::instances"),
-                contents: bytemuck::cast_slice(&data),
-                usage: wgpu::BufferUsages::VERTEX,
-            })
-        });
-        self.segments = segments;
-        self.prepared = true;
-        true
+        transparent.sort_by_key(|t| t.object);
+        transparent
     }
 
     /// Names the current draw list: what is drawn from it (shadow maps, projected polygons,

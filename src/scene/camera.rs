@@ -28,6 +28,8 @@
 use glam::{Mat4, Vec3, Vec4};
 use serde::{Deserialize, Serialize};
 
+use crate::base::Ray;
+
 /// How the camera projects: perspective through the eye, or parallel rays along `−ze`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -59,19 +61,6 @@ pub struct EyeFrame {
     pub xe: Vec3,
     pub ye: Vec3,
     pub ze: Vec3,
-}
-
-/// A ray `o + t·d`, with `d` of unit length.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Ray {
-    pub origin: Vec3,
-    pub direction: Vec3,
-}
-
-impl Ray {
-    pub fn at(&self, t: f32) -> Vec3 {
-        self.origin + t * self.direction
-    }
 }
 
 /// Why a camera cannot form an image.

@@ -162,7 +162,8 @@ use gltf::mesh::{Mode, Semantic};
 use gltf::scene::Transform;
 
 use super::material::{AlphaMode, ColorSpace, Wrap};
-use super::{Attenuation, Light, LightKind, Material, Mesh, SceneError, Texture, TextureId, light, texture};
+use super::{Attenuation, Light, LightKind, Material, Mesh, SceneError, Texture, light, texture};
+use crate::base::TextureId;
 
 /// What one glTF file contributes to a scene, in the glTF file's own world coordinates.
 #[derive(Clone, Debug, Default)]

@@ -5,13 +5,7 @@ use std::path::PathBuf;
 
 use glam::{Vec2, Vec3};
 
-/// Index into [`crate::scene::Scene::materials`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct MaterialId(pub usize);
-
-/// Index into [`crate::scene::Scene::textures`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct TextureId(pub usize);
+use crate::base::TextureId;
 
 /// How a texture's stored values are to be read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -4,7 +4,8 @@
 //! analytic shapes (sphere, axis-aligned box, plane) or triangle meshes, each placed by a
 //! `world_from_local` transform; glTF models are imported into meshes, materials, lights and
 //! cameras, Wavefront OBJ models (with their MTL materials) and PLY meshes into meshes and
-//! materials. Scenes are written in TOML ([`file`], documented in `docs/scene-format.md`).
+//! materials, NRRD and raw volume files ([`nrrd`]) into the voxel grids of [`crate::volume`].
+//! Scenes are written in TOML ([`file`], documented in `docs/scene-format.md`).
 
 pub mod camera;
 pub mod environment;
@@ -13,6 +14,7 @@ pub mod gltf;
 pub mod light;
 pub mod material;
 pub mod mesh;
+pub mod nrrd;
 pub mod obj;
 pub mod optics;
 pub mod ply;
@@ -24,16 +26,17 @@ use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
-pub use camera::{Camera, Projection, Ray};
+pub use camera::{Camera, Projection};
 pub use environment::{EnvImage, Environment, EnvironmentSource, Sky};
 pub use light::{Attenuation, Light, LightKind};
-pub use material::{AlphaMode, ColorSpace, Material, MaterialId, ProceduralHeight, Texture, TextureId, Wrap};
+pub use material::{AlphaMode, ColorSpace, Material, ProceduralHeight, Texture, Wrap};
 pub use mesh::Mesh;
 
 /// What one model file (glTF, OBJ or PLY) contributes to a scene. glTF's container is the fullest,
 /// so it serves all three; OBJ and PLY files leave its lights and cameras empty.
 pub type ModelImport = gltf::GltfImport;
 
+use crate::base::MaterialId;
 use crate::settings::RenderSettings;
 
 /// The geometry of an object, in its local coordinates.

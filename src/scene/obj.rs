@@ -91,7 +91,8 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::gltf::GltfObject;
 use super::material::{AlphaMode, ColorSpace, Wrap};
-use super::{Material, Mesh, ModelImport, SceneError, TextureId, texture};
+use super::{Material, Mesh, ModelImport, SceneError, texture};
+use crate::base::TextureId;
 
 /// The name of the material faces get without a `usemtl` (or with one naming nothing defined).
 pub const DEFAULT_MATERIAL: &str = "obj-default";

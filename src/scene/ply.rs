@@ -164,7 +164,23 @@ fn read(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
     if layout.partial_normals {
         warn("the vertices have some but not all of nx, ny, nz; normals are computed".into());
     }
+    let (vertices, faces) = read_elements(&mut reader, &header)?;
+    let count = vertex_count(&vertices)?;
+    let (indices, short_faces) = fans(&faces, count)?;
+    if short_faces > 0 {
+        warn(format!("skipped {short_faces} face(s) with fewer than three vertices"));
+    }
+    let name = path.file_stem().map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned());
+    let mesh = mesh_of(name, &vertices, (indices, faces.len()), &layout, &mut warn)?;
+    out.meshes.push(mesh);
+    out.materials.push(Material { name: DEFAULT_MATERIAL.into(), ..Material::default() });
+    out.objects.push(GltfObject { name: "mesh".into(), mesh: 0, material: 0, world_from_local: Mat4::IDENTITY });
+    Ok(out)
+}
 
+/// The payload, element by element in the header's order: the vertices and faces, other elements
+/// read past.
+fn read_elements(reader: &mut Reader<Cursor<&[u8]>>, header: &Header) -> Result<(Vec<Vertex>, Vec<Face>), String> {
     let (mut vertices, mut faces) = (Vec::new(), Vec::new());
     for (name, element) in &header.elements {
         let failed = |e: ply_rs_bw::parser::ParseError| describe_payload_error(element, e);
@@ -173,14 +189,19 @@ fn read(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
             continue;
         }
         match name.as_str() {
-            "vertex" => vertices = read_element::<Vertex>(&mut reader, element, &header).map_err(failed)?,
-            "face" => faces = read_element::<Face>(&mut reader, element, &header).map_err(failed)?,
+            "vertex" => vertices = read_element::<Vertex>(reader, element, header).map_err(failed)?,
+            "face" => faces = read_element::<Face>(reader, element, header).map_err(failed)?,
             _ => {
-                read_element::<Skipped>(&mut reader, element, &header).map_err(failed)?;
+                read_element::<Skipped>(reader, element, header).map_err(failed)?;
             }
         }
     }
+    Ok((vertices, faces))
+}
 
+/// How many vertices there are, once they are known to fit 32-bit indices and to have finite
+/// coordinates.
+fn vertex_count(vertices: &[Vertex]) -> Result<u32, String> {
     let count = u32::try_from(vertices.len())
         .map_err(|_| format!("{} vertices are more than 32-bit indices reach", vertices.len()))?;
     if let Some((i, v)) = vertices.iter().enumerate().find(|(_, v)| !Vec3::from_array(v.position).is_finite()) {
@@ -190,6 +211,12 @@ fn read(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
             v.position
         ));
     }
+    Ok(count)
+}
+
+/// The faces triangulated as fans `v0, vi, vi+1`, once every index is known to name one of the
+/// `count` vertices; and how many faces had fewer than three vertices (skipped).
+fn fans(faces: &[Face], count: u32) -> Result<(Vec<u32>, usize), String> {
     let mut indices = Vec::with_capacity(3 * faces.len());
     let mut short_faces = 0;
     for (f, face) in faces.iter().enumerate() {
@@ -208,11 +235,19 @@ fn read(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
             indices.extend_from_slice(&[v0, pair[0] as u32, pair[1] as u32]);
         }
     }
-    if short_faces > 0 {
-        warn(format!("skipped {short_faces} face(s) with fewer than three vertices"));
-    }
+    Ok((indices, short_faces))
+}
 
-    let name = path.file_stem().map_or_else(|| "mesh".to_string(), |s| s.to_string_lossy().into_owned());
+/// The mesh of `vertices` and the triangles `indices` (made from `faces` faces), degenerate
+/// triangles removed, with the file's normals where they are all usable and computed ones
+/// otherwise; an error when no triangle is left.
+fn mesh_of(
+    name: String,
+    vertices: &[Vertex],
+    (indices, faces): (Vec<u32>, usize),
+    layout: &Layout,
+    warn: &mut impl FnMut(String),
+) -> Result<Mesh, String> {
     let mut mesh = Mesh {
         name,
         positions: vertices.iter().map(|v| Vec3::from_array(v.position)).collect(),
@@ -232,7 +267,7 @@ fn read(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
         warn(format!("removed {removed} zero-area (degenerate) triangle(s)"));
     }
     if mesh.indices.is_empty() {
-        return Err(format!("no triangles to draw ({} faces, none with three vertices and an area)", faces.len()));
+        return Err(format!("no triangles to draw ({faces} faces, none with three vertices and an area)"));
     }
     let given: Option<Vec<Vec3>> =
         layout.normals.then(|| vertices.iter().map(|v| Vec3::from_array(v.normal).try_normalize()).collect()).flatten();
@@ -245,10 +280,7 @@ fn read(path: &Path, bytes: &[u8]) -> Result<ModelImport, String> {
             mesh.compute_normals();
         }
     }
-    out.meshes.push(mesh);
-    out.materials.push(Material { name: DEFAULT_MATERIAL.into(), ..Material::default() });
-    out.objects.push(GltfObject { name: "mesh".into(), mesh: 0, material: 0, world_from_local: Mat4::IDENTITY });
-    Ok(out)
+    Ok(mesh)
 }
 
 fn read_element<E: PropertyAccess>(

@@ -14,8 +14,9 @@ use glam::{Vec2, Vec3};
 use serde::Serialize;
 
 use super::geometry::SurfaceHit;
+use crate::base::Ray;
+use crate::scene::Scene;
 use crate::scene::shading::DirectTerms;
-use crate::scene::{Ray, Scene};
 
 /// What kind of ray a node of the tree is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

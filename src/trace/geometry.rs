@@ -45,7 +45,8 @@ use std::f32::consts::{FRAC_PI_2, PI, TAU};
 
 use glam::{Affine3A, Mat3, Mat3A, Vec2, Vec3, Vec3A};
 
-use crate::scene::{MaterialId, Object, Ray, Scene, Shape};
+use crate::base::{MaterialId, Ray};
+use crate::scene::{Object, Scene, Shape};
 
 /// Relative tolerance of sphere tracing: a hit is declared `SDF_EPSILON·(size + distance)`
 /// from the surface, in local units.

@@ -61,8 +61,9 @@
 use glam::{Vec2, Vec3, Vec4};
 
 use super::geometry::SurfaceHit;
+use crate::base::TextureId;
 use crate::output::srgb_decode;
-use crate::scene::{ColorSpace, Material, ProceduralHeight, Scene, Texture, TextureId};
+use crate::scene::{ColorSpace, Material, ProceduralHeight, Scene, Texture};
 use crate::settings::{BumpSettings, TextureFilter, TextureSettings, TracerLod};
 use crate::texture::tangents::normal_map_normal;
 use crate::texture::{
@@ -368,7 +369,7 @@ mod tests {
             uv: Vec2::ZERO,
             dpdu: 2.0 * Vec3::X,
             dpdv: -2.0 * Vec3::Y,
-            material: crate::scene::MaterialId(0),
+            material: crate::base::MaterialId(0),
             object: 0,
         };
         let cone = RayCone { width: 0.0, spread: 0.01 };

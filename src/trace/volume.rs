@@ -21,9 +21,10 @@
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use super::geometry::SurfaceHit;
+use crate::base::Ray;
+use crate::scene::Scene;
 use crate::scene::light::Incidence;
 use crate::scene::shading::{SurfaceSample, Terms, direct, emitted_and_ambient, facing_viewer};
-use crate::scene::{Ray, Scene};
 use crate::settings::{VolumeSettings, VolumeView};
 use crate::volume::march::{self, LocalRay};
 use crate::volume::{March, Rendering, Volume};

@@ -63,11 +63,12 @@ use super::explain::{Observer, RayKind, SurfaceState, Unobserved, VolumeState};
 use super::geometry::{Primitive, SurfaceHit};
 use super::texture::SceneTextures;
 use super::volume::{TracedVolumes, heat_colour, voxel_illumination, world_normal};
+use crate::base::Ray;
 use crate::scene::optics::{fresnel, refract, relative_index};
 use crate::scene::shading::{
     SurfaceSample, Terms, direct, direct_terms, emission_and_global_ambient, emitted_and_ambient, facing_viewer,
 };
-use crate::scene::{AlphaMode, Material, Ray, Scene};
+use crate::scene::{AlphaMode, Material, Scene};
 use crate::settings::{BumpSettings, BumpView, TextureSettings, VolumeView};
 use crate::texture::RayCone;
 

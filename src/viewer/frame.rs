@@ -1,7 +1,8 @@
-//! One frame of the viewer, top to bottom: scripted step → file watch → traced images in →
-//! UI (egui) → camera and settings changes → raster image at the view's size (drawn at the
-//! render scale, unless nothing it depends on changed) → traced request → compose and present
-//! the window (and a screenshot when asked) → when the next frame is due.
+//! One frame of the viewer, top to bottom: scripted step → file watch → traced images in → the
+//! volume ray under the cursor (CPU work kept out of the layout) → UI (egui) → camera and settings
+//! changes → raster image at the view's size (drawn at the render scale, unless nothing it
+//! depends on changed) → traced request → compose and present the window (and a screenshot when
+//! asked) → when the next frame is due.
 //!
 //! Frames are drawn only when something asks for one: input (egui says), a scripted step, a
 //! traced image arriving, the camera moving or settling, an egui animation. Otherwise the event
@@ -31,6 +32,7 @@ use super::script::Step;
 use super::traced::TracedView;
 use super::ui::{self, Action, UiModel, UiOutput};
 use super::view_mode::{ViewMode, ViewState};
+use super::volume_probe::{CursorProbe, ProbeAt};
 use crate::RenderSettings;
 use crate::scene::{Camera, Light};
 
@@ -72,6 +74,9 @@ pub struct Viewer {
     screenshot_waiting: Option<Instant>,
     /// Print the volume ray under the cursor after this frame's UI (the `probe` step).
     print_probe: bool,
+    /// The volume ray under the cursor, made before the UI, and the cursor the last UI saw.
+    probe: CursorProbe,
+    cursor: Option<Vec2>,
     /// The inspected pixel, and a pixel to inspect once the view has its size.
     inspection: Option<Inspection>,
     inspect_next: Option<Vec2>,
@@ -136,6 +141,8 @@ impl Viewer {
             screenshot: None,
             screenshot_waiting: None,
             print_probe: false,
+            probe: CursorProbe::default(),
+            cursor: None,
             inspection: None,
             inspect_next: None,
         }
@@ -215,38 +222,23 @@ impl Viewer {
         self.run_script(&mut input)?;
         self.poll_file();
         self.traced.poll(&screen.egui);
+        // The volume ray under the cursor, made here so that the layout only draws it.
+        let probe_at = self.probe_at();
+        self.probe.update(&mut self.scene, &self.settings, probe_at);
 
         // The UI decides the 3D view's size and gathers input.
         let ui_start = Instant::now();
-        let raw = screen.take_input();
-        let raster_id = (screen.composition == Composition::Textured).then(|| self.raster.texture_id());
-        let mut output = UiOutput::default();
-        let full = {
-            let mut model = UiModel {
-                settings: &self.settings,
-                scene: &mut self.scene,
-                view: &mut self.view,
-                navigation: &mut self.navigation,
-                raster: raster_id,
-                traced: &self.traced,
-                key: self.key,
-                stats: &self.stats,
-                passes: &self.raster.report.passes,
-                camera_error: &mut self.camera_error,
-                notices: &self.notices,
-                inspection: self.inspection.as_ref(),
-            };
-            screen.egui.run_ui(raw, |ui| output = ui::draw(ui, &mut model))
-        };
+        let (output, full) = self.lay_out(screen);
         times.ui = ui_start.elapsed();
         if std::mem::take(&mut self.print_probe) {
-            println!("{}", output.probe.as_ref().map_or("volume probe none".to_string(), |p| p.report()));
+            println!("{}", self.probe.probe().map_or("volume probe none".to_string(), |p| p.report()));
         }
         let repaint = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
         if output.inspection_closed {
             self.inspection = None;
         }
         self.inspect_next = output.inspect.or(self.inspect_next);
+        self.cursor = output.cursor;
         self.apply(&output, input, start);
         // Compared without the image size, which the frame sets below.
         let camera = &self.scene.scene.camera;
@@ -261,28 +253,91 @@ impl Viewer {
         });
         let moving = self.moving(Instant::now());
         let scale = self.scale(moving);
-        let mut drawn = Drawn::Kept;
-        if let Some((_, _, width, height)) = self.view_pixels {
-            // The camera's image size is the drawn one while the raster image is drawn, so the
-            // rasterizer's work shrinks with the scale; the view's size otherwise (picking, pans).
-            let scaled = |n: u32| ((n as f32 * scale).round() as u32).clamp(1, n);
-            let drawn_size = (scaled(width), scaled(height));
-            let filter =
-                if drawn_size == (width, height) { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
-            (self.scene.scene.camera.width, self.scene.scene.camera.height) = drawn_size;
-            let scene = (&self.scene.scene, self.scene.revision);
-            // Each pass is timed on its own only for the overlay, which lists them.
-            drawn = self.raster.render(screen, scene, &self.settings, (self.view.overlay_open, filter));
-            (self.scene.scene.camera.width, self.scene.scene.camera.height) = (width, height);
-            if let Drawn::New(time) = drawn {
-                times.raster = Some(time);
-            }
-            self.request_traced((width, height), scale == 1.0, screen);
-            if let Some(pixel) = self.inspect_next.take() {
-                self.inspect(screen, pixel, (width, height));
-            }
+        let drawn = self.draw_view(screen, scale, &mut times);
+        let presented = self.paint(screen, full, repaint, &mut times)?;
+        times.frame = start.elapsed();
+        times.scale = scale;
+        if moving && self.view.motion_fps > 0.0 && matches!(drawn, Drawn::New(_)) {
+            let target = Duration::from_secs_f32(1.0 / self.view.motion_fps);
+            self.budget.update(times.frame, target, self.view.motion_scale);
         }
+        self.stats.record(times);
+        if std::mem::take(&mut self.script.reset_stats) {
+            self.stats.reset();
+        }
+        let now = Instant::now();
+        let next = self.next_frame(screen, now, (moved, scale, repaint, presented));
+        let at_once = self.scripted || next.is_some_and(|t| t <= now);
+        self.last_frame = Some((start, at_once));
+        Ok(FrameEnd { next })
+    }
 
+    /// Lays the window out with egui: the UI reads the viewer's state and returns what it
+    /// gathered, with egui's output to paint.
+    fn lay_out(&mut self, screen: &mut Screen) -> (UiOutput, egui::FullOutput) {
+        let raw = screen.take_input();
+        let raster_id = (screen.composition == Composition::Textured).then(|| self.raster.texture_id());
+        let mut output = UiOutput::default();
+        let mut model = UiModel {
+            settings: &self.settings,
+            scene: &mut self.scene,
+            view: &mut self.view,
+            navigation: &mut self.navigation,
+            raster: raster_id,
+            traced: &self.traced,
+            key: self.key,
+            stats: &self.stats,
+            passes: &self.raster.report.passes,
+            camera_error: &mut self.camera_error,
+            notices: &self.notices,
+            inspection: self.inspection.as_ref(),
+            probe: self.probe.shown(),
+        };
+        let full = screen.egui.run_ui(raw, |ui| output = ui::draw(ui, &mut model));
+        (output, full)
+    }
+
+    /// Where the volume ray is probed: the script's cursor or the one the last layout saw, over
+    /// the view as the last frame sized it.
+    fn probe_at(&self) -> Option<ProbeAt> {
+        let (_, _, width, height) = self.view_pixels?;
+        let pixel = self.view.scripted_cursor.or(self.cursor)?;
+        Some(ProbeAt { pixel, size: (width, height) })
+    }
+
+    /// The raster image at the view's size (drawn at the render `scale`, unless nothing it depends
+    /// on changed), the traced request for it, and the pixel to inspect once the view has a size.
+    fn draw_view(&mut self, screen: &mut Screen, scale: f32, times: &mut FrameTimes) -> Drawn {
+        let Some((_, _, width, height)) = self.view_pixels else { return Drawn::Kept };
+        // The camera's image size is the drawn one while the raster image is drawn, so the
+        // rasterizer's work shrinks with the scale; the view's size otherwise (picking, pans).
+        let scaled = |n: u32| ((n as f32 * scale).round() as u32).clamp(1, n);
+        let drawn_size = (scaled(width), scaled(height));
+        let filter = if drawn_size == (width, height) { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
+        (self.scene.scene.camera.width, self.scene.scene.camera.height) = drawn_size;
+        let scene = (&self.scene.scene, self.scene.revision);
+        // Each pass is timed on its own only for the overlay, which lists them.
+        let drawn = self.raster.render(screen, scene, &self.settings, (self.view.overlay_open, filter));
+        (self.scene.scene.camera.width, self.scene.scene.camera.height) = (width, height);
+        if let Drawn::New(time) = drawn {
+            times.raster = Some(time);
+        }
+        self.request_traced((width, height), scale == 1.0, screen);
+        if let Some(pixel) = self.inspect_next.take() {
+            self.inspect(screen, pixel, (width, height));
+        }
+        drawn
+    }
+
+    /// Composes and presents the window, writing the screenshot that is due; a screenshot the
+    /// surface was not ready for is tried again next frame.
+    fn paint(
+        &mut self,
+        screen: &mut Screen,
+        full: egui::FullOutput,
+        repaint: Option<Duration>,
+        times: &mut FrameTimes,
+    ) -> anyhow::Result<Presented> {
         let paint_start = Instant::now();
         let screenshot = self.screenshot_due(repaint);
         let view = match (self.raster.image(), self.view_pixels) {
@@ -306,21 +361,19 @@ impl Viewer {
                 Presented::Skipped => self.screenshot = Some(path),
             }
         }
-        times.frame = start.elapsed();
-        times.scale = scale;
-        if moving && self.view.motion_fps > 0.0 && matches!(drawn, Drawn::New(_)) {
-            let target = Duration::from_secs_f32(1.0 / self.view.motion_fps);
-            self.budget.update(times.frame, target, self.view.motion_scale);
-        }
-        self.stats.record(times);
-        if std::mem::take(&mut self.script.reset_stats) {
-            self.stats.reset();
-        }
+        Ok(presented)
+    }
 
-        // The next frame: at once while the camera moves; at the end of the settling time after a
-        // frame drawn below full scale (full scale again); when egui animates; soon after a
-        // frame the surface was not ready for; else only when something happens.
-        let now = Instant::now();
+    /// When the next frame is due: at once while the camera moves or the volume probe is behind
+    /// the cursor; at the end of the settling time after a frame drawn below full scale (full
+    /// scale again); when egui animates; soon after a frame the surface was not ready for; else
+    /// only when something happens.
+    fn next_frame(
+        &self,
+        screen: &Screen,
+        now: Instant,
+        (moved, scale, repaint, presented): (bool, f32, Option<Duration>, Presented),
+    ) -> Option<Instant> {
         let settle = (scale < 1.0).then(|| self.moving_until.map_or(now, |t| t.max(now)));
         let animation = repaint.filter(|d| *d < Duration::from_secs(3600)).map(|d| now + d);
         let retry = (presented == Presented::Skipped).then(|| now + RETRY);
@@ -328,10 +381,9 @@ impl Viewer {
         // arrive a frame or two after they are asked for.
         let busy = self.traced.worker.busy() || self.raster.reading_back() || screen.screenshots_pending();
         let working = busy.then_some(now);
-        let next = [moved.then_some(now), settle, animation, retry, working].into_iter().flatten().min();
-        let at_once = self.scripted || next.is_some_and(|t| t <= now);
-        self.last_frame = Some((start, at_once));
-        Ok(FrameEnd { next })
+        let probe = !self.probe.is_current(&self.scene, &self.settings, self.probe_at());
+        let at_once = (moved || probe).then_some(now);
+        [at_once, settle, animation, retry, working].into_iter().flatten().min()
     }
 
     /// The screenshot to write this frame: the one asked for, unless egui is animating (a window

@@ -5,7 +5,8 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::scene::{Ray, Scene};
+use crate::base::Ray;
+use crate::scene::Scene;
 use crate::trace::accel::{self, AccelKind, Accelerator};
 use crate::trace::geometry::{Primitive, scene_primitives};
 

@@ -38,6 +38,8 @@ pub struct UiModel<'a> {
     pub notices: &'a [String],
     /// The inspected pixel, its explanation drawn over the view.
     pub inspection: Option<&'a super::inspect::Inspection>,
+    /// The volume ray under the cursor, made by the frame before the layout.
+    pub probe: Option<&'a volume_probe::Shown>,
 }
 
 /// Requests the UI makes of the frame.
@@ -68,8 +70,9 @@ pub struct UiOutput {
     pub camera_edited: bool,
     pub lights_edited: bool,
     pub material_edited: bool,
-    /// The volume ray under the cursor, as the view shows it.
-    pub probe: Option<volume_probe::Probe>,
+    /// The pixel of the 3D view under the mouse (or a script's cursor), where the next frame
+    /// probes the volume ray.
+    pub cursor: Option<Vec2>,
 }
 
 /// Draws the whole window.
@@ -315,7 +318,12 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     if let Some(inspection) = model.inspection {
         super::inspect::draw(&painter, inspection, &model.scene.scene.camera, (rect, ppp));
     }
-    output.probe = volume_probe::show(ui.ctx(), model.scene, model.settings, (rect, ppp), cursor);
+    output.cursor = cursor;
+    if cursor.is_some()
+        && let Some(shown) = model.probe
+    {
+        volume_probe::show(ui.ctx(), shown, model.settings, (rect, ppp));
+    }
     if model.view.overlay_open {
         overlay(ui, model, rect);
     }

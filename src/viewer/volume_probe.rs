@@ -12,14 +12,21 @@
 //! is the first the ray enters. Samples are shaded with the tracer's voxel illumination
 //! (`trace::volume::voxel_illumination`) without shadow rays: with `volume.shadows` on, the
 //! tracer's samples in shadow are darker than the swatches.
+//!
+//! Marching is CPU work, so it is not done while egui lays the window out: the frame makes the
+//! probe before the UI ([`CursorProbe::update`], at the cursor the last layout saw, or a
+//! script's) and keeps it while its inputs (pixel, view size, camera, settings, scene revision,
+//! lights) stay the same; the layout only draws it ([`show`]). A cursor that moved is probed in
+//! the next frame, which the frame asks for at once ([`CursorProbe::is_current`]).
 
 use egui::{Color32, Pos2, Rect, Stroke, pos2, vec2};
 use glam::{Vec2, Vec3};
 
 use super::scene_state::SceneState;
 use crate::RenderSettings;
+use crate::base::Ray;
 use crate::output::OutputTransform;
-use crate::scene::{Ray, Scene};
+use crate::scene::{Camera, Light, Scene};
 use crate::trace::volume::{voxel_illumination, world_normal};
 use crate::volume::march::{self, LocalRay, Sample};
 use crate::volume::{March, Rendering, Volume};
@@ -145,23 +152,92 @@ const ACCUMULATED_COLOUR: Color32 = Color32::from_rgb(60, 200, 255);
 const ISO_COLOUR: Color32 = Color32::from_rgb(255, 220, 60);
 const CROSSING_COLOUR: Color32 = Color32::from_rgb(255, 0, 255);
 
-/// Shows the probe of the ray under `pixel` (view pixels, the cursor's or a script's) over the 3D
-/// view `rect`: a ring at the pixel, and the plot in the lower corner across the view from it.
-/// Returns what it showed.
-pub fn show(
-    ctx: &egui::Context,
-    scene: &mut SceneState,
-    settings: &RenderSettings,
-    (rect, ppp): (Rect, f32),
-    pixel: Option<Vec2>,
-) -> Option<Probe> {
-    let size = ((rect.width() * ppp).round() as u32, (rect.height() * ppp).round() as u32);
-    let pixel = pixel.filter(|p| p.x >= 0.0 && p.y >= 0.0 && p.x < size.0 as f32 && p.y < size.1 as f32)?;
-    if scene.scene.volumes.is_empty() || !settings.volume.enabled {
+/// Where the probe is asked for: a pixel of the 3D view (the cursor's or a script's), and the
+/// view's size, both in pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProbeAt {
+    pub pixel: Vec2,
+    pub size: (u32, u32),
+}
+
+/// What the view shows of the volume ray: a ring at `pixel`, and the probe, or "no volume under
+/// the cursor" for `None`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shown {
+    pub pixel: Vec2,
+    pub probe: Option<Probe>,
+}
+
+/// Everything a probe is made from; the camera at the view's size.
+#[derive(Clone, Debug, PartialEq)]
+struct Inputs {
+    at: ProbeAt,
+    camera: Camera,
+    settings: RenderSettings,
+    revision: u64,
+    lights: Vec<Light>,
+}
+
+/// The probe the view shows, made before the UI is laid out and kept while its inputs stay the
+/// same.
+#[derive(Default)]
+pub struct CursorProbe {
+    /// What `shown` was made from; `None` when nothing is shown.
+    inputs: Option<Inputs>,
+    shown: Option<Shown>,
+}
+
+impl CursorProbe {
+    /// Makes the probe at `at` for the current scene and settings, unless it is the one kept.
+    pub fn update(&mut self, scene: &mut SceneState, settings: &RenderSettings, at: Option<ProbeAt>) {
+        let inputs = inputs(scene, settings, at);
+        if inputs == self.inputs {
+            return;
+        }
+        self.shown = inputs.as_ref().map(|inputs| Shown {
+            pixel: inputs.at.pixel,
+            probe: probe_at(scene, inputs.at.pixel, inputs.at.size, settings),
+        });
+        self.inputs = inputs;
+    }
+
+    /// Whether the kept probe is the one [`CursorProbe::update`] would make now.
+    pub fn is_current(&self, scene: &SceneState, settings: &RenderSettings, at: Option<ProbeAt>) -> bool {
+        inputs(scene, settings, at) == self.inputs
+    }
+
+    /// What the view shows: `None` when the cursor is off the view or there is no volume to probe.
+    pub fn shown(&self) -> Option<&Shown> {
+        self.shown.as_ref()
+    }
+
+    /// The probe itself: `None` also where the ray enters no volume.
+    pub fn probe(&self) -> Option<&Probe> {
+        self.shown.as_ref().and_then(|shown| shown.probe.as_ref())
+    }
+}
+
+/// The inputs of the probe at `at`; `None` where nothing is shown: no pixel inside the view, no
+/// volume, or volumes switched off.
+fn inputs(scene: &SceneState, settings: &RenderSettings, at: Option<ProbeAt>) -> Option<Inputs> {
+    let ProbeAt { pixel, size } = at?;
+    let inside = pixel.x >= 0.0 && pixel.y >= 0.0 && pixel.x < size.0 as f32 && pixel.y < size.1 as f32;
+    if !inside || scene.scene.volumes.is_empty() || !settings.volume.enabled {
         return None;
     }
-    let probe = probe_at(scene, pixel, size, settings);
-    let at = rect.min + vec2(pixel.x, pixel.y) / ppp;
+    Some(Inputs {
+        at: ProbeAt { pixel, size },
+        camera: Camera { width: size.0, height: size.1, ..scene.scene.camera.clone() },
+        settings: settings.clone(),
+        revision: scene.revision,
+        lights: scene.scene.lights.clone(),
+    })
+}
+
+/// Draws `shown` over the 3D view `rect`: a ring at its pixel, and the plot in the lower corner
+/// across the view from it. Nothing is computed here.
+pub fn show(ctx: &egui::Context, shown: &Shown, settings: &RenderSettings, (rect, ppp): (Rect, f32)) {
+    let at = rect.min + vec2(shown.pixel.x, shown.pixel.y) / ppp;
     ctx.layer_painter(egui::LayerId::new(egui::Order::Foreground, egui::Id::unique("mirador::volume_probe_ring")))
         .circle_stroke(at, 4.0, Stroke::new(2.0, CROSSING_COLOUR));
     // In the lower corner across the view from the cursor, so the plot never hides it.
@@ -173,7 +249,7 @@ pub fn show(
     egui::Area::new(egui::Id::unique("mirador::volume_probe")).fixed_pos(corner).pivot(align).interactable(false).show(
         ctx,
         |ui| {
-            egui::Frame::popup(ui.style()).fill(Color32::from_black_alpha(200)).show(ui, |ui| match &probe {
+            egui::Frame::popup(ui.style()).fill(Color32::from_black_alpha(200)).show(ui, |ui| match &shown.probe {
                 Some(probe) => probe_ui(ui, probe, OutputTransform::of(settings)),
                 None => {
                     ui.colored_label(Color32::WHITE, "Volume ray: no volume under the cursor");
@@ -181,7 +257,6 @@ pub fn show(
             });
         },
     );
-    probe
 }
 
 fn probe_ui(ui: &mut egui::Ui, probe: &Probe, output: OutputTransform) {

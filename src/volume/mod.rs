@@ -12,7 +12,10 @@
 //! - [`march`]: one ray through one volume: samples, compositing, early termination, the
 //!   isosurface search.
 //! - [`fields`]: procedural fields (Marschner–Lobb, signed distances, a CT-like phantom).
-//! - [`nrrd`]: NRRD and raw files.
+//!
+//! This is the math of the grids only, below the scene that holds them (docs/architecture.md,
+//! "Layers"): NRRD and raw files are read beside the other file formats, in `scene::nrrd`, and the
+//! ray and the material index come from [`crate::base`].
 //!
 //! The tracer marches these functions directly (`trace::volume`); the rasterizer runs their WGSL
 //! twin (`shaders/volume.wgsl`) over a 3D texture of the same normalized values.
@@ -20,7 +23,6 @@
 pub mod fields;
 pub mod grid;
 pub mod march;
-pub mod nrrd;
 pub mod transfer;
 
 use std::sync::Arc;
@@ -31,8 +33,7 @@ pub use grid::{Differences, Grid, Reconstruction};
 pub use march::{Composite, LocalRay, March, Sample};
 pub use transfer::{ControlPoint, Preset, Table, TransferFunction};
 
-use crate::scene::camera::Ray;
-use crate::scene::material::MaterialId;
+use crate::base::{MaterialId, Ray};
 use crate::settings::{VolumeGradient, VolumeMode, VolumeReconstruction, VolumeSettings};
 
 /// Cells a side up to which the rasterizer's wireframe (`volume.wireframe`) draws every grid

@@ -418,94 +418,27 @@ impl EnvironmentMaps {
     ) -> EnvironmentMaps {
         let world = world_uniform(scene);
         let params = UniformBuffer::new(device, "environment::params", &world);
-        let intensity = scene.environment.as_ref().map_or(1.0, |e| e.intensity);
-        let source = scene.environment.as_ref().map(|e| &e.source);
-        let (cube_face, map_size) = match source {
-            None => (4, 4),
-            Some(EnvironmentSource::Cube(faces)) => (faces[0].width, (2 * faces[0].width).min(MAX_MADE_SIZE / 2)),
-            Some(_) => (cube_size, (2 * cube_size).min(MAX_MADE_SIZE / 2)),
-        };
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("environment::encoder") });
-        let stand_in = |label| MapTexture::new(device, label, (1, 1), Layers::Single);
-        let stand_in_cube = MapTexture::new(device, "environment::no_cube", (1, 1), Layers::Cube);
         // Bound where no cube array is read, and always where a group is drawn into the dynamic
         // cubes (a texture may not be read and drawn into in one pass).
-        let stand_in_cubes = MapTexture::new(device, "environment::no_cubes", (1, 1), Layers::Cubes(1));
-        let sphere_source = match source {
-            Some(EnvironmentSource::Sphere(image)) => {
-                MapTexture::upload(device, queue, "environment::sphere_source", &[image], intensity)
-            }
-            _ => stand_in("environment::no_sphere_source"),
-        };
-        let latlong = match source {
-            Some(EnvironmentSource::LatLong(image)) => {
-                MapTexture::upload(device, queue, "environment::latlong", &[image], intensity)
-            }
-            _ => MapTexture::new(device, "environment::latlong", (2 * map_size, map_size), Layers::Single),
-        };
-        let cube = match source {
-            Some(EnvironmentSource::Cube(faces)) => {
-                let faces: Vec<&EnvImage> = faces.iter().collect();
-                MapTexture::upload(device, queue, "environment::cube", &faces, intensity)
-            }
-            _ => MapTexture::new(device, "environment::cube", (cube_face, cube_face), Layers::Cube),
-        };
-        // Sources first: their mip chains are what the conversions read.
-        mipmaps.record(device, &mut encoder, &sphere_source.texture);
-        let source_2d = match source {
-            Some(EnvironmentSource::Sphere(_)) => &sphere_source.view,
-            _ => &latlong.view,
-        };
-        match source {
-            Some(EnvironmentSource::LatLong(_)) => mipmaps.record(device, &mut encoder, &latlong.texture),
-            Some(EnvironmentSource::Cube(_)) => mipmaps.record(device, &mut encoder, &cube.texture),
-            _ => {}
-        }
-        if !matches!(source, Some(EnvironmentSource::Cube(_))) {
-            let group = pass.group(device, &params, (source_2d, &stand_in_cube.view, &stand_in_cubes.view));
-            for face in 0..6 {
-                Converter::draw(&mut encoder, &pass.to_cube, &group, &cube.layer(face), face);
-            }
-            mipmaps.record(device, &mut encoder, &cube.texture);
-        }
-        // Reads the source, or the world's cube made from it (what the sphere map is made from).
-        let reads_world = pass.group(device, &params, (&sphere_source.view, &cube.view, &stand_in_cubes.view));
-        if !matches!(source, Some(EnvironmentSource::LatLong(_))) {
-            Converter::draw(&mut encoder, &pass.to_latlong, &reads_world, &latlong.layer(0), 0);
-            mipmaps.record(device, &mut encoder, &latlong.texture);
-        }
-        let sphere = MapTexture::new(device, "environment::sphere", (map_size, map_size), Layers::Single);
+        let no_cubes = MapTexture::new(device, "environment::no_cubes", (1, 1), Layers::Cubes(1));
+        let maker = MapMaker { device, pass, mipmaps, params: &params, no_cubes: &no_cubes };
+        let maps = WorldMaps::upload(device, queue, scene, cube_size);
+        let reads_world = maker.world_forms(&mut encoder, &maps);
+        let sphere = MapTexture::new(device, "environment::sphere", (maps.map_size, maps.map_size), Layers::Single);
         let dynamic_cubes = dynamic_cubes as u32;
-        let dynamic_size = if dynamic_cubes == 0 { 1 } else { cube_size };
-        let dynamic =
-            MapTexture::new(device, "environment::dynamic", (dynamic_size, dynamic_size), Layers::Cubes(dynamic_cubes));
-        // Until it is drawn, each dynamic cube shows the world (a neighbour's cube seen in the
-        // first frame's captures is the world alone, not black).
-        if dynamic_cubes > 0 {
-            let group = pass.group(device, &params, (source_2d, &cube.view, &stand_in_cubes.view));
-            for layer in 0..6 * dynamic_cubes {
-                // The world's radiance at the dynamic cube's texels.
-                Converter::draw(&mut encoder, &pass.to_cube, &group, &dynamic.layer(layer), layer % 6);
-            }
-            mipmaps.record_layers(device, &mut encoder, &dynamic.texture, 0..6 * dynamic_cubes);
-        }
+        let dynamic = maker.dynamic_cubes(&mut encoder, &maps, dynamic_cubes, cube_size);
         queue.submit([encoder.finish()]);
-        let reads = |source_2d, source_cubes| pass.group(device, &params, (source_2d, &cube.view, source_cubes));
-        let views = ViewGroups {
-            cross_world: reads(&latlong.view, &stand_in_cubes.view),
-            cross_dynamic: (dynamic_cubes > 0).then(|| reads(&latlong.view, &dynamic.view)),
-            sphere: reads(&sphere.view, &stand_in_cubes.view),
-            latlong: reads(&latlong.view, &stand_in_cubes.view),
-        };
+        let views = maker.view_groups(&maps, &sphere, &dynamic, dynamic_cubes);
         EnvironmentMaps {
             reads_world,
             views,
             params,
             world,
-            cube,
+            cube: maps.cube,
             sphere,
-            latlong,
+            latlong: maps.latlong,
             dynamic,
             dynamic_cubes,
             cube_size,
@@ -632,6 +565,138 @@ impl EnvironmentMaps {
         };
         let viewport = settings.inset.then(|| view_rect(size, aspect, true));
         Converter::draw_into(encoder, pipeline, group, target, 0, viewport);
+    }
+}
+
+/// The world's environment as the scene gives it: its source uploaded (a sphere map, a lat–long
+/// map or a cube's six faces, times the environment's intensity) and blank images for the forms
+/// made from it. No environment gives a small blank cube and lat–long map.
+struct WorldMaps<'s> {
+    source: Option<&'s EnvironmentSource>,
+    /// The sphere map the scene gives (1×1, unused, for other sources).
+    sphere_source: MapTexture,
+    latlong: MapTexture,
+    cube: MapTexture,
+    /// The side of the sphere map and the height of the lat–long map made from the source.
+    map_size: u32,
+}
+
+impl<'s> WorldMaps<'s> {
+    fn upload(device: &wgpu::Device, queue: &wgpu::Queue, scene: &'s Scene, cube_size: u32) -> WorldMaps<'s> {
+        let intensity = scene.environment.as_ref().map_or(1.0, |e| e.intensity);
+        let source = scene.environment.as_ref().map(|e| &e.source);
+        let (cube_face, map_size) = match source {
+            None => (4, 4),
+            Some(EnvironmentSource::Cube(faces)) => (faces[0].width, (2 * faces[0].width).min(MAX_MADE_SIZE / 2)),
+            Some(_) => (cube_size, (2 * cube_size).min(MAX_MADE_SIZE / 2)),
+        };
+        let sphere_source = match source {
+            Some(EnvironmentSource::Sphere(image)) => {
+                MapTexture::upload(device, queue, "environment::sphere_source", &[image], intensity)
+            }
+            _ => MapTexture::new(device, "environment::no_sphere_source", (1, 1), Layers::Single),
+        };
+        let latlong = match source {
+            Some(EnvironmentSource::LatLong(image)) => {
+                MapTexture::upload(device, queue, "environment::latlong", &[image], intensity)
+            }
+            _ => MapTexture::new(device, "environment::latlong", (2 * map_size, map_size), Layers::Single),
+        };
+        let cube = match source {
+            Some(EnvironmentSource::Cube(faces)) => {
+                let faces: Vec<&EnvImage> = faces.iter().collect();
+                MapTexture::upload(device, queue, "environment::cube", &faces, intensity)
+            }
+            _ => MapTexture::new(device, "environment::cube", (cube_face, cube_face), Layers::Cube),
+        };
+        WorldMaps { source, sphere_source, latlong, cube, map_size }
+    }
+
+    /// The 2D map the world's radiance is read from by direction: the sphere map given, else the
+    /// lat–long map.
+    fn source_2d(&self) -> &wgpu::TextureView {
+        match self.source {
+            Some(EnvironmentSource::Sphere(_)) => &self.sphere_source.view,
+            _ => &self.latlong.view,
+        }
+    }
+}
+
+/// What the steps of [`EnvironmentMaps::new`] draw with: the conversions, the mip generator, the
+/// uniform every group reads and the stand-in cube array.
+struct MapMaker<'a> {
+    device: &'a wgpu::Device,
+    pass: &'a Converter,
+    mipmaps: &'a MipmapGenerator,
+    params: &'a UniformBuffer<GpuEnvironment>,
+    no_cubes: &'a MapTexture,
+}
+
+impl MapMaker<'_> {
+    fn group(&self, sources: (&wgpu::TextureView, &wgpu::TextureView, &wgpu::TextureView)) -> wgpu::BindGroup {
+        self.pass.group(self.device, self.params, sources)
+    }
+
+    /// Records the sources' mip chains, then the world's cube and lat–long map made from the
+    /// source where the scene gave neither; returns the group that reads the source, or the
+    /// world's cube made from it (what the sphere map is made from).
+    fn world_forms(&self, encoder: &mut wgpu::CommandEncoder, maps: &WorldMaps) -> wgpu::BindGroup {
+        let (device, mipmaps) = (self.device, self.mipmaps);
+        // Sources first: their mip chains are what the conversions read.
+        mipmaps.record(device, encoder, &maps.sphere_source.texture);
+        match maps.source {
+            Some(EnvironmentSource::LatLong(_)) => mipmaps.record(device, encoder, &maps.latlong.texture),
+            Some(EnvironmentSource::Cube(_)) => mipmaps.record(device, encoder, &maps.cube.texture),
+            _ => {}
+        }
+        if !matches!(maps.source, Some(EnvironmentSource::Cube(_))) {
+            let no_cube = MapTexture::new(device, "environment::no_cube", (1, 1), Layers::Cube);
+            let group = self.group((maps.source_2d(), &no_cube.view, &self.no_cubes.view));
+            for face in 0..6 {
+                Converter::draw(encoder, &self.pass.to_cube, &group, &maps.cube.layer(face), face);
+            }
+            mipmaps.record(device, encoder, &maps.cube.texture);
+        }
+        let reads_world = self.group((&maps.sphere_source.view, &maps.cube.view, &self.no_cubes.view));
+        if !matches!(maps.source, Some(EnvironmentSource::LatLong(_))) {
+            Converter::draw(encoder, &self.pass.to_latlong, &reads_world, &maps.latlong.layer(0), 0);
+            mipmaps.record(device, encoder, &maps.latlong.texture);
+        }
+        reads_world
+    }
+
+    /// The cube array of `count` dynamic cubes of `size` texels a side (1×1 for none). Until it is
+    /// drawn, each dynamic cube shows the world (a neighbour's cube seen in the first frame's
+    /// captures is the world alone, not black).
+    fn dynamic_cubes(&self, encoder: &mut wgpu::CommandEncoder, maps: &WorldMaps, count: u32, size: u32) -> MapTexture {
+        let size = if count == 0 { 1 } else { size };
+        let dynamic = MapTexture::new(self.device, "environment::dynamic", (size, size), Layers::Cubes(count));
+        if count > 0 {
+            let group = self.group((maps.source_2d(), &maps.cube.view, &self.no_cubes.view));
+            for layer in 0..6 * count {
+                // The world's radiance at the dynamic cube's texels.
+                Converter::draw(encoder, &self.pass.to_cube, &group, &dynamic.layer(layer), layer % 6);
+            }
+            self.mipmaps.record_layers(self.device, encoder, &dynamic.texture, 0..6 * count);
+        }
+        dynamic
+    }
+
+    /// The teaching views' groups over the finished maps.
+    fn view_groups(
+        &self,
+        maps: &WorldMaps,
+        sphere: &MapTexture,
+        dynamic: &MapTexture,
+        dynamic_cubes: u32,
+    ) -> ViewGroups {
+        let reads = |source_2d, source_cubes| self.group((source_2d, &maps.cube.view, source_cubes));
+        ViewGroups {
+            cross_world: reads(&maps.latlong.view, &self.no_cubes.view),
+            cross_dynamic: (dynamic_cubes > 0).then(|| reads(&maps.latlong.view, &dynamic.view)),
+            sphere: reads(&sphere.view, &self.no_cubes.view),
+            latlong: reads(&maps.latlong.view, &self.no_cubes.view),
+        }
     }
 }
 

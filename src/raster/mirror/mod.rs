@@ -750,7 +750,7 @@ mod tests {
     fn with_mesh(mesh: Mesh, world_from_local: Mat4) -> Scene {
         let mut scene = scene("");
         let material =
-            crate::scene::MaterialId(scene.materials.iter().position(|m| m.name == "silver").expect("silver"));
+            crate::base::MaterialId(scene.materials.iter().position(|m| m.name == "silver").expect("silver"));
         scene.meshes.push(mesh);
         let shape = Shape::Mesh(scene.meshes.len() - 1);
         scene.objects.push(Object { name: "model".into(), shape, material, world_from_local });

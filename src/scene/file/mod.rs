@@ -21,8 +21,9 @@ use super::camera::{Camera, Projection};
 use super::environment::{self, Environment, EnvironmentSource, Sky};
 use super::gltf::{GltfCamera, GltfProjection};
 use super::light::{Attenuation, Light, LightKind};
-use super::material::{AlphaMode, ColorSpace, Material, MaterialId, ProceduralHeight, TextureId, Wrap};
+use super::material::{AlphaMode, ColorSpace, Material, ProceduralHeight, Wrap};
 use super::{ModelImport, Object, Scene, SceneError, Shape, texture};
+use crate::base::{MaterialId, TextureId};
 use crate::settings::{Parallax, Refraction, RenderSettings};
 
 /// Reads a scene file: TOML, or a bare model (glTF, OBJ or PLY, told by the file's extension).

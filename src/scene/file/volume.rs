@@ -10,8 +10,8 @@ use toml::Spanned;
 
 use super::{Builder, Finite, Scale, V3, transform};
 use crate::scene::SceneError;
+use crate::scene::nrrd::{Endian, RawDesc, ScalarType, read_nrrd, read_raw};
 use crate::volume::grid::{MAX_VOXELS, voxel_count};
-use crate::volume::nrrd::{Endian, RawDesc, ScalarType, read_nrrd, read_raw};
 use crate::volume::{ControlPoint, Grid, Preset, Rendering, TransferFunction, Volume, fields};
 
 #[derive(Deserialize)]

@@ -45,7 +45,7 @@ use web_time::Instant;
 use glam::{BVec3A, Vec3A, Vec4};
 
 use super::{AccelStats, Accelerator, Hit, offer};
-use crate::scene::Ray;
+use crate::base::Ray;
 use crate::trace::geometry::{Aabb, PreparedRay, Primitive, intersect_triangle};
 
 /// Bins per node along the split axis.

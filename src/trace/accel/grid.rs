@@ -28,7 +28,7 @@ use web_time::Instant;
 use glam::{UVec3, Vec3};
 
 use super::{AccelStats, Accelerator, Hit, Mailbox, offer};
-use crate::scene::Ray;
+use crate::base::Ray;
 use crate::trace::geometry::{Aabb, PreparedRay, Primitive};
 
 /// Target cells per primitive (λ).

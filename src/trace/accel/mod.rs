@@ -23,7 +23,7 @@ use std::time::Duration;
 
 use web_time::Instant;
 
-use crate::scene::Ray;
+use crate::base::Ray;
 use crate::trace::geometry::{PreparedRay, Primitive};
 
 /// The nearest hit: its distance along the ray and the index of the primitive in the slice the

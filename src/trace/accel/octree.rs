@@ -24,7 +24,7 @@ use web_time::Instant;
 use glam::Vec3;
 
 use super::{AccelStats, Accelerator, Hit, Mailbox, offer};
-use crate::scene::Ray;
+use crate::base::Ray;
 use crate::trace::geometry::{Aabb, PreparedRay, Primitive};
 
 /// Nodes with more primitives than this are divided.

@@ -65,8 +65,8 @@ use std::str::FromStr;
 
 use glam::{UVec3, Vec3};
 
-use super::grid::{Grid, MAX_DIM, MAX_VOXELS, voxel_count};
 use crate::files::Opened;
+use crate::volume::grid::{Grid, MAX_DIM, MAX_VOXELS, voxel_count};
 
 /// The type of the samples in a file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
