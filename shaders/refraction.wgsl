@@ -1,6 +1,6 @@
 // Refraction (docs/course/06-transparency.md#refraction; src/raster/refraction.rs): glass whose
-// ior ≠ 1, drawn after the opaque surfaces and before the other transparent ones, composed into
-// the scene module after transparency.wgsl.
+// ior ≠ 1, drawn after the opaque surfaces and before the other transparent ones, with the
+// surface code of shaders/common/surface.wgsl.
 //
 // A z-buffer sees one surface per pixel, so the ray's path through the glass is found in screen
 // space. For a fragment of the glass's front face at p1:
@@ -27,11 +27,13 @@ const REFRACTION_SCREEN: u32 = 2u;
 const MARCH_STEPS: u32 = 96u;
 const BISECTION_STEPS: u32 = 6u;
 
-// Group 3: opaque_depth (binding 0, transparency.wgsl) is a copy of the view's depth before the
-// glass is drawn; the glass's nearest back faces; a copy of the opaque image.
-@group(3) @binding(8) var back_depth: texture_2d<f32>;
-@group(3) @binding(9) var back_normal: texture_2d<f32>;
-@group(3) @binding(10) var opaque_image: texture_2d<f32>;
+// Group 3: a copy of the view's depth before the glass is drawn; the glass's nearest back faces;
+// a copy of the opaque image. Depth images read with textureLoad are declared as float
+// textures, depth in x (src/gpu/layout.rs, depth_texels).
+@group(3) @binding(0) var opaque_depth: texture_2d<f32>;
+@group(3) @binding(1) var back_depth: texture_2d<f32>;
+@group(3) @binding(2) var back_normal: texture_2d<f32>;
+@group(3) @binding(3) var opaque_image: texture_2d<f32>;
 
 // The back-face pass: the glass's outward normal where its nearest back face is.
 @fragment
@@ -224,3 +226,13 @@ fn refraction_fragment(in: VertexOut) -> vec4f {
     }
     return vec4f(shaded.radiance + reflected + through, 1.0);
 }
+
+// The inspecting twins (shaders/common/inspect.wgsl).
+@fragment
+fn fs_refraction_inspect(in: VertexOut) -> @location(0) vec4f {
+    probe.object = in.object;
+    let out = refraction_fragment(in);
+    inspect_record(INSPECT_REFRACTION, in.clip, out.rgb);
+    return out;
+}
+

@@ -1,404 +1,13 @@
-// The scene pass: every surface of the scene drawn from one view, shaded per fragment by the
-// illumination model (shaders/common/lighting.wgsl) for all lights, each weighted by its
-// visibility from the shadow pass, into the linear HDR target. One module serves every variant
-// (depth prepass, opaque, mirrors; the transparent, refracting and volume passes compose their
-// entry points into the same module); src/raster/scene_pass.rs says which.
-//
-// Toggles that switch code on or off are pipeline constants, not uniforms: a software GPU such
-// as lavapipe runs both sides of a branch on a uniform value, so a shader that merely skips
-// switched-off work would still pay for all of it. Each variant is compiled with its code only.
+// The scene pass (src/raster/scene_pass.rs): every opaque surface of the scene drawn from one
+// view with the surface code of shaders/common/surface.wgsl: the depth prepass (fs_mask for
+// cut-out materials), the shaded surfaces (fs_scene), planar mirrors with their reflection
+// (fs_mirror), and the world where nothing was drawn (fs_background); each with its inspecting
+// twin (`*_inspect`, shaders/common/inspect.wgsl).
 
-// The frame's toggles (src/raster/scene_pass.rs, FrameKey).
-override SHADOW_METHOD: u32 = 0u;
-override SHADOW_FILTER: u32 = 0u;
-override SHADOW_TRANSMISSION: bool = false;
-override SHADOW_TEXELS_VIEW: bool = false;
-override LEVEL_COLOUR: bool = false;
-override BUMP: bool = false;
-override BUMP_VIEW: u32 = 0u;
-override TANGENTS_PER_VERTEX: bool = false;
-override BUMP_ANALYTIC: bool = false;
-override FLAT_COLOUR: bool = false;
-// The material's inputs (MaterialKey).
-override COLOR_TEXTURE: bool = false;
-override HEIGHT_KIND: u32 = 0u;
-override NORMAL_MAP: bool = false;
-// ALPHA_* of shaders/common/types.wgsl: whether coverage cuts the surface out or blends it.
-override ALPHA_MODE: u32 = 0u;
-// ENV_MAP_*: the map curved mirrors look kps·MPS·L(r) up in; 0: none.
-override ENVIRONMENT: u32 = 0u;
-
-const SHADOWS_OFF: u32 = 0u;
-const SHADOWS_MAP: u32 = 1u;
-const SHADOWS_PROJECTED: u32 = 2u;
-
-const BUMP_VIEW_NORMALS: u32 = 1u;
-const BUMP_VIEW_TANGENTS: u32 = 2u;
-
-const HEIGHT_NONE: u32 = 0u;
-const HEIGHT_TEXTURE: u32 = 1u;
-const HEIGHT_SINE: u32 = 2u;
-const HEIGHT_NOISE: u32 = 3u;
-
-const ENV_MAP_CUBE: u32 = 1u;
-const ENV_MAP_SPHERE: u32 = 2u;
-const ENV_MAP_LATLONG: u32 = 3u;
-const ENV_MAP_DYNAMIC: u32 = 4u;
-
-@group(0) @binding(0) var<uniform> view: View;
-@group(0) @binding(1) var<uniform> frame: Frame;
-// Bilinear, for height and normal maps (read on level 0).
-@group(0) @binding(2) var height_sampler: sampler;
-@group(1) @binding(0) var<uniform> material: Material;
-// sRGB, with its whole mip chain: the sampler decodes to linear before it filters.
-@group(1) @binding(1) var color_texture: texture_2d<f32>;
-// Linear grey levels f_h(u, v); the red channel is the height.
-@group(1) @binding(2) var height_texture: texture_2d<f32>;
-// Tangent-space normals (glTF's normalTexture), linear.
-@group(1) @binding(3) var normal_texture: texture_2d<f32>;
-// The chosen texture filter (docs/course/03-mipmaps.md) with the material's wrap modes.
-@group(1) @binding(4) var color_sampler: sampler;
-// Group 2, what this view's shading reads: shaders/view_group.wgsl.
 // Group 3 (mirror variants only): the reflection, drawn by the camera mirrored about this mirror's
 // plane at the same size as this view, so the mirror's own pixel is where its reflection is
 // (the projective lookup of docs/course/07-planar-mirrors.md reduces to the fragment's pixel).
-@group(3) @binding(2) var mirror_image: texture_2d<f32>;
-
-struct VertexIn {
-    @location(0) position: vec3f,
-    @location(1) normal: vec3f,
-    @location(2) uv: vec2f,
-    @location(3) tangent: vec4f,
-}
-
-struct VertexOut {
-    // Invariant: the shading pass after a depth prepass tests Equal against the prepass's depth,
-    // so both must compute exactly the same position.
-    @builtin(position) @invariant clip: vec4f,
-    @location(0) world: vec3f,
-    @location(1) normal: vec3f,
-    @location(2) uv: vec2f,
-    // World-space tangent, and the bitangent's sign in w.
-    @location(3) tangent: vec4f,
-    // The object's dynamic environment cube, −1 for the world's.
-    @location(4) @interpolate(flat) env_layer: i32,
-    @location(5) @interpolate(flat) object: u32,
-}
-
-@vertex
-fn vs_scene(in: VertexIn, instance: Instance) -> VertexOut {
-    let world_from_local = instance_world_from_local(instance);
-    let world = world_from_local * vec4f(in.position, 1.0);
-    var out: VertexOut;
-    out.clip = view.clip_from_world * world;
-    out.world = world.xyz;
-    out.normal = instance_normal_from_local(instance) * in.normal;
-    out.uv = in.uv;
-    out.tangent = vec4f((world_from_local * vec4f(in.tangent.xyz, 0.0)).xyz, in.tangent.w);
-    out.env_layer = instance.env_layer;
-    out.object = instance.object;
-    return out;
-}
-
-// The unit vector from p towards the viewer, for either projection.
-fn view_vector(p: vec3f) -> vec3f {
-    if view.orthographic != 0u {
-        return view.view_axis;
-    }
-    return normalize(view.eye - p);
-}
-
-// V_i for one light at p: 1 lit, 0 in shadow, a colour behind transparent occluders.
-// `facing` is the normal on the side the light is on, for the normal offset.
-fn visibility(light: Light, p: vec3f, facing: vec3f, pixel: vec2f) -> vec3f {
-    if SHADOW_METHOD == SHADOWS_OFF || light.shadow_layer < 0 {
-        return vec3f(1.0);
-    }
-    if SHADOW_METHOD == SHADOWS_PROJECTED {
-        let mask = textureLoad(projected_mask, vec2i(pixel), 0);
-        if INSPECT {
-            probe.lights[probe_light].lit = 1.0 - mask[light.shadow_slot];
-        }
-        return vec3f(1.0 - mask[light.shadow_slot]);
-    }
-    var layer = u32(light.shadow_layer);
-    if light.kind == LIGHT_POINT {
-        layer += cube_face(p - light.position);
-    }
-    let coordinates = shadow_lookup_point(shadows.layers[layer], light.position, p, facing, shadows.normal_offset);
-    if coordinates.w == 0.0 {
-        return vec3f(1.0);
-    }
-    var v = vec3f(shadow_filtered(
-        shadow_maps, shadow_sampler, coordinates.xy, coordinates.z, layer, SHADOW_FILTER,
-        shadows.map_size,
-    ));
-    if INSPECT {
-        let texel = min(vec2u(coordinates.xy * f32(shadows.map_size)), vec2u(shadows.map_size - 1u));
-        probe.lights[probe_light].layer = i32(layer);
-        probe.lights[probe_light].texel = vec2f(texel);
-        probe.lights[probe_light].receiver_depth = coordinates.z;
-        probe.lights[probe_light].lit = v.x;
-    }
-    // A transparent receiver is not tinted by transparent occluders: the transmission map holds
-    // one product over every transparent surface in front of the nearest opaque one, the
-    // receiver's own share included, and its nearest depth, with no bias to tell a surface from
-    // itself. (Tried: dividing out the receiver's own share darkened sloped walls by self-tinting
-    // worse than leaving the tint out.)
-    if SHADOW_TRANSMISSION && material.transparent == 0u {
-        let size = vec2f(textureDimensions(transmission_maps));
-        let tint = textureLoad(transmission_maps, vec2i(coordinates.xy * size), layer, 0);
-        if coordinates.z > tint.a {
-            v *= tint.rgb;
-        }
-    }
-    return v;
-}
-
-// f_h(u, v): the height map's red channel (bilinear on level 0), or a procedural field.
-fn height_at(uv: vec2f) -> f32 {
-    switch HEIGHT_KIND {
-        case HEIGHT_SINE: {
-            return sine_height(uv, material.height_frequency, material.height_amplitude);
-        }
-        case HEIGHT_NOISE: {
-            return value_noise(uv, material.noise_seed, material.noise_cells, material.noise_octaves, material.height_amplitude).x;
-        }
-        default: {
-            return textureSampleLevel(height_texture, height_sampler, uv, 0.0).r;
-        }
-    }
-}
-
-// The finite-difference step Δ: bump_delta_texels texels of the height map, or of a procedural
-// field's own step (a 64th of a sine's shortest period, a 16th of the finest noise cell), as
-// src/texture/height.rs's default_delta.
-fn height_delta() -> vec2f {
-    switch HEIGHT_KIND {
-        case HEIGHT_SINE: {
-            return frame.bump_delta_texels / (64.0 * max(abs(material.height_frequency), vec2f(1.0)));
-        }
-        case HEIGHT_NOISE: {
-            let finest = max(material.noise_cells, 1u) << min(max(material.noise_octaves, 1u) - 1u, 20u);
-            return vec2f(frame.bump_delta_texels / (16.0 * f32(finest)));
-        }
-        default: {
-            return frame.bump_delta_texels / vec2f(textureDimensions(height_texture));
-        }
-    }
-}
-
-// The slopes (du, dv) = k·∇f_h: central differences (docs/course/04-bump-mapping.md), or for procedural fields
-// their closed-form gradient when asked.
-fn height_slopes(uv: vec2f, k: f32) -> vec2f {
-    if BUMP_ANALYTIC && HEIGHT_KIND == HEIGHT_SINE {
-        return k * sine_height_gradient(uv, material.height_frequency, material.height_amplitude);
-    }
-    if BUMP_ANALYTIC && HEIGHT_KIND == HEIGHT_NOISE {
-        return k * value_noise(uv, material.noise_seed, material.noise_cells, material.noise_octaves, material.height_amplitude).yz;
-    }
-    let delta = height_delta();
-    return bump_central_differences(
-        height_at(uv + vec2f(delta.x, 0.0)), height_at(uv - vec2f(delta.x, 0.0)),
-        height_at(uv + vec2f(0.0, delta.y)), height_at(uv - vec2f(0.0, delta.y)),
-        delta, k,
-    );
-}
-
-// The surface colour C(p): the material's colour times its texture, or the level-colour view.
-fn surface_color(uv: vec2f, duv_dx: vec2f, duv_dy: vec2f) -> vec3f {
-    if !COLOR_TEXTURE {
-        return material.color;
-    }
-    if LEVEL_COLOUR {
-        let size = vec2f(textureDimensions(color_texture));
-        let lod = mip_lod(duv_dx, duv_dy, size, frame.lod_bias);
-        return mip_level_colour(clamp(lod, 0.0, f32(textureNumLevels(color_texture) - 1u)));
-    }
-    return material.color * textureSampleBias(color_texture, color_sampler, uv, frame.lod_bias).rgb;
-}
-
-// The shading normal: the interpolated normal, perturbed by the height field (docs/course/04-bump-mapping.md:
-// t'u = tu + du·n, t'v = tv + dv·n, n' = normalize(t'u × t'v)) and by a normal map.
-fn shading_normal(in: VertexOut, tangents: SurfaceTangents) -> vec3f {
-    var n = normalize(in.normal);
-    if !BUMP || !tangents.valid {
-        return n;
-    }
-    if HEIGHT_KIND != HEIGHT_NONE {
-        let g = height_slopes(in.uv, material.bump_scale * frame.bump_scale);
-        n = perturbed_normal(n, tangents.tu, tangents.tv, g.x, g.y);
-        if INSPECT {
-            probe.bump = g;
-            probe.bump_k = material.bump_scale * frame.bump_scale;
-            probe.bump_delta = height_delta();
-        }
-    }
-    if NORMAL_MAP {
-        // glTF's frame: t along ∂p/∂u (in n's plane), the bitangent's sign from ∂p/∂v.
-        let t = tangents.tu - dot(tangents.tu, n) * n;
-        let handedness = select(1.0, -1.0, dot(cross(n, t), tangents.tv) < 0.0);
-        let rgb = textureSampleLevel(normal_texture, height_sampler, in.uv, 0.0).rgb;
-        n = normal_map_normal(n, vec4f(t, handedness), rgb, material.normal_scale);
-    }
-    return n;
-}
-
-// The tangents ∂p/∂u, ∂p/∂v of the surface: from the change of position and uv across pixels
-// (screen-space derivatives: call in uniform control flow), or the interpolated per-vertex
-// tangent t and bitangent sign·(n × t), both unit length.
-fn surface_tangents(in: VertexOut) -> SurfaceTangents {
-    if TANGENTS_PER_VERTEX {
-        let t = normalize(in.tangent.xyz);
-        return SurfaceTangents(t, sign(in.tangent.w) * cross(normalize(in.normal), t), length(in.tangent.xyz) > 0.0);
-    }
-    return tangents_from_derivatives(dpdx(in.world), dpdy(in.world), dpdx(in.uv), dpdy(in.uv));
-}
-
-// What shading a fragment found: the radiance leaving it towards the viewer, and for the
-// passes that add transmission (transparency.wgsl, refraction.wgsl) the shading normal n (turned
-// to the viewer), the view vector v and L(r), the environment looked up along the reflected
-// direction (zero where the frame has no environment map or the object looks none up).
-struct Shaded {
-    radiance: vec3f,
-    n: vec3f,
-    v: vec3f,
-    environment: vec3f,
-}
-
-// The radiance leaving the surface towards the viewer: ME + AG + Σ_i V_i·S_i·L_dir, plus the
-// mirror term kps·MPS·L(r) of a curved mirror.
-fn shade(in: VertexOut) -> vec3f {
-    return shade_surface(in).radiance;
-}
-
-fn shade_surface(in: VertexOut) -> Shaded {
-    // Screen-space derivatives first, in uniform control flow: the texture's level of detail and
-    // the tangents ∂p/∂u, ∂p/∂v of the surface, from the change of position and uv across pixels.
-    let duv_dx = dpdx(in.uv);
-    let duv_dy = dpdy(in.uv);
-    let tangents = surface_tangents(in);
-    let color = surface_color(in.uv, duv_dx, duv_dy);
-    if INSPECT {
-        probe.world = in.world;
-        probe.uv = in.uv;
-        probe.colour = color;
-        probe.geometric = normalize(in.normal);
-        probe.lod = -1.0;
-        if COLOR_TEXTURE {
-            let size = vec2f(textureDimensions(color_texture));
-            probe.lod = mip_lod(duv_dx, duv_dy, size, frame.lod_bias);
-            probe.footprint = vec2f(length(duv_dx * size), length(duv_dy * size));
-        }
-    }
-    if FLAT_COLOUR {
-        return Shaded(color, normalize(in.normal), view_vector(in.world), vec3f(0.0));
-    }
-    let v = view_vector(in.world);
-    let n = facing_viewer(shading_normal(in, tangents), v);
-    if BUMP_VIEW == BUMP_VIEW_NORMALS {
-        return Shaded(0.5 + 0.5 * n, n, v, vec3f(0.0));
-    }
-    if BUMP_VIEW == BUMP_VIEW_TANGENTS {
-        return Shaded(0.5 + 0.5 * normalize(tangents.tu), n, v, vec3f(0.0));
-    }
-    let surface = Surface(
-        color, material.ka, material.kd, material.ks,
-        material.specular_color, material.shininess, material.emission,
-    );
-    var radiance = emitted_and_ambient(surface, frame.ambient, frame.terms);
-    if INSPECT {
-        probe.normal = n;
-        probe.emission = select(vec3f(0.0), surface.emission, (frame.terms & TERM_EMISSION) != 0u);
-        probe.global_ambient = select(vec3f(0.0), frame.ambient * surface.kd * surface.color, (frame.terms & TERM_AMBIENT) != 0u);
-    }
-    var checker = -1.0;
-    for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {
-        let light = frame.lights[i];
-        let incidence = light_incidence(light, in.world);
-        if incidence.valid {
-            let facing = select(-n, n, dot(n, incidence.l) >= 0.0);
-            if INSPECT {
-                probe_light = i;
-                probe.lights[i].layer = -1;
-                probe.lights[i].lit = 1.0;
-            }
-            let visible = visibility(light, in.world, facing, in.clip.xy);
-            if INSPECT {
-                let parts = direct_terms(surface, n, v, incidence, frame.terms);
-                probe.lights[i].ambient = parts[0];
-                probe.lights[i].diffuse = parts[1];
-                probe.lights[i].specular = parts[2];
-                probe.lights[i].visibility = visible;
-            }
-            radiance += visible * direct(surface, n, v, incidence, frame.terms);
-            if SHADOW_TEXELS_VIEW && SHADOW_METHOD == SHADOWS_MAP && light.shadow_layer >= 0 && checker < 0.0 {
-                var layer = u32(light.shadow_layer);
-                if light.kind == LIGHT_POINT {
-                    layer += cube_face(in.world - light.position);
-                }
-                checker = shadow_texel_checker(shadow_coordinates(shadows.layers[layer].clip_from_world, in.world).xy, shadows.map_size);
-            }
-        }
-    }
-    if checker >= 0.0 {
-        radiance *= mix(0.55, 1.0, checker);
-    }
-    var environment_radiance = vec3f(0.0);
-    if ENVIRONMENT != 0u {
-        // Looked up everywhere (its derivatives need uniform control flow), kept where the
-        // object reflects through a map.
-        let r = 2.0 * dot(n, v) * n - v;
-        environment_radiance = select(vec3f(0.0), environment_lookup(in.world, r, in.env_layer), in.env_layer != ENV_LAYER_NONE);
-        radiance += material.reflectance * environment_radiance;
-        if INSPECT {
-            probe.environment = material.reflectance * environment_radiance;
-            probe.env_direction = r;
-            probe.env_layer = in.env_layer;
-        }
-    }
-    return Shaded(radiance, n, v, environment_radiance);
-}
-
-// L(d), the radiance arriving at p from direction d, looked up in the environment map: for the
-// mirror term kps·MPS·L(r) of a curved mirror (docs/course/08-environment-maps.md), r = 2(n·v)n − v,
-// and for glass's reflection and refraction. An object's own dynamic cube is read along the
-// direction the parallax setting gives (parallax_direction). The level of detail comes from the
-// direction's change across the pixel, taken here in uniform control flow, so a reflection
-// minified on a small sphere is filtered rather than aliased.
-fn environment_lookup(p: vec3f, d: vec3f, layer: i32) -> vec3f {
-    var lookup = d;
-    if ENVIRONMENT == ENV_MAP_DYNAMIC && layer >= 0 {
-        lookup = parallax_direction(environment, p, d, environment.cube_centres[layer].xyz);
-    }
-    let dx = dpdx(lookup);
-    let dy = dpdy(lookup);
-    if ENVIRONMENT == ENV_MAP_SPHERE {
-        let uv = sphere_map_uv(environment.sphere_from_world * d);
-        return textureSampleGrad(env_sphere, env_sampler, uv, dpdx(uv), dpdy(uv)).rgb;
-    }
-    if ENVIRONMENT == ENV_MAP_LATLONG {
-        let uv = latlong_uv(d);
-        return textureSampleGrad(env_latlong, env_sampler, uv, latlong_gradient(dpdx(uv)), latlong_gradient(dpdy(uv))).rgb;
-    }
-    if ENVIRONMENT == ENV_MAP_DYNAMIC && layer >= 0 {
-        return textureSampleGrad(env_cubes, env_sampler, lookup, layer, dx, dy).rgb;
-    }
-    return textureSampleGrad(env_cube, env_sampler, d, dx, dy).rgb;
-}
-
-// Coverage α: the material's alpha times its colour texture's (glTF's base colour alpha).
-fn coverage(uv: vec2f) -> f32 {
-    if !COLOR_TEXTURE {
-        return material.alpha;
-    }
-    return material.alpha * textureSampleBias(color_texture, color_sampler, uv, frame.lod_bias).a;
-}
-
-// Whether a cut-out surface (ALPHA_MASK) is absent at this fragment.
-fn masked_out(uv: vec2f) -> bool {
-    return ALPHA_MODE == ALPHA_MASK && coverage(uv) < material.alpha_cutoff;
-}
+@group(3) @binding(0) var mirror_image: texture_2d<f32>;
 
 fn scene_fragment(in: VertexOut) -> vec4f {
     if masked_out(in.uv) {
@@ -496,3 +105,38 @@ fn world_radiance(d: vec3f) -> vec3f {
     }
     return environment.background;
 }
+
+// The inspecting twins (shaders/common/inspect.wgsl).
+@fragment
+fn fs_scene_inspect(in: VertexOut) -> @location(0) vec4f {
+    probe.object = in.object;
+    let out = scene_fragment(in);
+    inspect_record(INSPECT_OPAQUE, in.clip, out.rgb);
+    return out;
+}
+
+@fragment
+fn fs_mirror_inspect(in: VertexOut) -> @location(0) vec4f {
+    probe.object = in.object;
+    let out = mirror_fragment(in);
+    inspect_record(INSPECT_MIRROR, in.clip, out.rgb);
+    return out;
+}
+
+@fragment
+fn fs_background_inspect(in: BackgroundOut) -> @location(0) vec4f {
+    let out = background_fragment(in);
+    probe.object = 0xffffffffu;
+    if all(vec2u(in.clip.xy) == inspection.pixel) {
+        let index = atomicAdd(&inspection.count, 1u);
+        if index < MAX_INSPECTED {
+            probe.kind = INSPECT_BACKGROUND;
+            probe.depth = 1.0;
+            probe.material = 0xffffffffu;
+            probe.radiance = out.rgb;
+            inspection.fragments[index] = probe;
+        }
+    }
+    return out;
+}
+

@@ -1,6 +1,6 @@
-// Transparent surfaces (docs/course/06-transparency.md), composed after shaders/scene.wgsl into
-// one module. src/raster/transparency.rs draws them after the opaque surfaces, farthest first,
-// with the blend I = Im + kt·Mt·I: the fragment returns Im (times the coverage α for alpha
+// Transparent surfaces (docs/course/06-transparency.md), with the surface code of
+// shaders/common/surface.wgsl. src/raster/transparency.rs draws them after the opaque surfaces,
+// farthest first, with the blend I = Im + kt·Mt·I: the fragment returns Im (times the coverage α for alpha
 // blending), and the blend state multiplies what the target holds by kt·Mt.
 
 @fragment
@@ -84,3 +84,23 @@ fn fs_peel(in: VertexOut) {
         discard;
     }
 }
+
+// The inspecting twins (shaders/common/inspect.wgsl).
+@fragment
+fn fs_transparent_inspect(in: VertexOut) -> @location(0) vec4f {
+    probe.object = in.object;
+    let out = transparent_fragment(in);
+    probe.alpha = out.a;
+    inspect_record(INSPECT_TRANSPARENT, in.clip, out.rgb);
+    return out;
+}
+
+@fragment
+fn fs_transparent_fresnel_inspect(in: VertexOut) -> @location(0) vec4f {
+    probe.object = in.object;
+    let out = transparent_fresnel_fragment(in);
+    probe.alpha = 1.0;
+    inspect_record(INSPECT_TRANSPARENT, in.clip, out.rgb);
+    return out;
+}
+

@@ -1,6 +1,6 @@
-// Direct volume rendering (docs/course/11-volumes.md), composed after shaders/scene.wgsl and
-// shaders/transparency.wgsl into one module: the GPU twin of src/volume/march.rs, drawn by
-// src/raster/volume.rs over the opaque image.
+// Direct volume rendering (docs/course/11-volumes.md), with the surface code of
+// shaders/common/surface.wgsl (the illumination model, the shadow lookups): the GPU twin of
+// src/volume/march.rs, drawn by src/raster/volume.rs over the opaque image.
 //
 // The volume's box is the proxy geometry: its back faces are drawn (so a camera inside still
 // gets fragments), and each fragment casts the camera ray through its pixel centre, as the
@@ -52,13 +52,17 @@ struct Volume {
     samples_white: f32,
 }
 
-// Group 3 bindings 0 and 1 are transparency.wgsl's `opaque_depth` (the view's depth: a copy of
-// it for isosurfaces, which write depth) and `peeled_depth`.
-@group(3) @binding(3) var near_depth: texture_2d<f32>;
-@group(3) @binding(4) var<uniform> volume: Volume;
-@group(3) @binding(5) var volume_texture: texture_3d<f32>;
-@group(3) @binding(6) var volume_sampler: sampler;
-@group(3) @binding(7) var transfer_table: texture_2d<f32>;
+// Group 3: the view's depth (a copy of it for isosurfaces, which write depth), the transparent
+// layers that bound the rays (`peeled_depth` behind, `near_depth` in front), and the volume's
+// uniform, field, sampler and transfer table. Depth images read with textureLoad are declared as
+// float textures, depth in x (src/gpu/layout.rs, depth_texels).
+@group(3) @binding(0) var opaque_depth: texture_2d<f32>;
+@group(3) @binding(1) var peeled_depth: texture_2d<f32>;
+@group(3) @binding(2) var near_depth: texture_2d<f32>;
+@group(3) @binding(3) var<uniform> volume: Volume;
+@group(3) @binding(4) var volume_texture: texture_3d<f32>;
+@group(3) @binding(5) var volume_sampler: sampler;
+@group(3) @binding(6) var transfer_table: texture_2d<f32>;
 
 struct VolumeVertex {
     @builtin(position) clip: vec4f,
@@ -387,4 +391,22 @@ fn isosurface_fragment(in: VolumeVertex) -> IsosurfaceOut {
     }
     let clip = view.clip_from_world * vec4f(p, 1.0);
     return IsosurfaceOut(vec4f(radiance, 1.0), clip.z / clip.w);
+}
+
+// The inspecting twins (shaders/common/inspect.wgsl).
+@fragment
+fn fs_volume_composite_inspect(in: VolumeVertex) -> @location(0) vec4f {
+    probe.object = 0xffffffffu;
+    let out = composite_fragment(in);
+    probe.alpha = out.a;
+    inspect_record(INSPECT_VOLUME, in.clip, out.rgb);
+    return out;
+}
+
+@fragment
+fn fs_volume_isosurface_inspect(in: VolumeVertex) -> IsosurfaceOut {
+    probe.object = 0xffffffffu;
+    let out = isosurface_fragment(in);
+    inspect_record(INSPECT_ISOSURFACE, vec4f(in.clip.xy, out.depth, 1.0), out.colour.rgb);
+    return out;
 }

@@ -1,5 +1,6 @@
 //! WGSL composition, in one place: every pass's shader is the shared files of `shaders/common/`
-//! followed by the pass's own file. Shared code is never copied between shaders.
+//! followed by the pass's own file; the passes that draw the scene's surfaces get the surface
+//! code ([`SURFACE`]) between the two. Shared code is never copied between shaders.
 
 /// The shared WGSL, in dependency order.
 pub const COMMON: &[(&str, &str)] = &[
@@ -11,23 +12,23 @@ pub const COMMON: &[(&str, &str)] = &[
     ("common/environment.wgsl", include_str!("../shaders/common/environment.wgsl")),
 ];
 
-/// The scene pass and the transparent surfaces' entry points: one module, so that every variant
-/// computes exactly the same vertex positions (depth peeling tests `Equal` against them). The
-/// volumes' ray marching joins them to share the illumination model and the shadow lookups.
-/// The view group's declarations (group 2, what a view's shading reads) come first.
-pub const SCENE: &str = concat!(
-    include_str!("../shaders/view_group.wgsl"),
-    "\n// ---- scene.wgsl\n",
-    include_str!("../shaders/scene.wgsl"),
-    "\n// ---- transparency.wgsl\n",
-    include_str!("../shaders/transparency.wgsl"),
-    "\n// ---- refraction.wgsl\n",
-    include_str!("../shaders/refraction.wgsl"),
-    "\n// ---- volume.wgsl\n",
-    include_str!("../shaders/volume.wgsl"),
-    "\n// ---- inspect.wgsl\n",
-    include_str!("../shaders/inspect.wgsl")
-);
+/// The surface code every pass that draws the scene's surfaces shares, in its modules only, after
+/// [`COMMON`]: the view group (group 2), the inspection's record, and the vertex stage and the
+/// illumination model at a fragment with groups 0 and 1 (`shaders/common/surface.wgsl`).
+pub const SURFACE: &[(&str, &str)] = &[
+    ("common/view_group.wgsl", include_str!("../shaders/common/view_group.wgsl")),
+    ("common/inspect.wgsl", include_str!("../shaders/common/inspect.wgsl")),
+    ("common/surface.wgsl", include_str!("../shaders/common/surface.wgsl")),
+];
+
+/// The surface passes' own files: each composed after [`SURFACE`] into a module of its own, with
+/// its private bindings (group 3) numbered from 0. The vertex stage is `@invariant`, so depth
+/// written by one module is met exactly by another's `Equal` test (prepass and shading, depth
+/// peeling).
+pub const SCENE: &str = include_str!("../shaders/scene.wgsl");
+pub const TRANSPARENCY: &str = include_str!("../shaders/transparency.wgsl");
+pub const REFRACTION: &str = include_str!("../shaders/refraction.wgsl");
+pub const VOLUME: &str = include_str!("../shaders/volume.wgsl");
 pub const PRESENT: &str = include_str!("../shaders/present.wgsl");
 pub const MIPMAP: &str = include_str!("../shaders/mipmap.wgsl");
 pub const DEPTH_COPY: &str = include_str!("../shaders/depth_copy.wgsl");
@@ -38,23 +39,36 @@ pub const ENVIRONMENT: &str = include_str!("../shaders/environment.wgsl");
 /// The viewer's: its 3D view's image stretched over the view while the camera moves.
 pub const UPSCALE: &str = include_str!("../shaders/upscale.wgsl");
 
-/// Every pass's own file, by name, for tests that validate them all.
-pub const PASSES: &[(&str, &str)] = &[
-    ("scene", SCENE),
-    ("present", PRESENT),
-    ("mipmap", MIPMAP),
-    ("depth_copy", DEPTH_COPY),
-    ("shadow", SHADOW),
-    ("shadow_projected", SHADOW_PROJECTED),
-    ("overlays", OVERLAYS),
-    ("environment", ENVIRONMENT),
-    ("upscale", UPSCALE),
-];
+/// Every pass's whole source, by name, for tests that validate them all.
+pub fn passes() -> Vec<(&'static str, String)> {
+    let surface = [("scene", SCENE), ("transparency", TRANSPARENCY), ("refraction", REFRACTION), ("volume", VOLUME)];
+    let others = [
+        ("present", PRESENT),
+        ("mipmap", MIPMAP),
+        ("depth_copy", DEPTH_COPY),
+        ("shadow", SHADOW),
+        ("shadow_projected", SHADOW_PROJECTED),
+        ("overlays", OVERLAYS),
+        ("environment", ENVIRONMENT),
+        ("upscale", UPSCALE),
+    ];
+    let surface = surface.into_iter().map(|(name, pass)| (name, compose_surface(pass)));
+    surface.chain(others.into_iter().map(|(name, pass)| (name, compose(pass)))).collect()
+}
 
 /// The full source of a pass: the common files, then the pass's own.
 pub fn compose(pass: &str) -> String {
+    compose_after(COMMON.iter(), pass)
+}
+
+/// The full source of a surface pass: the common files, the surface code, then the pass's own.
+pub fn compose_surface(pass: &str) -> String {
+    compose_after(COMMON.iter().chain(SURFACE), pass)
+}
+
+fn compose_after<'a>(shared: impl Iterator<Item = &'a (&'a str, &'a str)>, pass: &str) -> String {
     let mut source = String::new();
-    for (name, text) in COMMON {
+    for (name, text) in shared {
         source.push_str("// ---- ");
         source.push_str(name);
         source.push('\n');
@@ -69,5 +83,13 @@ pub fn module(device: &wgpu::Device, label: &str, pass: &str) -> wgpu::ShaderMod
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(compose(pass).into()),
+    })
+}
+
+/// A surface pass's module ([`compose_surface`]).
+pub fn surface_module(device: &wgpu::Device, label: &str, pass: &str) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(compose_surface(pass).into()),
     })
 }

@@ -37,12 +37,16 @@ fn structs(module: &naga::Module) -> Vec<StructLayout> {
         .collect()
 }
 
-/// The value of a named `const` of scalar type.
-fn constant(module: &naga::Module, name: &str) -> f64 {
-    let (_, c) = module
-        .constants
+/// Every surface pass's module, parsed.
+fn surface_modules() -> Vec<naga::Module> {
+    SURFACE_PASSES.iter().map(|(_, pass)| parse(&shaders::compose_surface(pass))).collect()
+}
+
+/// The value of a named `const` of scalar type, in the first of `modules` that has it.
+fn constant(modules: &[naga::Module], name: &str) -> f64 {
+    let (module, c) = modules
         .iter()
-        .find(|(_, c)| c.name.as_deref() == Some(name))
+        .find_map(|m| m.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).map(|(_, c)| (m, c)))
         .unwrap_or_else(|| panic!("no const {name} in the WGSL"));
     match module.global_expressions[c.init] {
         naga::Expression::Literal(naga::Literal::U32(v)) => f64::from(v),
@@ -73,7 +77,7 @@ macro_rules! fields {
 
 #[test]
 fn gpu_structs_match_their_wgsl_twins_field_by_field() {
-    let scene = structs(&parse(&shaders::compose(shaders::SCENE)));
+    let scene = structs(&parse(&shaders::compose_surface(shaders::SCENE)));
     check_struct(
         &scene,
         "Light",
@@ -167,7 +171,7 @@ fn gpu_structs_match_their_wgsl_twins_field_by_field() {
 
 #[test]
 fn instance_attributes_match_the_wgsl_locations() {
-    let module = parse(&shaders::compose(shaders::SCENE));
+    let module = parse(&shaders::compose_surface(shaders::SCENE));
     let (_, ty) = module
         .types
         .iter()
@@ -190,9 +194,9 @@ fn instance_attributes_match_the_wgsl_locations() {
         "the matrix columns, the normal matrix's, the environment layer, then the object"
     );
     use mirador::raster::volume::GpuVolume;
-    let scene = structs(&parse(&shaders::compose(shaders::SCENE)));
+    let volume = structs(&parse(&shaders::compose_surface(shaders::VOLUME)));
     check_struct(
-        &scene,
+        &volume,
         "Volume",
         size_of::<GpuVolume>(),
         &fields!(GpuVolume {
@@ -216,7 +220,7 @@ fn instance_attributes_match_the_wgsl_locations() {
 
 #[test]
 fn codes_shared_by_rust_and_wgsl_agree() {
-    let module = parse(&shaders::compose(shaders::SCENE));
+    let module = surface_modules();
     let codes: [(&str, f64); 43] = [
         ("MAX_LIGHTS", uniforms::MAX_LIGHTS as f64),
         ("MAX_SHADOW_LAYERS", MAX_LAYERS as f64),
@@ -290,39 +294,63 @@ fn codes_shared_by_rust_and_wgsl_agree() {
         ("TONE_MAP_PBR_NEUTRAL", ToneMap::PbrNeutral),
     ] {
         let code = mirador::raster::present::tone_map_code(curve);
-        assert_eq!(constant(&present, name), f64::from(code), "{name}: WGSL vs Rust");
+        assert_eq!(constant(std::slice::from_ref(&present), name), f64::from(code), "{name}: WGSL vs Rust");
     }
 }
 
+/// The surface passes' own files, by name.
+const SURFACE_PASSES: [(&str, &str); 4] = [
+    ("scene", shaders::SCENE),
+    ("transparency", shaders::TRANSPARENCY),
+    ("refraction", shaders::REFRACTION),
+    ("volume", shaders::VOLUME),
+];
+
 #[test]
-fn every_pipeline_constant_is_an_override_of_the_scene_shader() {
-    let module = parse(&shaders::compose(shaders::SCENE));
-    let overrides: Vec<String> = module.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect();
-    let keys = [
-        FrameKey::NAMES,
-        MaterialKey::NAMES,
-        mirador::raster::volume::VolumeKey::NAMES,
-        mirador::raster::refraction::RefractionKey::NAMES,
-    ];
-    let names: Vec<&str> = keys.concat();
-    for name in &names {
-        assert!(
-            overrides.iter().any(|o| o == name),
-            "{name} is set by a pipeline key but is no override of scene.wgsl"
-        );
+fn every_pipeline_constant_is_an_override_of_its_pass_module() {
+    let shared = [FrameKey::NAMES, MaterialKey::NAMES].concat();
+    for (name, pass) in SURFACE_PASSES {
+        let module = parse(&shaders::compose_surface(pass));
+        let overrides: Vec<String> = module.overrides.iter().filter_map(|(_, o)| o.name.clone()).collect();
+        let own: &[&str] = match name {
+            "volume" => mirador::raster::volume::VolumeKey::NAMES,
+            "refraction" => mirador::raster::refraction::RefractionKey::NAMES,
+            _ => &[],
+        };
+        let names: Vec<&str> = shared.iter().chain(own).copied().collect();
+        for key in &names {
+            assert!(overrides.iter().any(|o| o == key), "{key} is set by a pipeline key but is no override of {name}");
+        }
+        assert_eq!(overrides.len(), names.len(), "{name} has overrides no key sets: {overrides:?}");
     }
-    assert_eq!(overrides.len(), names.len(), "scene.wgsl has overrides no key sets: {overrides:?}");
 }
 
 #[test]
 fn every_pass_shader_validates() {
-    for (name, pass) in shaders::PASSES {
-        let source = shaders::compose(pass);
+    for (name, source) in shaders::passes() {
         let module =
             naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&source)));
         naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
             .validate(&module)
             .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    }
+}
+
+#[test]
+fn each_surface_pass_numbers_its_own_bindings_from_zero_in_its_own_file() {
+    for (_, shared) in shaders::SURFACE {
+        assert!(!shared.contains("@group(3)"), "the surface code declares no pass's private binding");
+    }
+    for (name, pass) in SURFACE_PASSES {
+        let module = parse(&shaders::compose_surface(pass));
+        let mut bindings: Vec<u32> = module
+            .global_variables
+            .iter()
+            .filter_map(|(_, var)| var.binding.as_ref().filter(|b| b.group == 3).map(|b| b.binding))
+            .collect();
+        bindings.sort_unstable();
+        let expected: Vec<u32> = (0..bindings.len() as u32).collect();
+        assert_eq!(bindings, expected, "{name}'s group 3, numbered from 0 without gaps");
     }
 }
 
@@ -362,10 +390,11 @@ fn binding_mismatch(module: &naga::Module, var: &naga::GlobalVariable, ty: &wgpu
     (!fits).then(|| format!("{inner:?} in {:?}, the table says {ty:?}", var.space))
 }
 
-/// Every difference between the view group's table and the group-2 variables of `source`.
+/// Every difference between the view group's table and the group-2 variables of `source`, a
+/// whole module's source.
 fn view_group_differences(source: &str) -> Vec<String> {
     use mirador::raster::view_group::VIEW_GROUP;
-    let module = parse(&shaders::compose(source));
+    let module = parse(source);
     let mut differences = Vec::new();
     let mut declared = Vec::new();
     for (_, var) in module.global_variables.iter() {
@@ -392,10 +421,13 @@ fn view_group_differences(source: &str) -> Vec<String> {
 
 #[test]
 fn the_view_group_table_is_the_wgsl_binding_by_binding() {
-    let differences = view_group_differences(shaders::SCENE);
-    assert!(differences.is_empty(), "the view group's table against its WGSL:\n{}", differences.join("\n"));
+    for (name, pass) in SURFACE_PASSES {
+        let differences = view_group_differences(&shaders::compose_surface(pass));
+        assert!(differences.is_empty(), "{name}: the view group's table against its WGSL:\n{}", differences.join("\n"));
+    }
+    let scene = shaders::compose_surface(shaders::SCENE);
     // The check can fail: a view image renamed, retyped, or left out of the table.
-    let renamed = shaders::SCENE
+    let renamed = scene
         .replace("var projected_mask:", "var shadow_mask:")
         .replace("textureLoad(projected_mask", "textureLoad(shadow_mask");
     let found = view_group_differences(&renamed);
@@ -405,7 +437,7 @@ fn the_view_group_table_is_the_wgsl_binding_by_binding() {
     let row = mirador::raster::view_group::VIEW_GROUP.iter().find(|row| row.binding == 4).unwrap();
     assert!(binding_mismatch(&retyped, var, &row.ty).is_some(), "a 2D array where the table has a 2D image");
     assert!(binding_mismatch(&retyped, var, &mirador::raster::view_group::VIEW_GROUP[3].ty).is_none());
-    let extra = format!("{}\n@group(2) @binding(20) var stray: texture_2d<f32>;", shaders::SCENE);
+    let extra = format!("{scene}\n@group(2) @binding(20) var stray: texture_2d<f32>;");
     assert!(view_group_differences(&extra).iter().any(|d| d.contains("stray")));
     // Every view image has its row.
     for image in mirador::raster::targets::ViewImage::ALL {

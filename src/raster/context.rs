@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use web_time::Instant;
 
-use super::scene_gpu::{SceneGpu, SceneShader};
+use super::scene_gpu::{SceneGpu, SurfaceLayout};
 use super::view::FrameView;
 use super::view_group::ViewGroups;
 use crate::gpu::Gpu;
@@ -16,13 +16,13 @@ use crate::scene::Scene;
 use crate::settings::RenderSettings;
 
 /// What every pass of one frame reads: the device, the scene on both sides, the settings, the
-/// scene shader every scene-module pass compiles from, and every view's view group (group 2).
+/// pipeline layout every surface pass shares (groups 0 to 2), and every view's view group (group 2).
 pub struct FrameContext<'a> {
     pub gpu: &'a Gpu,
     pub scene: &'a Scene,
     pub scene_gpu: &'a SceneGpu,
     pub settings: &'a RenderSettings,
-    pub shader: &'a SceneShader,
+    pub surface: &'a SurfaceLayout,
     /// Group 2 of each view: the shadow maps, the environment maps and the view's own images.
     pub view_groups: &'a ViewGroups,
 }
@@ -36,7 +36,7 @@ impl FrameContext<'_> {
         &self.gpu.queue
     }
 
-    /// What `view`'s shading reads (group 2 of the scene module).
+    /// What `view`'s shading reads (group 2 of every surface module).
     pub fn view_group(&self, view: &FrameView) -> &wgpu::BindGroup {
         self.view_groups.get(view)
     }

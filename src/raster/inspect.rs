@@ -1,5 +1,5 @@
 //! Inspecting one pixel of the rasterizer's frame: the values its shaders computed there, read
-//! back from the GPU (`shaders/inspect.wgsl`), not computed again on the CPU.
+//! back from the GPU (`shaders/common/inspect.wgsl`), not computed again on the CPU.
 //!
 //! An inspecting renderer (`Renderer::inspecting`) binds a storage buffer in the lighting group
 //! (binding 11). While a pixel is inspected, the main view's pipelines are the `INSPECT` variants
@@ -21,7 +21,7 @@ use glam::{Vec2, Vec3};
 use super::uniforms::MAX_LIGHTS;
 use crate::gpu::Gpu;
 
-/// `MAX_INSPECTED` of `shaders/inspect.wgsl`: the records one pixel keeps.
+/// `MAX_INSPECTED` of `shaders/common/inspect.wgsl`: the records one pixel keeps.
 pub const MAX_INSPECTED: usize = 32;
 
 /// `INSPECT_*` kinds of fragment.
@@ -33,7 +33,7 @@ pub const INSPECT_ISOSURFACE: u32 = 5;
 pub const INSPECT_VOLUME: u32 = 6;
 pub const INSPECT_REFRACTION: u32 = 7;
 
-/// `InspectLight` of `shaders/inspect.wgsl`.
+/// `InspectLight` of `shaders/common/inspect.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct GpuInspectLight {
@@ -50,7 +50,7 @@ pub struct GpuInspectLight {
     pub _pad1: f32,
 }
 
-/// `InspectFragment` of `shaders/inspect.wgsl`: what one fragment at the pixel computed.
+/// `InspectFragment` of `shaders/common/inspect.wgsl`: what one fragment at the pixel computed.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct GpuInspectFragment {
@@ -91,7 +91,7 @@ pub struct GpuInspectFragment {
     pub lights: [GpuInspectLight; MAX_LIGHTS],
 }
 
-/// The head of `Inspection` in `shaders/inspect.wgsl`; the records follow it.
+/// The head of `Inspection` in `shaders/common/inspect.wgsl`; the records follow it.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct GpuInspectionHead {

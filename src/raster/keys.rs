@@ -1,6 +1,6 @@
 //! Shader variants' keys: which toggles of a frame and which inputs of a material switch code on
-//! or off in the scene module (`shaders/scene.wgsl`'s `override`s). Each pass that draws with the
-//! scene module compiles one pipeline per key it meets; toggles are pipeline constants rather
+//! or off in the surface passes' modules (the `override`s of `shaders/common/surface.wgsl` and of
+//! a pass's own file). Each surface pass compiles one pipeline per key it meets; toggles are pipeline constants rather
 //! than uniform flags because a software GPU runs both sides of a branch on a uniform value.
 //!
 //! A toggle is declared once, in a [`pipeline_constants!`] key: its field, the `override` it
@@ -84,7 +84,7 @@ pipeline_constants! {
         flat_colour: bool = "FLAT_COLOUR" <- settings.raster.flat_colour,
         /// `ENV_MAP_*`: where curved mirrors look their reflection up; 0: nowhere.
         environment: u32 = "ENVIRONMENT" <- environment_code(&settings.environment),
-        /// Record what the shading computes at the inspected pixel (`shaders/inspect.wgsl`): the
+        /// Record what the shading computes at the inspected pixel (`shaders/common/inspect.wgsl`): the
         /// main view of an inspected frame only.
         inspect: bool = "INSPECT" <- false,
     }

@@ -38,7 +38,7 @@ use std::collections::HashMap;
 use super::context::{Figure, FrameContext, FrameEncoder};
 use super::geometry::TransparentObject;
 use super::keys::{FrameKey, MaterialKey, constants, pipeline_constants};
-use super::scene_gpu::{SceneLayouts, SceneShader};
+use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::scene_pass::scissor;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
 use super::view::FrameView;
@@ -46,6 +46,7 @@ use crate::gpu::depth_copy::{DepthCopy, DepthImageCopy};
 use crate::gpu::layout;
 use crate::gpu::texture::GpuTexture;
 use crate::settings::{Refraction, RenderSettings};
+use crate::shaders;
 
 /// `REFRACTION` of `shaders/refraction.wgsl`: where the light along the twice-refracted ray is
 /// read.
@@ -53,7 +54,7 @@ pub const REFRACTION_ENVIRONMENT: u32 = 1;
 pub const REFRACTION_SCREEN: u32 = 2;
 
 pipeline_constants! {
-    /// The pipeline constant the refraction pass sets besides the scene module's: where the
+    /// The pipeline constant the refraction pass sets besides the surface code's: where the
     /// refracted ray is read (`REFRACTION_*` of `shaders/refraction.wgsl`).
     #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
     pub struct RefractionKey(mode: Refraction) {
@@ -79,6 +80,8 @@ type BackKey = (Culled, FrameKey, MaterialKey);
 type FrontKey = (Culled, Refraction, FrameKey, MaterialKey);
 
 pub struct RefractionPass {
+    /// `shaders/refraction.wgsl` with the surface code.
+    module: SurfaceModule,
     group_layout: wgpu::BindGroupLayout,
     layout: wgpu::PipelineLayout,
     back: HashMap<BackKey, wgpu::RenderPipeline>,
@@ -99,7 +102,7 @@ struct RefractionImages {
 }
 
 impl RefractionPass {
-    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SceneShader) -> RefractionPass {
+    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SurfaceLayout) -> RefractionPass {
         let depth = |binding| layout::depth_texels(binding, wgpu::TextureViewDimension::D2);
         let colour = |binding| {
             layout::texture(
@@ -110,10 +113,11 @@ impl RefractionPass {
         };
         let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("refraction::group_layout"),
-            entries: &[depth(0), depth(8), colour(9), colour(10)],
+            entries: &[depth(0), depth(1), colour(2), colour(3)],
         });
         let layout = shader.layout_with(device, layouts, "refraction::layout", &group_layout);
         RefractionPass {
+            module: SurfaceModule::new(device, "refraction::shader", shaders::REFRACTION),
             group_layout,
             layout,
             back: HashMap::new(),
@@ -147,10 +151,10 @@ impl RefractionPass {
                 let object = &ctx.scene_gpu.geometry.transparent[index];
                 let material = ctx.scene_gpu.material_keys[object.material];
                 let back = (culled(object, view, wgpu::Face::Front), view.key, material);
-                self.back.entry(back).or_insert_with(|| back_pipeline(ctx, back));
+                self.back.entry(back).or_insert_with(|| back_pipeline(ctx, &self.module, back));
                 let front = (culled(object, view, wgpu::Face::Back), mode, view.key, material);
                 let layout = &self.layout;
-                self.front.entry(front).or_insert_with(|| front_pipeline(ctx, layout, front));
+                self.front.entry(front).or_insert_with(|| front_pipeline(ctx, (layout, &self.module), front));
             }
             if !self.images.iter().any(|(depth, _)| *depth == targets.depth.view) {
                 let images = RefractionImages::new(ctx.device(), (&self.group_layout, &self.depth_copy), targets);
@@ -270,9 +274,9 @@ impl RefractionImages {
             layout: group_layout,
             entries: &[
                 entry(0, &opaque_depth.image.view),
-                entry(8, &back_depth.view),
-                entry(9, &back_normal.view),
-                entry(10, &opaque.view),
+                entry(1, &back_depth.view),
+                entry(2, &back_normal.view),
+                entry(3, &opaque.view),
             ],
         });
         RefractionImages { back_depth, back_normal, opaque, opaque_depth, group }
@@ -280,17 +284,17 @@ impl RefractionImages {
 }
 
 /// The back faces' depth and normals (`Less`, written).
-fn back_pipeline(ctx: &FrameContext, (cull, frame, material): BackKey) -> wgpu::RenderPipeline {
+fn back_pipeline(ctx: &FrameContext, module: &SurfaceModule, (cull, frame, material): BackKey) -> wgpu::RenderPipeline {
     let constants = constants(&frame, &material);
     ctx.device().create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("refraction::back_pipeline"),
-        layout: Some(&ctx.shader.layout),
-        vertex: ctx.shader.vertex(),
+        layout: Some(&ctx.surface.layout),
+        vertex: module.vertex(),
         primitive: wgpu::PrimitiveState { cull_mode: Some(cull), ..Default::default() },
         depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less, true),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: &ctx.shader.module,
+            module: &module.module,
             entry_point: Some("fs_refraction_back"),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             targets: &[Some(NORMAL_FORMAT.into())],
@@ -304,7 +308,7 @@ fn back_pipeline(ctx: &FrameContext, (cull, frame, material): BackKey) -> wgpu::
 /// depth written).
 fn front_pipeline(
     ctx: &FrameContext,
-    layout: &wgpu::PipelineLayout,
+    (layout, module): (&wgpu::PipelineLayout, &SurfaceModule),
     (cull, mode, frame, material): FrontKey,
 ) -> wgpu::RenderPipeline {
     let mut constants = constants(&frame, &material);
@@ -312,12 +316,12 @@ fn front_pipeline(
     ctx.device().create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("refraction::front_pipeline"),
         layout: Some(layout),
-        vertex: ctx.shader.vertex(),
+        vertex: module.vertex(),
         primitive: wgpu::PrimitiveState { cull_mode: Some(cull), ..Default::default() },
         depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less, true),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: &ctx.shader.module,
+            module: &module.module,
             entry_point: Some(if frame.inspect { "fs_refraction_inspect" } else { "fs_refraction" }),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             targets: &[Some(HDR_FORMAT.into())],

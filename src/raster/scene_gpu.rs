@@ -5,9 +5,8 @@
 //! change, the draw list. What a technique keeps per scene (a volume's 3D texture, the
 //! environment maps, the planar mirrors) belongs to its pass.
 //!
-//! [`SceneShader`] is the shading module every scene-module pass compiles its variants from
-//! (`shaders/scene.wgsl` with the transparency and volume entry points composed after it), so
-//! that every variant computes bit-identical positions.
+//! [`SurfaceLayout`] is the pipeline layout of groups 0 to 2 every surface pass shares, and
+//! [`SurfaceModule`] a surface pass's own module (the shared surface code and its file).
 
 use super::geometry::SceneGeometry;
 use super::keys::MaterialKey;
@@ -36,7 +35,7 @@ pub struct SceneLayouts {
 
 impl SceneLayouts {
     /// The layouts; `inspect` adds the inspection buffer and the shadow maps read as floats to
-    /// the view group (bindings 11 and 12, `shaders/inspect.wgsl`), for a renderer that
+    /// the view group (bindings 11 and 12, `shaders/common/inspect.wgsl`), for a renderer that
     /// inspects pixels.
     pub fn new(device: &wgpu::Device, inspect: bool) -> SceneLayouts {
         let both = wgpu::ShaderStages::VERTEX_FRAGMENT;
@@ -63,10 +62,9 @@ impl SceneLayouts {
     }
 }
 
-/// The scene module and the pipeline layout of groups 0 to 2 that every pass drawing with it
-/// shares; a pass with a group 3 of its own makes its layout with [`Self::layout_with`].
-pub struct SceneShader {
-    pub module: wgpu::ShaderModule,
+/// The pipeline layout of groups 0 to 2 that every pass drawing the scene's surfaces shares; a
+/// pass with a group 3 of its own makes its layout with [`Self::layout_with`].
+pub struct SurfaceLayout {
     pub layout: wgpu::PipelineLayout,
 }
 
@@ -74,15 +72,14 @@ pub struct SceneShader {
 pub const VERTEX_BUFFERS: [Option<wgpu::VertexBufferLayout<'static>>; 2] =
     [Some(Vertex::LAYOUT), Some(GpuInstance::LAYOUT)];
 
-impl SceneShader {
-    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts) -> SceneShader {
-        let module = shaders::module(device, "scene::shader", shaders::SCENE);
+impl SurfaceLayout {
+    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts) -> SurfaceLayout {
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("scene::layout"),
             bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.material), Some(&layouts.view)],
             immediate_size: 0,
         });
-        SceneShader { module, layout }
+        SurfaceLayout { layout }
     }
 
     /// A pipeline layout of groups 0 to 2 and `group3`.
@@ -99,8 +96,20 @@ impl SceneShader {
             immediate_size: 0,
         })
     }
+}
 
-    /// The vertex stage every scene pipeline shares (`vs_scene`).
+/// A surface pass's shader module: the surface code of `shaders/common/surface.wgsl` and the
+/// pass's own file (`src/shaders.rs`, `compose_surface`).
+pub struct SurfaceModule {
+    pub module: wgpu::ShaderModule,
+}
+
+impl SurfaceModule {
+    pub fn new(device: &wgpu::Device, label: &str, pass: &str) -> SurfaceModule {
+        SurfaceModule { module: shaders::surface_module(device, label, pass) }
+    }
+
+    /// The vertex stage every surface pipeline shares (`vs_scene`, its position `@invariant`).
     pub fn vertex(&self) -> wgpu::VertexState<'_> {
         wgpu::VertexState {
             module: &self.module,

@@ -4,7 +4,7 @@
 //! `shaders/common/lighting.wgsl`) for all lights, each weighted by its visibility from the
 //! shadow pass, into the linear HDR target.
 //!
-//! Variants, one shading module:
+//! Variants, one module (`shaders/scene.wgsl` after the surface code):
 //! - **Depth prepass** ([`PreparedScene::record_prepass`]): the depth of the nearest surface at
 //!   every pixel, and nothing else. The shading pass that follows tests `Equal` against it, so the
 //!   illumination model runs once per pixel instead of once per fragment drawn: on a software
@@ -24,11 +24,12 @@ use std::ops::Range;
 
 use super::context::{FrameContext, FrameEncoder};
 use super::keys::{FrameKey, MaterialKey, constants};
-use super::scene_gpu::{SceneGpu, SceneLayouts, SceneShader};
+use super::scene_gpu::{SceneGpu, SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
 use super::uniforms::ALPHA_MASK;
 use super::view::{FrameView, ViewSlot};
 use crate::gpu::layout;
+use crate::shaders;
 
 /// The depth test of a shading variant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -47,6 +48,8 @@ type ShadingKey = (DepthMode, FrameKey, MaterialKey, bool);
 type BatchKeys = (ShadingKey, Option<ShadingKey>);
 
 pub struct ScenePass {
+    /// `shaders/scene.wgsl` with the surface code.
+    module: SurfaceModule,
     /// Group 3 of the mirror variants: the reflection image.
     mirror_group_layout: wgpu::BindGroupLayout,
     mirror_layout: wgpu::PipelineLayout,
@@ -75,12 +78,13 @@ pub struct MirrorImages {
 pub type MirrorPart = (Option<Range<u32>>, Option<wgpu::BindGroup>);
 
 impl ScenePass {
-    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SceneShader) -> ScenePass {
+    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SurfaceLayout) -> ScenePass {
+        let module = SurfaceModule::new(device, "scene::shader", shaders::SCENE);
         let prepass_pipeline = |label, fragment| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: Some(&shader.layout),
-                vertex: shader.vertex(),
+                vertex: module.vertex(),
                 primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
                 depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Less, true),
                 multisample: Default::default(),
@@ -95,7 +99,7 @@ impl ScenePass {
         let prepass_masked = prepass_pipeline(
             "scene::prepass_masked_pipeline",
             Some(wgpu::FragmentState {
-                module: &shader.module,
+                module: &module.module,
                 entry_point: Some("fs_mask"),
                 compilation_options: wgpu::PipelineCompilationOptions {
                     constants: &mask_constants,
@@ -107,7 +111,7 @@ impl ScenePass {
         let mirror_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("scene::mirror_group_layout"),
             entries: &[layout::texture(
-                2,
+                0,
                 wgpu::TextureSampleType::Float { filterable: false },
                 wgpu::TextureViewDimension::D2,
             )],
@@ -129,8 +133,9 @@ impl ScenePass {
             bind_group_layouts: &[Some(&layouts.frame), Some(&empty_layout), Some(&layouts.view)],
             immediate_size: 0,
         });
-        let background = background_pipeline(device, shader, &background_layout, "fs_background");
+        let background = background_pipeline(device, &module, &background_layout, "fs_background");
         ScenePass {
+            module,
             background,
             empty_group,
             background_inspect: None,
@@ -179,7 +184,7 @@ impl ScenePass {
         }
         if views.iter().any(|(view, _)| view.key.inspect) && self.background_inspect.is_none() {
             let device = ctx.device();
-            let pipeline = background_pipeline(device, ctx.shader, &self.background_layout, "fs_background_inspect");
+            let pipeline = background_pipeline(device, &self.module, &self.background_layout, "fs_background_inspect");
             self.background_inspect = Some(pipeline);
         }
         let this = &*self;
@@ -197,6 +202,7 @@ impl ScenePass {
     }
 
     fn shading_pipeline(&self, ctx: &FrameContext, key: ShadingKey) -> wgpu::RenderPipeline {
+        let module = &self.module;
         let (depth, frame, material, mirror) = key;
         // A mirror drawn with its image reflects through it, not through an environment map.
         let frame = if mirror { FrameKey { environment: 0, ..frame } } else { frame };
@@ -207,13 +213,13 @@ impl ScenePass {
         };
         ctx.device().create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("scene::shading_pipeline"),
-            layout: Some(if mirror { &self.mirror_layout } else { &ctx.shader.layout }),
-            vertex: ctx.shader.vertex(),
+            layout: Some(if mirror { &self.mirror_layout } else { &ctx.surface.layout }),
+            vertex: module.vertex(),
             primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
             depth_stencil: depth_state,
             multisample: Default::default(),
             fragment: Some(wgpu::FragmentState {
-                module: &ctx.shader.module,
+                module: &module.module,
                 // A mirror drawn with its reflection reads group 3 (`fs_mirror`).
                 entry_point: Some(match (mirror, frame.inspect) {
                     (false, false) => "fs_scene",
@@ -239,7 +245,7 @@ impl ScenePass {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene::mirror_image_group"),
             layout: &self.mirror_group_layout,
-            entries: &[wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(image) }],
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(image) }],
         })
     }
 }
@@ -369,7 +375,7 @@ pub fn scissor(pass: &mut wgpu::RenderPass<'_>, view: &FrameView) {
 /// The world where nothing is drawn: one triangle at the far plane, drawn where no surface is.
 fn background_pipeline(
     device: &wgpu::Device,
-    shader: &SceneShader,
+    module: &SurfaceModule,
     layout: &wgpu::PipelineLayout,
     entry_point: &str,
 ) -> wgpu::RenderPipeline {
@@ -377,7 +383,7 @@ fn background_pipeline(
         label: Some("scene::background_pipeline"),
         layout: Some(layout),
         vertex: wgpu::VertexState {
-            module: &shader.module,
+            module: &module.module,
             entry_point: Some("vs_background"),
             compilation_options: Default::default(),
             buffers: &[],
@@ -387,7 +393,7 @@ fn background_pipeline(
         depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::LessEqual, false),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: &shader.module,
+            module: &module.module,
             entry_point: Some(entry_point),
             compilation_options: Default::default(),
             targets: &[Some(HDR_FORMAT.into())],

@@ -64,7 +64,7 @@ use super::context::{Figure, FrameContext, FrameEncoder};
 use super::geometry::{DrawListId, TransparentObject, build_mesh};
 use super::keys::{FrameKey, MaterialKey, constants};
 use super::refraction::refracts;
-use super::scene_gpu::{SceneLayouts, SceneShader};
+use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::scene_pass::scissor;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
 use super::uniforms::{ALPHA_BLEND, GpuInstance, Vertex};
@@ -74,6 +74,7 @@ use crate::gpu::layout;
 use crate::gpu::texture::GpuTexture;
 use crate::scene::Scene;
 use crate::settings::{Refraction, TransparencySort};
+use crate::shaders;
 use crate::texture::tangents::tangents_or_generate;
 
 /// How the blend finds `kt·Mt`.
@@ -129,6 +130,8 @@ enum Step {
 }
 
 pub struct TransparencyPass {
+    /// `shaders/transparency.wgsl` with the surface code.
+    module: SurfaceModule,
     peel_group_layout: wgpu::BindGroupLayout,
     peel_layout: wgpu::PipelineLayout,
     pipelines: HashMap<PipelineKey, wgpu::RenderPipeline>,
@@ -148,7 +151,7 @@ struct ViewSteps {
 }
 
 impl TransparencyPass {
-    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SceneShader) -> TransparencyPass {
+    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SurfaceLayout) -> TransparencyPass {
         let depth = |binding| layout::depth_texels(binding, wgpu::TextureViewDimension::D2);
         let peel_group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("transparency::peel_group_layout"),
@@ -156,6 +159,7 @@ impl TransparencyPass {
         });
         let peel_layout = shader.layout_with(device, layouts, "transparency::peel_layout", &peel_group_layout);
         TransparencyPass {
+            module: SurfaceModule::new(device, "transparency::shader", shaders::TRANSPARENCY),
             peel_group_layout,
             peel_layout,
             pipelines: HashMap::new(),
@@ -205,7 +209,7 @@ impl TransparencyPass {
             for step in &steps {
                 if let Step::Draw(draw) = step {
                     for key in pipeline_keys(ctx, view.key, draw, depth) {
-                        self.pipelines.entry(key).or_insert_with(|| shading_pipeline(ctx, key));
+                        self.pipelines.entry(key).or_insert_with(|| shading_pipeline(ctx, &self.module, key));
                     }
                 }
             }
@@ -213,7 +217,7 @@ impl TransparencyPass {
                 for object in drawn(ctx, view).map(|i| &geometry.transparent[i]) {
                     let key = (view.key, ctx.scene_gpu.material_keys[object.material]);
                     if !self.peel_pipelines.contains_key(&key) {
-                        let pipeline = peel_pipeline(ctx, &self.peel_layout, key);
+                        let pipeline = peel_pipeline(ctx, (&self.peel_layout, &self.module), key);
                         self.peel_pipelines.insert(key, pipeline);
                     }
                 }
@@ -541,7 +545,7 @@ fn blend_state(blend: Blend) -> wgpu::BlendState {
     }
 }
 
-fn shading_pipeline(ctx: &FrameContext, key: PipelineKey) -> wgpu::RenderPipeline {
+fn shading_pipeline(ctx: &FrameContext, module: &SurfaceModule, key: PipelineKey) -> wgpu::RenderPipeline {
     let (blend, faces, depth, frame, material) = key;
     let constants = constants(&frame, &material);
     let cull_mode = match faces {
@@ -555,13 +559,13 @@ fn shading_pipeline(ctx: &FrameContext, key: PipelineKey) -> wgpu::RenderPipelin
     };
     ctx.device().create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("transparency::shading_pipeline"),
-        layout: Some(&ctx.shader.layout),
-        vertex: ctx.shader.vertex(),
+        layout: Some(&ctx.surface.layout),
+        vertex: module.vertex(),
         primitive: wgpu::PrimitiveState { cull_mode, ..Default::default() },
         depth_stencil: layout::depth_test(DEPTH_FORMAT, compare, false),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: &ctx.shader.module,
+            module: &module.module,
             entry_point: Some(match (blend, frame.inspect) {
                 (Blend::Transmit, _) => "fs_transparent_transmit",
                 (Blend::Add, false) => "fs_transparent_fresnel",
@@ -584,19 +588,19 @@ fn shading_pipeline(ctx: &FrameContext, key: PipelineKey) -> wgpu::RenderPipelin
 /// The depth-only pass of one peel: the farthest surviving fragment wins (`Greater`, cleared to 0).
 fn peel_pipeline(
     ctx: &FrameContext,
-    peel_layout: &wgpu::PipelineLayout,
+    (peel_layout, module): (&wgpu::PipelineLayout, &SurfaceModule),
     (frame, material): (FrameKey, MaterialKey),
 ) -> wgpu::RenderPipeline {
     let constants = constants(&frame, &material);
     ctx.device().create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some("transparency::peel_pipeline"),
         layout: Some(peel_layout),
-        vertex: ctx.shader.vertex(),
+        vertex: module.vertex(),
         primitive: wgpu::PrimitiveState { cull_mode: None, ..Default::default() },
         depth_stencil: layout::depth_test(DEPTH_FORMAT, wgpu::CompareFunction::Greater, true),
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
-            module: &ctx.shader.module,
+            module: &module.module,
             entry_point: Some("fs_peel"),
             compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             targets: &[],

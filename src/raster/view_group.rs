@@ -1,5 +1,5 @@
-//! The view group: what the shading of one view reads (group 2 of the scene module, declared
-//! in `shaders/view_group.wgsl`). One bind group per view, holding
+//! The view group: what the shading of one view reads (group 2 of every surface pass's
+//! module, declared in `shaders/common/view_group.wgsl`). One bind group per view, holding
 //!
 //! - the frame's inputs, the same in every view: the shadow maps and how to read them, the
 //!   environment maps;
@@ -31,7 +31,7 @@ pub enum Resource {
     LatlongMap,
     /// The view's own image.
     View(ViewImage),
-    /// An inspecting renderer's record of one pixel (`shaders/inspect.wgsl`).
+    /// An inspecting renderer's record of one pixel (`shaders/common/inspect.wgsl`).
     Inspection,
     /// The shadow maps read as floats, for the inspection's texel values.
     ShadowTexels,

@@ -31,7 +31,7 @@ use glam::{Mat4, UVec3, Vec3};
 
 use super::context::{Figure, FrameContext, FrameEncoder};
 use super::keys::{FrameKey, MaterialKey, constants, pipeline_constants};
-use super::scene_gpu::{SceneLayouts, SceneShader};
+use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::scene_pass::scissor;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
 use super::view::FrameView;
@@ -41,6 +41,7 @@ use crate::gpu::layout;
 use crate::gpu::uniform::UniformBuffer;
 use crate::scene::Scene;
 use crate::settings::{VOLUME_SAMPLES_WHITE, VolumeGradient, VolumeReconstruction, VolumeSettings, VolumeView};
+use crate::shaders;
 use crate::volume::transfer::TABLE_SIZE;
 use crate::volume::{Grid, Reconstruction, Rendering, Volume};
 
@@ -222,6 +223,8 @@ pub struct RaySpan<'a> {
 type PipelineKey = (FrameKey, VolumeKey, bool, bool);
 
 pub struct VolumePass {
+    /// `shaders/volume.wgsl` with the surface code.
+    module: SurfaceModule,
     group_layout: wgpu::BindGroupLayout,
     layout: wgpu::PipelineLayout,
     pipelines: HashMap<PipelineKey, wgpu::RenderPipeline>,
@@ -236,19 +239,19 @@ pub struct VolumePass {
 }
 
 impl VolumePass {
-    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SceneShader) -> VolumePass {
+    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SurfaceLayout) -> VolumePass {
         let depth = |binding| layout::depth_texels(binding, wgpu::TextureViewDimension::D2);
         let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("volume::group_layout"),
             entries: &[
                 depth(0),
                 depth(1),
-                depth(3),
-                layout::uniform(4, wgpu::ShaderStages::VERTEX_FRAGMENT),
-                layout::texture(5, wgpu::TextureSampleType::Float { filterable: true }, wgpu::TextureViewDimension::D3),
-                layout::sampler(6, wgpu::SamplerBindingType::Filtering),
+                depth(2),
+                layout::uniform(3, wgpu::ShaderStages::VERTEX_FRAGMENT),
+                layout::texture(4, wgpu::TextureSampleType::Float { filterable: true }, wgpu::TextureViewDimension::D3),
+                layout::sampler(5, wgpu::SamplerBindingType::Filtering),
                 layout::texture(
-                    7,
+                    6,
                     wgpu::TextureSampleType::Float { filterable: false },
                     wgpu::TextureViewDimension::D2,
                 ),
@@ -264,6 +267,7 @@ impl VolumePass {
             })
         };
         VolumePass {
+            module: SurfaceModule::new(device, "volume::shader", shaders::VOLUME),
             group_layout,
             layout,
             pipelines: HashMap::new(),
@@ -281,7 +285,7 @@ impl VolumePass {
     }
 
     fn pipeline(&mut self, ctx: &FrameContext, key: PipelineKey) {
-        let layout = &self.layout;
+        let (layout, module) = (&self.layout, &self.module);
         self.pipelines.entry(key).or_insert_with(|| {
             let (frame, volume, isosurface, mirrored) = key;
             let mut constants = constants(&frame, &MaterialKey::default());
@@ -301,7 +305,7 @@ impl VolumePass {
                 label: Some("volume::pipeline"),
                 layout: Some(layout),
                 vertex: wgpu::VertexState {
-                    module: &ctx.shader.module,
+                    module: &module.module,
                     entry_point: Some("vs_volume"),
                     compilation_options: wgpu::PipelineCompilationOptions {
                         constants: &constants,
@@ -317,7 +321,7 @@ impl VolumePass {
                     .flatten(),
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
-                    module: &ctx.shader.module,
+                    module: &module.module,
                     entry_point: Some(match (isosurface, frame.inspect) {
                         (true, false) => "fs_volume_isosurface",
                         (false, false) => "fs_volume_composite",
@@ -410,11 +414,11 @@ impl PreparedVolumes<'_> {
             entries: &[
                 texture(0, depth),
                 texture(1, far),
-                texture(3, near),
-                wgpu::BindGroupEntry { binding: 4, resource: gpu.uniform.binding() },
-                texture(5, &gpu.field),
-                wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::Sampler(sampler) },
-                texture(7, &gpu.table),
+                texture(2, near),
+                wgpu::BindGroupEntry { binding: 3, resource: gpu.uniform.binding() },
+                texture(4, &gpu.field),
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::Sampler(sampler) },
+                texture(6, &gpu.table),
             ],
         })
     }

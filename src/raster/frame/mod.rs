@@ -27,7 +27,7 @@ use super::mirror::pass::{MirrorPass, volumes as mirror_volumes};
 use super::overlays::{FRUSTUM_COLOUR, Overlays, WIREFRAME_COLOUR, box_edges};
 use super::present::PresentPass;
 use super::refraction::{PreparedRefraction, RefractionPass};
-use super::scene_gpu::{DrawnAlone, SceneGpu, SceneLayouts, SceneShader};
+use super::scene_gpu::{DrawnAlone, SceneGpu, SceneLayouts, SurfaceLayout};
 use super::scene_pass::{MirrorImages, PreparedScene, ScenePass};
 use super::shadow::projected::ProjectedPass;
 use super::shadow::{ShadowMaps, ShadowPass};
@@ -48,7 +48,7 @@ use plan::{FramePlan, plan};
 pub struct Renderer {
     pub layouts: SceneLayouts,
     pub mipmaps: MipmapGenerator,
-    shader: SceneShader,
+    surface: SurfaceLayout,
     scene_gpu: SceneGpu,
     shadow: ShadowPass,
     projected: ProjectedPass,
@@ -97,18 +97,18 @@ impl Renderer {
     fn build(gpu: &Gpu, scene: &Scene, output_format: wgpu::TextureFormat, inspect: bool) -> Renderer {
         let device = &gpu.device;
         let layouts = SceneLayouts::new(device, inspect);
-        let shader = SceneShader::new(device, &layouts);
+        let surface = SurfaceLayout::new(device, &layouts);
         let mipmaps = MipmapGenerator::new(device);
         let mut mirrors = MirrorPass::default();
         let mut environment = EnvironmentPass::new(device);
-        let mut volumes = VolumePass::new(device, &layouts, &shader);
+        let mut volumes = VolumePass::new(device, &layouts, &surface);
         let scene_gpu = load(gpu, scene, (&layouts, &mipmaps), (&mut mirrors, &mut environment, &mut volumes));
         Renderer {
             shadow: ShadowPass::new(device, &layouts),
             projected: ProjectedPass::new(device, &layouts),
-            scene: ScenePass::new(device, &layouts, &shader),
-            refraction: RefractionPass::new(device, &layouts, &shader),
-            transparency: TransparencyPass::new(device, &layouts, &shader),
+            scene: ScenePass::new(device, &layouts, &surface),
+            refraction: RefractionPass::new(device, &layouts, &surface),
+            transparency: TransparencyPass::new(device, &layouts, &surface),
             overlays: Overlays::new(device, &layouts),
             present: PresentPass::new(device, output_format),
             scene_gpu,
@@ -116,7 +116,7 @@ impl Renderer {
             mirrors,
             environment,
             mipmaps,
-            shader,
+            surface,
             layouts,
             view_groups: ViewGroups::default(),
             inspector: inspect.then(|| Inspector::new(device)),
@@ -203,7 +203,7 @@ impl Renderer {
             scene,
             scene_gpu: &self.scene_gpu,
             settings,
-            shader: &self.shader,
+            surface: &self.surface,
             view_groups: &self.view_groups,
         };
         let phases = Phases {

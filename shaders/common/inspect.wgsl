@@ -1,5 +1,6 @@
 // Inspecting one pixel (`mirador explain`, the viewer's inspect mode; src/raster/inspect.rs):
-// composed last into the scene module. Under INSPECT the shading functions of scene.wgsl,
+// composed into every surface module before surface.wgsl; each pass's file has its own
+// `*_inspect` entry points. Under INSPECT the shading functions of scene.wgsl,
 // transparency.wgsl and volume.wgsl also fill `probe`, a private record of what they computed
 // (each term, each light's visibility and shadow-map lookup, the texture's level, the bumped
 // normal, the reflections); the `*_inspect` entry points, drawn only in the main view of an
@@ -130,78 +131,3 @@ fn inspect_record(kind: u32, clip: vec4f, radiance: vec3f) {
     }
 }
 
-@fragment
-fn fs_scene_inspect(in: VertexOut) -> @location(0) vec4f {
-    probe.object = in.object;
-    let out = scene_fragment(in);
-    inspect_record(INSPECT_OPAQUE, in.clip, out.rgb);
-    return out;
-}
-
-@fragment
-fn fs_mirror_inspect(in: VertexOut) -> @location(0) vec4f {
-    probe.object = in.object;
-    let out = mirror_fragment(in);
-    inspect_record(INSPECT_MIRROR, in.clip, out.rgb);
-    return out;
-}
-
-@fragment
-fn fs_transparent_inspect(in: VertexOut) -> @location(0) vec4f {
-    probe.object = in.object;
-    let out = transparent_fragment(in);
-    probe.alpha = out.a;
-    inspect_record(INSPECT_TRANSPARENT, in.clip, out.rgb);
-    return out;
-}
-
-@fragment
-fn fs_transparent_fresnel_inspect(in: VertexOut) -> @location(0) vec4f {
-    probe.object = in.object;
-    let out = transparent_fresnel_fragment(in);
-    probe.alpha = 1.0;
-    inspect_record(INSPECT_TRANSPARENT, in.clip, out.rgb);
-    return out;
-}
-
-@fragment
-fn fs_refraction_inspect(in: VertexOut) -> @location(0) vec4f {
-    probe.object = in.object;
-    let out = refraction_fragment(in);
-    inspect_record(INSPECT_REFRACTION, in.clip, out.rgb);
-    return out;
-}
-
-@fragment
-fn fs_background_inspect(in: BackgroundOut) -> @location(0) vec4f {
-    let out = background_fragment(in);
-    probe.object = 0xffffffffu;
-    if all(vec2u(in.clip.xy) == inspection.pixel) {
-        let index = atomicAdd(&inspection.count, 1u);
-        if index < MAX_INSPECTED {
-            probe.kind = INSPECT_BACKGROUND;
-            probe.depth = 1.0;
-            probe.material = 0xffffffffu;
-            probe.radiance = out.rgb;
-            inspection.fragments[index] = probe;
-        }
-    }
-    return out;
-}
-
-@fragment
-fn fs_volume_composite_inspect(in: VolumeVertex) -> @location(0) vec4f {
-    probe.object = 0xffffffffu;
-    let out = composite_fragment(in);
-    probe.alpha = out.a;
-    inspect_record(INSPECT_VOLUME, in.clip, out.rgb);
-    return out;
-}
-
-@fragment
-fn fs_volume_isosurface_inspect(in: VolumeVertex) -> IsosurfaceOut {
-    probe.object = 0xffffffffu;
-    let out = isosurface_fragment(in);
-    inspect_record(INSPECT_ISOSURFACE, vec4f(in.clip.xy, out.depth, 1.0), out.colour.rgb);
-    return out;
-}

@@ -1,10 +1,10 @@
-// The view group (group 2 of the scene module): what the shading of one view reads. One bind
+// The view group (group 2 of every surface pass's module): what the shading of one view reads. One bind
 // group per view (src/raster/view_group.rs, whose VIEW_GROUP table tests/layouts.rs checks
 // against these declarations binding by binding): the frame's shadow and environment maps, the
 // same in every view, and the images earlier phases of this view made for its shading (the
 // projected-shadow mask), so a technique that makes one shows in the main camera, every mirrored
 // camera and every cube face alike. An inspecting renderer adds bindings 11 and 12
-// (shaders/inspect.wgsl).
+// (shaders/common/inspect.wgsl).
 
 // The shadow pass's outputs and how to read them.
 @group(2) @binding(0) var<uniform> shadows: Shadows;
