@@ -137,6 +137,10 @@ fn shadow_acne_is_diagnosed_with_the_depths_that_show_it() {
     }
     let (x, explanation) = found.expect("some floor pixel shows acne with no bias");
     let diagnosis = explanation.diagnosis.as_deref().unwrap();
+    // Every cure the course teaches for acne.
+    for cure in ["shadows.depth_bias", "shadows.slope_bias", "shadows.normal_offset"] {
+        assert!(diagnosis.contains(cure), "{cure} missing from: {diagnosis}");
+    }
     let light = explanation.raster.lights.iter().find(|l| diagnosis.contains(&format!("`{}`", l.name))).unwrap();
     let shadow = light.shadow.as_ref().unwrap();
     let (stored, receiver) = (shadow.stored_depth.unwrap(), shadow.receiver_depth.unwrap());
@@ -375,4 +379,65 @@ fn refracting_glass_is_explained_with_its_path_and_fresnel() {
         assert!(term(&raster.terms, "refracted").radiance.max_element() > 0.0);
         assert!(diagnosis.contains("glass ball"), "{refraction:?}: {diagnosis}");
     }
+}
+
+/// Projected shadows (issue 35's case): on the back wall of the course's scene, a plane that
+/// receives the polygons, a pixel on the shadow's edge is named an edge, never "not a receiver";
+/// a pixel inside the shadow, where both renderers agree, gets no such sentence; and a box (no
+/// receiver) under a ball's shadow is named as not a receiver.
+#[test]
+fn projected_shadows_are_diagnosed_from_the_receiver_and_the_edge() {
+    let scene = common::load("scenes/course/shadows-methods.toml");
+    let mut settings = scene.settings.clone();
+    settings.shadows.method = mirador::settings::ShadowMethod::Projected;
+    let mut explainer = Explainer::new(common::gpu(), &scene, &settings).unwrap();
+    let edge = explainer.explain(common::gpu(), (197, 80)).unwrap();
+    let diagnosis = edge.diagnosis.as_deref().unwrap_or_default();
+    assert_eq!(edge.raster.surface.as_ref().and_then(|s| s.object.as_deref()), Some("back wall"));
+    assert!(
+        diagnosis.starts_with("On the edge of a projected shadow") && diagnosis.contains("`back wall`"),
+        "{diagnosis}"
+    );
+    assert!(!diagnosis.contains("not one"), "{diagnosis}");
+    let inside = explainer.explain(common::gpu(), (175, 90)).unwrap();
+    let lit = |e: &Explanation| e.raster.lights[0].visibility.max_element();
+    assert!(lit(&inside) < 0.01, "inside the shadow on the wall: V = {}", lit(&inside));
+    assert!(inside.diagnosis.as_deref().is_none_or(|d| !d.contains("projected")), "{:?}", inside.diagnosis);
+
+    let scene = parse(
+        r#"
+        [camera]
+        eye = [0, 4, 2]
+        center = [0, 0, 0]
+        fovy = 40
+        width = 64
+        height = 64
+        [materials.grey]
+        color = [0.8, 0.8, 0.8]
+        [[lights]]
+        type = "point"
+        position = [0, 6, 0]
+        [[objects]]
+        type = "box"
+        min = [-1, 0, -1]
+        max = [1, 0.5, 1]
+        material = "grey"
+        [[objects]]
+        type = "sphere"
+        center = [0.6, 1.5, 0.6]
+        radius = 0.3
+        material = "grey"
+        "#,
+    );
+    let mut settings = scene.settings.clone();
+    settings.shadows.method = mirador::settings::ShadowMethod::Projected;
+    // A pixel of the box's top inside the ball's shadow (the ball hides the light from it), but
+    // not behind the ball as the camera sees it.
+    let mut explainer = Explainer::new(common::gpu(), &scene, &settings).unwrap();
+    let found = (0..64).step_by(3).flat_map(|y| (0..64).step_by(3).map(move |x| (x, y))).find_map(|pixel| {
+        let e = explainer.explain(common::gpu(), pixel).unwrap();
+        e.diagnosis.filter(|d| d.contains("is not one"))
+    });
+    let diagnosis = found.expect("a pixel of the box in the ball's shadow is named as no receiver");
+    assert!(diagnosis.starts_with("Projected shadows fall only on `plane` receivers"), "{diagnosis}");
 }

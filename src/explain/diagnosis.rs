@@ -44,7 +44,7 @@ pub fn diagnose(scene: &Scene, settings: &RenderSettings, raster: &RasterSide, t
             seen(traced_object, rays.hit.is_none()),
         ));
     }
-    shadows(settings, raster, rays)
+    shadows(scene, settings, raster, rays)
         .or_else(|| refraction(scene, raster, rays))
         .or_else(|| transparency(settings, raster))
         .or_else(|| environment(raster, rays))
@@ -52,8 +52,46 @@ pub fn diagnose(scene: &Scene, settings: &RenderSettings, raster: &RasterSide, t
         .or_else(|| Some(largest(raster, trace)))
 }
 
+/// Projected shadows (object precision) seen differently from the shadow ray, from what is
+/// recorded: whether the surface is a `plane` (the only receivers the polygons are projected
+/// onto) and which way the two disagree. On a receiver, the polygons are the caster's
+/// tessellation projected, so they differ from the exact shape's shadow along its outline.
+fn projected(
+    scene: &Scene,
+    raster: &RasterSide,
+    (name, v_raster, v_traced): (&str, f32, f32),
+    occluder: Option<&crate::trace::explain::Hit>,
+) -> String {
+    let surface = raster.surface.as_ref().and_then(|s| s.object.as_deref());
+    let receiver = surface.is_some_and(|surface| {
+        scene.objects.iter().any(|o| o.name == surface && matches!(o.shape, crate::scene::Shape::Plane { .. }))
+    });
+    let by = occluder.and_then(|h| h.object.clone()).map_or(String::new(), |o| format!(" by `{o}`"));
+    let on = surface.map_or("this surface".to_string(), |s| format!("`{s}`"));
+    match (receiver, v_raster < v_traced) {
+        (false, false) => format!(
+            "Projected shadows fall only on `plane` receivers and {on} is not one: it gets no shadow from light `{name}`, \
+             though its shadow ray is blocked{by}."
+        ),
+        (false, true) => format!(
+            "Projected shadows: a shadow polygon of light `{name}` covers this point of {on}, but its shadow ray reaches \
+             the light."
+        ),
+        (true, false) => format!(
+            "On the edge of a projected shadow: {on} receives the polygons of light `{name}`, but none covers this pixel's \
+             centre (V = {v_raster:.2}) while its shadow ray is blocked{by} (V = {v_traced:.2}). The polygons are the \
+             caster's tessellation projected from the light, so their outline differs from the exact shape's shadow."
+        ),
+        (true, true) => format!(
+            "On the edge of a projected shadow: a polygon of light `{name}` covers this pixel's centre on {on} \
+             (V = {v_raster:.2}) where its shadow ray reaches the light (V = {v_traced:.2}). The polygons are the caster's \
+             tessellation projected from the light, so their outline differs from the exact shape's shadow."
+        ),
+    }
+}
+
 /// A light seen differently: acne, peter-panning, the map's reach or its texels.
-fn shadows(settings: &RenderSettings, raster: &RasterSide, rays: &RayNode) -> Option<String> {
+fn shadows(scene: &Scene, settings: &RenderSettings, raster: &RasterSide, rays: &RayNode) -> Option<String> {
     for light in &raster.lights {
         let traced = rays.lights.iter().find(|l| l.light == light.light)?;
         let (v_raster, v_traced) = (light.visibility.max_element(), traced.visibility.max_element());
@@ -70,17 +108,7 @@ fn shadows(settings: &RenderSettings, raster: &RasterSide, rays: &RayNode) -> Op
             ));
         };
         if lookup.method == "projected" {
-            return Some(if v_raster < v_traced {
-                format!(
-                    "Projected shadows: a shadow polygon of light `{name}` covers this point, but its shadow ray reaches the light."
-                )
-            } else {
-                format!(
-                    "Projected shadows fall only on `plane` receivers: this point gets none from light `{name}`, though its \
-                     shadow ray is blocked{}.",
-                    occluder.map_or(String::new(), |h| format!(" by `{}`", h.object.clone().unwrap_or_default()))
-                )
-            });
+            return Some(projected(scene, raster, (name, v_raster, v_traced), occluder));
         }
         let (Some(stored), Some(receiver), Some([tx, ty]), Some(layer)) =
             (lookup.stored_depth, lookup.receiver_depth, lookup.texel, lookup.layer)
@@ -101,8 +129,8 @@ fn shadows(settings: &RenderSettings, raster: &RasterSide, rays: &RayNode) -> Op
                 format!(
                     "Shadow acne: light `{name}` is shadowed by the shadow map ({depths}) but the shadow ray reaches the \
                      light: the surface shadows itself, its own depth resampled in the map lying {difference:.2e} in front \
-                     of it; raise shadows.depth_bias ({}) or shadows.normal_offset ({}).",
-                    settings.shadows.depth_bias, settings.shadows.normal_offset
+                     of it; raise shadows.depth_bias ({}), shadows.slope_bias ({}) or shadows.normal_offset ({}).",
+                    settings.shadows.depth_bias, settings.shadows.slope_bias, settings.shadows.normal_offset
                 )
             } else {
                 format!(

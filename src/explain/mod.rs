@@ -20,10 +20,9 @@ use serde::Serialize;
 use crate::gpu::Gpu;
 use crate::gpu::texture::GpuTexture;
 use crate::raster::inspect::{
-    GpuInspectFragment, INSPECT_BACKGROUND, INSPECT_ISOSURFACE, INSPECT_MIRROR, INSPECT_OPAQUE, INSPECT_REFRACTION,
-    INSPECT_TRANSPARENT, INSPECT_VOLUME, RasterPixel,
+    FrameFacts, GpuInspectFragment, INSPECT_BACKGROUND, INSPECT_ISOSURFACE, INSPECT_MIRROR, INSPECT_OPAQUE,
+    INSPECT_REFRACTION, INSPECT_TRANSPARENT, INSPECT_VOLUME, RasterPixel,
 };
-use crate::raster::shadow::views::shadow_layout_in;
 use crate::raster::uniforms::{UNKNOWN_OBJECT, transmittance};
 use crate::raster::{FrameTargets, OUTPUT_FORMAT, Renderer};
 use crate::scene::Scene;
@@ -373,7 +372,7 @@ fn raster_side(scene: &Scene, settings: &RenderSettings, pixel: &RasterPixel) ->
     }
     let mut terms = Vec::new();
     let surface_through = front[0];
-    let surface = kept.surface.map(|record| raster_surface(scene, settings, record, pixel.pixel));
+    let surface = kept.surface.map(|record| raster_surface(scene, settings, record, pixel));
     let mut lights = Vec::new();
     match kept.surface {
         Some(record) if record.kind == INSPECT_BACKGROUND => {
@@ -382,7 +381,7 @@ fn raster_side(scene: &Scene, settings: &RenderSettings, pixel: &RasterPixel) ->
         Some(record) => {
             let name = object_name(scene, record.object).unwrap_or_else(|| "isosurface".into());
             fragment_terms(scene, record, &name, surface_through, &mut terms);
-            lights = raster_lights(scene, settings, record);
+            lights = raster_lights(scene, settings, record, &pixel.facts);
         }
         None => terms.push(Term { name: "background colour".into(), radiance: surface_through * scene.background }),
     }
@@ -444,8 +443,9 @@ fn raster_surface(
     scene: &Scene,
     settings: &RenderSettings,
     record: &GpuInspectFragment,
-    pixel: (u32, u32),
+    pixel: &RasterPixel,
 ) -> RasterSurface {
+    let facts = &pixel.facts;
     let kind = match record.kind {
         INSPECT_MIRROR => "mirror",
         INSPECT_REFRACTION => "refraction",
@@ -457,16 +457,13 @@ fn raster_surface(
     let reflective =
         scene.materials.get(record.material as usize).is_some_and(|m| m.mirror > 0.0 || record.fresnel > 0.0);
     let looked_up = record.kind != INSPECT_MIRROR && record.env_direction != Vec3::ZERO;
-    let environment = (reflective && looked_up && !background).then(|| environment_lookup(scene, settings, record));
+    let environment = (reflective && looked_up && !background).then(|| environment_lookup(settings, record, facts));
     let mirror = (record.kind == INSPECT_MIRROR).then(|| {
+        // The plane the frame's mirrored camera was reflected about.
         let eye = scene.camera.eye;
-        let plane = crate::raster::mirror::find_mirrors(scene)
-            .0
-            .into_iter()
-            .find(|m| m.object as u32 == record.object)
-            .map(|m| m.plane);
+        let plane = facts.mirrors.iter().find(|(object, _)| *object as u32 == record.object).map(|(_, plane)| plane);
         let mirrored_eye = plane.map_or(eye, |p| eye - 2.0 * p.distance(eye) * p.normal);
-        MirrorLookup { mirrored_eye, texel: [pixel.0, pixel.1], radiance: record.mirror }
+        MirrorLookup { mirrored_eye, texel: [pixel.pixel.0, pixel.pixel.1], radiance: record.mirror }
     });
     RasterSurface {
         kind,
@@ -499,18 +496,16 @@ fn raster_surface(
     }
 }
 
-fn environment_lookup(scene: &Scene, settings: &RenderSettings, record: &GpuInspectFragment) -> EnvironmentLookup {
+fn environment_lookup(settings: &RenderSettings, record: &GpuInspectFragment, facts: &FrameFacts) -> EnvironmentLookup {
     use crate::settings::EnvironmentMap;
     let r = record.env_direction.normalize_or_zero();
     let env = &settings.environment;
     let dynamic = env.map == EnvironmentMap::Cube && env.dynamic && record.env_layer >= 0;
+    // The point the frame drew the object's cube from, and the bounds of its parallax proxy.
     let centre = dynamic
-        .then(|| {
-            (record.object != UNKNOWN_OBJECT)
-                .then(|| crate::raster::environment::object_centre(scene, record.object as usize).0)
-        })
+        .then(|| facts.cubes.iter().find(|(object, _)| *object as u32 == record.object).map(|(_, centre)| *centre))
         .flatten();
-    let read_along = match (centre, scene.bounds()) {
+    let read_along = match (centre, facts.bounds) {
         (Some(centre), Some(bounds)) => {
             crate::raster::environment::parallax_direction(env.parallax, bounds, record.world, r, centre).normalize()
         }
@@ -536,9 +531,15 @@ fn environment_lookup(scene: &Scene, settings: &RenderSettings, record: &GpuInsp
     EnvironmentLookup { direction: r, map, centre, read_along, texel, radiance: record.environment }
 }
 
-fn raster_lights(scene: &Scene, settings: &RenderSettings, record: &GpuInspectFragment) -> Vec<RasterLight> {
+fn raster_lights(
+    scene: &Scene,
+    settings: &RenderSettings,
+    record: &GpuInspectFragment,
+    facts: &FrameFacts,
+) -> Vec<RasterLight> {
     let shadows = &settings.shadows;
-    let layout = shadow_layout_in(scene, scene.bounds(), shadows);
+    // The lights' views the frame drew and read its shadows with.
+    let layout = &facts.lights;
     scene
         .lights
         .iter()

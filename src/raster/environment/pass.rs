@@ -22,6 +22,8 @@ pub struct EnvironmentPass {
     pub converter: Converter,
     /// The objects with a dynamic cube of their own, by cube (found by [`Self::load`]).
     pub objects: Vec<usize>,
+    /// Each of those objects and the point its cube is drawn from (set by [`Self::prepare`]).
+    centres: Vec<(usize, Vec3)>,
     /// The world's maps and the dynamic cubes: made at the first frame of a scene (their size is
     /// a setting) and again when `environment.cube_size` changes.
     maps: Option<EnvironmentMaps>,
@@ -40,7 +42,13 @@ pub struct CubeFace {
 
 impl EnvironmentPass {
     pub fn new(device: &wgpu::Device) -> EnvironmentPass {
-        EnvironmentPass { converter: Converter::new(device), objects: Vec::new(), maps: None, capture: None }
+        EnvironmentPass {
+            converter: Converter::new(device),
+            objects: Vec::new(),
+            centres: Vec::new(),
+            maps: None,
+            capture: None,
+        }
     }
 
     /// Finds the curved mirrors of `scene` (objects that are not `planar_mirrors`), in place of
@@ -76,6 +84,7 @@ impl EnvironmentPass {
         let maps = self.maps.as_mut().expect("made just above");
         let centres: Vec<Vec3> = self.objects.iter().map(|&object| object_centre(scene, object).0).collect();
         maps.set_proxy(env.parallax, bounds, &centres);
+        self.centres = self.objects.iter().copied().zip(centres).collect();
         let rotation = view_rotation(&scene.camera);
         let sphere_made = maps.prepare(&gpu.device, &gpu.queue, &self.converter, mipmaps, settings, rotation);
         let drawn = env.enabled && env.dynamic && env.map == EnvironmentMap::Cube;
@@ -108,6 +117,12 @@ impl EnvironmentPass {
             }));
         }
         faces
+    }
+
+    /// Each curved mirror's object and the point its cube is drawn from, as the last
+    /// [`Self::prepare`] set them.
+    pub fn centres(&self) -> &[(usize, Vec3)] {
+        &self.centres
     }
 
     /// The maps, once [`Self::prepare`] has made them.

@@ -22,7 +22,7 @@ use glam::Vec3;
 
 use super::context::{Figure, FrameContext, FrameEncoder, FrameReport};
 use super::environment::pass::EnvironmentPass;
-use super::inspect::{Inspector, RasterPixel};
+use super::inspect::{FrameFacts, Inspector, RasterPixel};
 use super::mirror::pass::{MirrorPass, volumes as mirror_volumes};
 use super::overlays::{FRUSTUM_COLOUR, Overlays, WIREFRAME_COLOUR, box_edges};
 use super::present::PresentPass;
@@ -179,9 +179,12 @@ impl Renderer {
         let targets = &*targets;
         let mut frame = FrameEncoder::new(gpu, self.profile);
         let mut plan = self.plan(gpu, scene, settings, size, &mut frame);
-        if let Some((inspector, pixel)) = self.inspector.as_ref().and_then(|i| Some((i, i.pixel?))) {
+        if let Some(inspector) = self.inspector.as_mut()
+            && let Some(pixel) = inspector.pixel
+        {
             inspector.begin(&gpu.queue, pixel);
             plan.main.key.inspect = true;
+            inspector.facts = facts(&plan, &self.mirrors, &self.environment, self.scene_gpu.geometry.bounds);
         }
         let layers = (&plan.maps, plan.first_shadow_slot);
         self.shadow.record(gpu, &mut frame, &self.scene_gpu, layers, &settings.shadows);
@@ -295,6 +298,23 @@ impl Renderer {
             self.overlays.record_lines(ctx, frame, main, &edges, FRUSTUM_COLOUR);
         }
         self.environment.record_view(frame, settings, targets);
+    }
+}
+
+/// What an inspected frame decided before it drew, for the explainer: the lights' views, the
+/// planes the main view's mirrored cameras were reflected about, the cubes' centres, the bounds.
+fn facts(
+    plan: &FramePlan,
+    mirrors: &MirrorPass,
+    environment: &EnvironmentPass,
+    bounds: Option<(Vec3, Vec3)>,
+) -> FrameFacts {
+    let seen = plan.mirror_nodes.iter().filter(|node| node.parent.is_none());
+    FrameFacts {
+        lights: plan.lights.clone(),
+        mirrors: seen.map(|node| (mirrors.mirrors[node.mirror].object, mirrors.mirrors[node.mirror].plane)).collect(),
+        cubes: environment.centres().to_vec(),
+        bounds,
     }
 }
 
