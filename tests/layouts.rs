@@ -445,3 +445,32 @@ fn the_view_group_table_is_the_wgsl_binding_by_binding() {
         assert!(mirador::raster::view_group::VIEW_GROUP.iter().any(|row| row.resource == resource), "{image:?}");
     }
 }
+
+/// Every kind of inspection record the WGSL writes (`INSPECT_*` of shaders/common/inspect.wgsl)
+/// is declared by exactly one pass (its `RECORDS`), with a name of its own: the explainer knows
+/// the kinds only through those declarations.
+#[test]
+fn every_inspection_record_kind_is_declared_once_by_its_pass() {
+    let modules = surface_modules();
+    let mut wgsl: Vec<(String, u32)> = modules[0]
+        .constants
+        .iter()
+        .filter_map(|(_, c)| c.name.clone())
+        .filter(|name| name.starts_with("INSPECT_"))
+        .map(|name| {
+            let code = constant(&modules, &name) as u32;
+            (name, code)
+        })
+        .collect();
+    wgsl.sort_by_key(|(_, code)| *code);
+    let kinds: Vec<_> = mirador::raster::frame::record_kinds().collect();
+    for (name, code) in &wgsl {
+        let declared = kinds.iter().filter(|k| k.code == *code).count();
+        assert_eq!(declared, 1, "{name} = {code} is declared by {declared} passes");
+    }
+    assert_eq!(kinds.len(), wgsl.len(), "a pass declares a kind the WGSL does not write");
+    let mut names: Vec<&str> = kinds.iter().map(|k| k.name).collect();
+    names.sort_unstable();
+    names.dedup();
+    assert_eq!(names.len(), kinds.len(), "each kind has a name of its own");
+}

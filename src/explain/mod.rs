@@ -19,9 +19,9 @@ use serde::Serialize;
 
 use crate::gpu::Gpu;
 use crate::gpu::texture::GpuTexture;
+use crate::raster::frame::record_kinds;
 use crate::raster::inspect::{
-    FrameFacts, GpuInspectFragment, INSPECT_BACKGROUND, INSPECT_ISOSURFACE, INSPECT_MIRROR, INSPECT_OPAQUE,
-    INSPECT_REFRACTION, INSPECT_TRANSPARENT, INSPECT_VOLUME, RasterPixel,
+    FrameFacts, GpuInspectFragment, INSPECT_MIRROR, INSPECT_REFRACTION, Part, RasterPixel, RecordKind,
 };
 use crate::raster::uniforms::{UNKNOWN_OBJECT, transmittance};
 use crate::raster::{FrameTargets, OUTPUT_FORMAT, Renderer};
@@ -294,22 +294,25 @@ struct Kept<'r> {
 /// nothing was; transparent fragments are blended where nearer than it, in draw order; with
 /// depth peeling each peel's shading pass draws every transparent fragment and keeps the one at
 /// its layer's depth (layers farthest first, `peel_layers` of them).
+/// The kind of a record, as the pass that wrote it declared it.
+fn kind_of(record: &GpuInspectFragment) -> Option<&'static RecordKind> {
+    record_kinds().find(|kind| kind.code == record.kind)
+}
+
 fn kept<'r>(scene: &Scene, settings: &RenderSettings, pixel: &'r RasterPixel) -> Kept<'r> {
     let records = &pixel.fragments;
-    let solid = |r: &&GpuInspectFragment| {
-        matches!(r.kind, INSPECT_OPAQUE | INSPECT_MIRROR | INSPECT_ISOSURFACE | INSPECT_REFRACTION)
-    };
+    let part = |r: &GpuInspectFragment| kind_of(r).map(|k| k.part);
     let surface = records
         .iter()
-        .filter(solid)
+        .filter(|r| part(r) == Some(Part::Surface))
         .min_by(|a, b| a.depth.total_cmp(&b.depth))
-        .or_else(|| records.iter().find(|r| r.kind == INSPECT_BACKGROUND));
-    let depth = surface.filter(|s| s.kind != INSPECT_BACKGROUND).map_or(1.0, |s| s.depth);
+        .or_else(|| records.iter().find(|r| part(r) == Some(Part::Background)));
+    let depth = surface.filter(|s| part(s) == Some(Part::Surface)).map_or(1.0, |s| s.depth);
     // The blend's `kt·Mt`: the material's constant, `(1 − F)·kt·Mt` for glass weighted by
     // Fresnel, or `1 − α` where a texture's alpha blends it per pixel
     // (`crate::raster::transparency`); a volume lets `1 − α` through.
     let lets_through = |r: &GpuInspectFragment| -> Vec3 {
-        if r.kind == INSPECT_VOLUME {
+        if part(r) == Some(Part::Composited) {
             return Vec3::splat(1.0 - r.alpha);
         }
         let material = &scene.materials[r.material as usize];
@@ -321,7 +324,7 @@ fn kept<'r>(scene: &Scene, settings: &RenderSettings, pixel: &'r RasterPixel) ->
             transmittance(material)
         }
     };
-    let transparent: Vec<&GpuInspectFragment> = records.iter().filter(|r| r.kind == INSPECT_TRANSPARENT).collect();
+    let transparent: Vec<&GpuInspectFragment> = records.iter().filter(|r| part(r) == Some(Part::Transparent)).collect();
     let peeled = settings.transparency.enabled && settings.transparency.sort == TransparencySort::Exact;
     let mut layers = Vec::new();
     if peeled && !transparent.is_empty() {
@@ -335,9 +338,9 @@ fn kept<'r>(scene: &Scene, settings: &RenderSettings, pixel: &'r RasterPixel) ->
         depths.truncate(passes);
         let mut seen = 0;
         for record in records {
-            match record.kind {
-                INSPECT_VOLUME => layers.push((record, lets_through(record))),
-                INSPECT_TRANSPARENT => {
+            match part(record) {
+                Some(Part::Composited) => layers.push((record, lets_through(record))),
+                Some(Part::Transparent) => {
                     let pass = seen / group;
                     seen += 1;
                     if depths.get(pass) == Some(&record.depth) {
@@ -349,9 +352,9 @@ fn kept<'r>(scene: &Scene, settings: &RenderSettings, pixel: &'r RasterPixel) ->
         }
     } else {
         for record in records {
-            let blended = match record.kind {
-                INSPECT_VOLUME => true,
-                INSPECT_TRANSPARENT => record.depth < depth,
+            let blended = match part(record) {
+                Some(Part::Composited) => true,
+                Some(Part::Transparent) => record.depth < depth,
                 _ => false,
             };
             if blended {
@@ -375,7 +378,7 @@ fn raster_side(scene: &Scene, settings: &RenderSettings, pixel: &RasterPixel) ->
     let surface = kept.surface.map(|record| raster_surface(scene, settings, record, pixel));
     let mut lights = Vec::new();
     match kept.surface {
-        Some(record) if record.kind == INSPECT_BACKGROUND => {
+        Some(record) if kind_of(record).is_some_and(|k| k.part == Part::Background) => {
             terms.push(Term { name: "the world (background)".into(), radiance: surface_through * record.radiance });
         }
         Some(record) => {
@@ -389,7 +392,8 @@ fn raster_side(scene: &Scene, settings: &RenderSettings, pixel: &RasterPixel) ->
     for (k, (record, through)) in kept.layers.iter().enumerate() {
         let weight = front[k + 1];
         let object = object_name(scene, record.object);
-        if record.kind == INSPECT_VOLUME {
+        let composited = kind_of(record).is_some_and(|k| k.part == Part::Composited);
+        if composited {
             terms.push(Term { name: "composited volume C".into(), radiance: weight * record.radiance });
         } else {
             let name = object.clone().or_else(|| material_name(scene, record.material)).unwrap_or_default();
@@ -397,13 +401,13 @@ fn raster_side(scene: &Scene, settings: &RenderSettings, pixel: &RasterPixel) ->
             fragment_terms(scene, record, &format!("{name} (transparent)"), weight * record.alpha, &mut terms);
         }
         layers.push(Layer {
-            kind: if record.kind == INSPECT_VOLUME { "volume" } else { "transparent" },
+            kind: kind_of(record).map_or("unknown", |k| k.name),
             object,
-            material: (record.kind != INSPECT_VOLUME).then(|| material_name(scene, record.material)).flatten(),
+            material: (!composited).then(|| material_name(scene, record.material)).flatten(),
             depth: record.depth,
             adds: record.radiance,
             lets_through: *through,
-            samples: (record.kind == INSPECT_VOLUME).then_some(record.samples as u32),
+            samples: composited.then_some(record.samples as u32),
         });
     }
     RasterSide { radiance: pixel.radiance, terms, surface, lights, layers }
@@ -433,9 +437,9 @@ fn fragment_terms(scene: &Scene, record: &GpuInspectFragment, name: &str, weight
         "environment map kps·MPS·L(r)".into()
     };
     push(reflection, record.environment);
-    push("planar mirror kps·MPS·L(r)".into(), record.mirror);
-    if record.kind == INSPECT_REFRACTION {
-        push("refracted (1 − F1)·kt·Mt·(Im2 + (1 − F2)·kt·Mt·L(t2))".into(), record.refracted);
+    // The light paths of the pass that drew it (a mirror's reflection, the refracted light).
+    for (term, radiance) in kind_of(record).map_or_else(Vec::new, |kind| (kind.terms)(record)) {
+        push(term.into(), radiance);
     }
 }
 
@@ -446,14 +450,8 @@ fn raster_surface(
     pixel: &RasterPixel,
 ) -> RasterSurface {
     let facts = &pixel.facts;
-    let kind = match record.kind {
-        INSPECT_MIRROR => "mirror",
-        INSPECT_REFRACTION => "refraction",
-        INSPECT_ISOSURFACE => "isosurface",
-        INSPECT_BACKGROUND => "background",
-        _ => "opaque",
-    };
-    let background = record.kind == INSPECT_BACKGROUND;
+    let kind = kind_of(record).map_or("unknown", |k| k.name);
+    let background = kind_of(record).is_some_and(|k| k.part == Part::Background);
     let reflective =
         scene.materials.get(record.material as usize).is_some_and(|m| m.mirror > 0.0 || record.fresnel > 0.0);
     let looked_up = record.kind != INSPECT_MIRROR && record.env_direction != Vec3::ZERO;

@@ -36,6 +36,38 @@ pub const INSPECT_ISOSURFACE: u32 = 5;
 pub const INSPECT_VOLUME: u32 = 6;
 pub const INSPECT_REFRACTION: u32 = 7;
 
+/// What the depth test and the blend do with a kind of record: how it takes part in the pixel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    /// A surface the z-buffer keeps when it is the nearest (`Less`).
+    Surface,
+    /// The world, drawn where no surface is.
+    Background,
+    /// Blended over the surface in draw order where nearer than it (one per layer when peeled),
+    /// letting `kt·Mt` (or `1 − α`) of what is behind through.
+    Transparent,
+    /// Composited over what is behind wherever it was drawn, letting `1 − α` through.
+    Composited,
+}
+
+/// A kind of record, declared by the pass whose `*_inspect` entry point writes it: its code
+/// (`INSPECT_*`), the name `mirador explain` gives it, how it takes part in the pixel, and the
+/// terms of its own light paths beyond the illumination model (each named as the course writes
+/// it). The frame lists every pass's kinds (`crate::raster::frame::record_kinds`); the explainer
+/// replays the depth test and the blend from `part` alone.
+#[derive(Clone, Copy, Debug)]
+pub struct RecordKind {
+    pub code: u32,
+    pub name: &'static str,
+    pub part: Part,
+    pub terms: fn(&GpuInspectFragment) -> Vec<(&'static str, Vec3)>,
+}
+
+/// No terms beyond the illumination model's (and the environment's, which every surface may add).
+pub fn no_terms(_: &GpuInspectFragment) -> Vec<(&'static str, Vec3)> {
+    Vec::new()
+}
+
 /// `InspectLight` of `shaders/common/inspect.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]

@@ -37,6 +37,7 @@ use std::collections::HashMap;
 
 use super::context::{Figure, FrameContext, FrameEncoder};
 use super::geometry::TransparentObject;
+use super::inspect::{GpuInspectFragment, INSPECT_REFRACTION, Part, RecordKind};
 use super::keys::{FrameKey, MaterialKey, constants, pipeline_constants};
 use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::scene_pass::scissor;
@@ -78,6 +79,16 @@ type Culled = wgpu::Face;
 
 type BackKey = (Culled, FrameKey, MaterialKey);
 type FrontKey = (Culled, Refraction, FrameKey, MaterialKey);
+
+/// The records the refraction pass's `*_inspect` entry point writes: glass that bends light, a
+/// surface the z-buffer keeps, with the light refracted through it.
+pub const RECORDS: [RecordKind; 1] =
+    [RecordKind { code: INSPECT_REFRACTION, name: "refraction", part: Part::Surface, terms: refraction_terms }];
+
+/// The light through the glass: `(1 − F1)·kt·Mt·(Im2 + (1 − F2)·kt·Mt·L(t2))`.
+fn refraction_terms(record: &GpuInspectFragment) -> Vec<(&'static str, glam::Vec3)> {
+    vec![("refracted (1 − F1)·kt·Mt·(Im2 + (1 − F2)·kt·Mt·L(t2))", record.refracted)]
+}
 
 pub struct RefractionPass {
     /// `shaders/refraction.wgsl` with the surface code.

@@ -22,7 +22,12 @@
 use std::collections::HashMap;
 use std::ops::Range;
 
+use glam::Vec3;
+
 use super::context::{FrameContext, FrameEncoder};
+use super::inspect::{
+    GpuInspectFragment, INSPECT_BACKGROUND, INSPECT_MIRROR, INSPECT_OPAQUE, Part, RecordKind, no_terms,
+};
 use super::keys::{FrameKey, MaterialKey, constants};
 use super::scene_gpu::{SceneGpu, SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
@@ -30,6 +35,19 @@ use super::uniforms::ALPHA_MASK;
 use super::view::{FrameView, ViewSlot};
 use crate::gpu::layout;
 use crate::shaders;
+
+/// The records the scene pass's `*_inspect` entry points write: opaque surfaces, planar mirrors
+/// with the reflection their mirrored camera drew, and the world where nothing is.
+pub const RECORDS: [RecordKind; 3] = [
+    RecordKind { code: INSPECT_OPAQUE, name: "opaque", part: Part::Surface, terms: no_terms },
+    RecordKind { code: INSPECT_MIRROR, name: "mirror", part: Part::Surface, terms: mirror_terms },
+    RecordKind { code: INSPECT_BACKGROUND, name: "background", part: Part::Background, terms: no_terms },
+];
+
+/// A planar mirror's term: `kps·MPS·L(r)`, `L(r)` read from its mirrored camera's image.
+fn mirror_terms(record: &GpuInspectFragment) -> Vec<(&'static str, Vec3)> {
+    vec![("planar mirror kps·MPS·L(r)", record.mirror)]
+}
 
 /// The depth test of a shading variant.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

@@ -62,6 +62,7 @@ use wgpu::util::DeviceExt;
 
 use super::context::{Figure, FrameContext, FrameEncoder};
 use super::geometry::{DrawListId, TransparentObject, build_mesh};
+use super::inspect::{INSPECT_TRANSPARENT, Part, RecordKind, no_terms};
 use super::keys::{FrameKey, MaterialKey, constants};
 use super::refraction::refracts;
 use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
@@ -128,6 +129,11 @@ enum Step {
     /// March the composited volumes (one, or all) over whole rays.
     Volumes(VolumeSet),
 }
+
+/// The records the transparency pass's `*_inspect` entry points write: a transparent surface's
+/// fragment, blended over what is behind it.
+pub const RECORDS: [RecordKind; 1] =
+    [RecordKind { code: INSPECT_TRANSPARENT, name: "transparent", part: Part::Transparent, terms: no_terms }];
 
 pub struct TransparencyPass {
     /// `shaders/transparency.wgsl` with the surface code.

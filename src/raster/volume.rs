@@ -30,6 +30,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, UVec3, Vec3};
 
 use super::context::{Figure, FrameContext, FrameEncoder};
+use super::inspect::{INSPECT_ISOSURFACE, INSPECT_VOLUME, Part, RecordKind, no_terms};
 use super::keys::{FrameKey, MaterialKey, constants, pipeline_constants};
 use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::scene_pass::scissor;
@@ -221,6 +222,13 @@ pub struct RaySpan<'a> {
 /// samples are shadowed, the rendering, whether the view is mirrored (its back faces are the
 /// other winding), and which limits bound the rays (far, near).
 type PipelineKey = (FrameKey, VolumeKey, bool, bool);
+
+/// The records the volume pass's `*_inspect` entry points write: an isosurface (a surface the
+/// z-buffer keeps) and a composited volume's colour along the ray.
+pub const RECORDS: [RecordKind; 2] = [
+    RecordKind { code: INSPECT_ISOSURFACE, name: "isosurface", part: Part::Surface, terms: no_terms },
+    RecordKind { code: INSPECT_VOLUME, name: "volume", part: Part::Composited, terms: no_terms },
+];
 
 pub struct VolumePass {
     /// `shaders/volume.wgsl` with the surface code.

@@ -29,6 +29,7 @@ use super::scene_panel;
 use super::scene_state::SceneState;
 use super::screen::{Composition, Presented, Screen, ViewImage};
 use super::script::Step;
+use super::seen::CursorDirection;
 use super::traced::TracedView;
 use super::ui::{self, Action, UiModel, UiOutput};
 use super::view_mode::{ViewMode, ViewState};
@@ -76,6 +77,8 @@ pub struct Viewer {
     print_probe: bool,
     /// The volume ray under the cursor, made before the UI, and the cursor the last UI saw.
     probe: CursorProbe,
+    /// The direction the environment is seen in under the cursor (the lat–long view's marker).
+    seen: CursorDirection,
     cursor: Option<Vec2>,
     /// The inspected pixel, and a pixel to inspect once the view has its size.
     inspection: Option<Inspection>,
@@ -142,6 +145,7 @@ impl Viewer {
             screenshot_waiting: None,
             print_probe: false,
             probe: CursorProbe::default(),
+            seen: CursorDirection::default(),
             cursor: None,
             inspection: None,
             inspect_next: None,
@@ -222,9 +226,11 @@ impl Viewer {
         self.run_script(&mut input)?;
         self.poll_file();
         self.traced.poll(&screen.egui);
-        // The volume ray under the cursor, made here so that the layout only draws it.
+        // The volume ray and the environment's direction under the cursor, made here so that the
+        // layout only draws them.
         let probe_at = self.probe_at();
         self.probe.update(&mut self.scene, &self.settings, probe_at);
+        self.seen.update(&mut self.scene, &self.settings, probe_at.map(|at| (at.pixel, at.size)));
 
         // The UI decides the 3D view's size and gathers input.
         let ui_start = Instant::now();
@@ -292,6 +298,7 @@ impl Viewer {
             notices: &self.notices,
             inspection: self.inspection.as_ref(),
             probe: self.probe.shown(),
+            seen: self.seen.shown(),
         };
         let full = screen.egui.run_ui(raw, |ui| output = ui::draw(ui, &mut model));
         (output, full)
@@ -364,8 +371,8 @@ impl Viewer {
         Ok(presented)
     }
 
-    /// When the next frame is due: at once while the camera moves or the volume probe is behind
-    /// the cursor; at the end of the settling time after a frame drawn below full scale (full
+    /// When the next frame is due: at once while the camera moves or the volume probe or the
+    /// lat–long marker is behind the cursor; at the end of the settling time after a frame drawn below full scale (full
     /// scale again); when egui animates; soon after a frame the surface was not ready for; else
     /// only when something happens.
     fn next_frame(
@@ -381,8 +388,10 @@ impl Viewer {
         // arrive a frame or two after they are asked for.
         let busy = self.traced.worker.busy() || self.raster.reading_back() || screen.screenshots_pending();
         let working = busy.then_some(now);
-        let probe = !self.probe.is_current(&self.scene, &self.settings, self.probe_at());
-        let at_once = (moved || probe).then_some(now);
+        let at = self.probe_at();
+        let behind = !self.probe.is_current(&self.scene, &self.settings, at)
+            || !self.seen.is_current(&self.scene, &self.settings, at.map(|at| (at.pixel, at.size)));
+        let at_once = (moved || behind).then_some(now);
         [at_once, settle, animation, retry, working].into_iter().flatten().min()
     }
 

@@ -38,6 +38,7 @@ pub mod scene_panel;
 pub mod scene_state;
 pub mod screen;
 pub mod script;
+pub mod seen;
 pub mod traced;
 pub mod ui;
 pub mod upscale;

@@ -11,6 +11,7 @@ use glam::{Vec2, Vec3};
 use super::camera_control::{CameraInput, Navigation};
 use super::hud::{self, FrameStats};
 use super::panel;
+use super::picking::SeenDirection;
 use super::scene_panel;
 use super::scene_state::SceneState;
 use super::traced::TracedView;
@@ -40,6 +41,8 @@ pub struct UiModel<'a> {
     pub inspection: Option<&'a super::inspect::Inspection>,
     /// The volume ray under the cursor, made by the frame before the layout.
     pub probe: Option<&'a volume_probe::Shown>,
+    /// The environment's direction under the cursor and its pixel, for the lat–long marker.
+    pub seen: Option<&'a (Vec2, SeenDirection)>,
 }
 
 /// Requests the UI makes of the frame.
@@ -311,9 +314,10 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     let cursor = response.hover_pos().map(|p| (p - rect.min) * ppp).map(|p| Vec2::new(p.x, p.y));
     let cursor = model.view.scripted_cursor.or(cursor);
     if model.view.mode == ViewMode::Raster
-        && let Some(pixel) = cursor
+        && cursor.is_some()
+        && let Some(&(pixel, seen)) = model.seen
     {
-        latlong_marker(&painter, model, rect, ppp, pixel);
+        latlong_marker(&painter, model, (rect, ppp), (pixel, seen));
     }
     if let Some(inspection) = model.inspection {
         super::inspect::draw(&painter, inspection, &model.scene.scene.camera, (rect, ppp));
@@ -372,28 +376,24 @@ fn camera_input(ui: &egui::Ui, response: &egui::Response, rect: Rect, ppp: f32, 
 /// The colour of the lat–long view's marker: no sky, ground or environment map is magenta.
 pub const MARKER_COLOUR: Color32 = Color32::from_rgb(255, 0, 255);
 
-/// On the inset lat–long view (`environment.view = "latlong"`, `environment.inset`), marks the
-/// direction the environment is seen in at view pixel `pixel`: the reflected direction of the
-/// surface there, or the view ray over the background. The map is the world's, in world
-/// coordinates, so the mark lands where the mirror reads it (a dynamic cube reads the same
-/// direction from its own images).
-fn latlong_marker(painter: &egui::Painter, model: &mut UiModel, rect: Rect, ppp: f32, pixel: Vec2) {
-    use crate::settings::EnvironmentView;
-    let env = &model.settings.environment;
-    if env.view != EnvironmentView::Latlong || !env.inset {
-        return;
-    }
+/// On the inset lat–long view (`environment.view = "latlong"`, `environment.inset`), marks `seen`,
+/// the direction the environment is seen in at view pixel `pixel` (found before the layout,
+/// `super::seen`): the reflected direction of the surface there, or the view ray over the
+/// background. The map is the world's, in world coordinates, so the mark lands where the mirror
+/// reads it (a dynamic cube reads the same direction from its own images).
+fn latlong_marker(
+    painter: &egui::Painter,
+    model: &UiModel,
+    (rect, ppp): (Rect, f32),
+    (pixel, seen): (Vec2, SeenDirection),
+) {
     let size = ((rect.width() * ppp).round() as u32, (rect.height() * ppp).round() as u32);
-    if pixel.x < 0.0 || pixel.y < 0.0 || pixel.x >= size.0 as f32 || pixel.y >= size.1 as f32 {
-        return;
-    }
     let [x, y, w, h] = crate::raster::environment::view_rect(size, 2.0, true);
     let map = Rect::from_min_size(rect.min + egui::vec2(x, y) / ppp, egui::vec2(w, h) / ppp);
     let at = rect.min + egui::vec2(pixel.x, pixel.y) / ppp;
     if map.contains(at) {
         return;
     }
-    let seen = model.scene.seen_direction(pixel, size);
     let uv = crate::scene::environment::latlong_uv(seen.direction);
     let mark = map.min + egui::vec2(uv.x * map.width(), uv.y * map.height());
     let stroke = |width: f32, colour: Color32| egui::Stroke::new(width, colour);

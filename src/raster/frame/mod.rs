@@ -22,7 +22,7 @@ use glam::Vec3;
 
 use super::context::{Figure, FrameContext, FrameEncoder, FrameReport};
 use super::environment::pass::EnvironmentPass;
-use super::inspect::{FrameFacts, Inspector, RasterPixel};
+use super::inspect::{FrameFacts, Inspector, RasterPixel, RecordKind};
 use super::mirror::pass::{MirrorPass, volumes as mirror_volumes};
 use super::overlays::{FRUSTUM_COLOUR, Overlays, WIREFRAME_COLOUR, box_edges};
 use super::present::PresentPass;
@@ -347,6 +347,17 @@ fn record_view(
         Some(transparency) => transparency.record(ctx, frame, (view, targets), &mut composite),
         None => composite(frame, RaySpan { volumes: VolumeSet::All, near: None, far: None }),
     }
+}
+
+/// Every kind of inspection record the passes write, each declared by its pass.
+pub fn record_kinds() -> impl Iterator<Item = &'static RecordKind> {
+    let passes: [&'static [RecordKind]; 4] = [
+        &super::scene_pass::RECORDS,
+        &super::transparency::RECORDS,
+        &super::refraction::RECORDS,
+        &super::volume::RECORDS,
+    ];
+    passes.into_iter().flatten()
 }
 
 /// Uploads `scene` and lets each pass find what it keeps per scene: the planar mirrors, the
