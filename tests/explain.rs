@@ -441,3 +441,16 @@ fn projected_shadows_are_diagnosed_from_the_receiver_and_the_edge() {
     let diagnosis = found.expect("a pixel of the box in the ball's shadow is named as no receiver");
     assert!(diagnosis.starts_with("Projected shadows fall only on `plane` receivers"), "{diagnosis}");
 }
+
+/// A light behind the surface that adds nothing to it (`n·l ≤ 0`, no ambient term) is left out
+/// on both sides (issue 35: the rasterizer listed it with V = 0 from the shadow map, the tracer
+/// omitted it): here the `fill` light, shining down onto the left mirror's back.
+#[test]
+fn both_sides_list_the_same_lights() {
+    let scene = common::load("scenes/mirrors.toml");
+    let explanation = explained(&scene, &scene.settings, (150, 187));
+    let raster: Vec<&str> = explanation.raster.lights.iter().map(|l| l.name.as_str()).collect();
+    let traced: Vec<&str> = explanation.trace.lights.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(raster, traced);
+    assert_eq!(raster, ["key"], "the fill light lies behind the mirror's surface");
+}

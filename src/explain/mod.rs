@@ -5,9 +5,13 @@
 //! each light's visibility and shadow-map lookup, the texture's level, the bumped normal, the
 //! reflections, the transparent layers and volumes blended over the surface. This module works out
 //! which fragments the depth test and the blend kept, in which order, and writes the pixel's
-//! radiance as a sum of terms (each weighted by what the layers in front let through). The
-//! tracer's side is its ray tree (`crate::trace::explain`): every ray the pixel cast, each with
-//! the terms of its radiance. [`diagnosis`] names the technique behind a difference.
+//! radiance as a sum of terms (each weighted by what the layers in front let through). The passes
+//! say what their records are: each declares its kinds (`RECORDS`: the part each takes in the
+//! pixel and the terms of its own light paths), and turns a record into its evidence (the mirror's
+//! lookup, the refraction's path, the environment's and the shadow's lookups), read against what
+//! the frame decided before it drew (`crate::raster::frame::FrameFacts`), never decided again
+//! here. The tracer's side is its ray tree (`crate::trace::explain`): every ray the pixel cast,
+//! each with the terms of its radiance. [`diagnosis`] names the technique behind a difference.
 //!
 //! Used by `mirador explain`, the viewer's inspect mode and the tests.
 
@@ -19,14 +23,16 @@ use serde::Serialize;
 
 use crate::gpu::Gpu;
 use crate::gpu::texture::GpuTexture;
-use crate::raster::frame::record_kinds;
-use crate::raster::inspect::{
-    FrameFacts, GpuInspectFragment, INSPECT_MIRROR, INSPECT_REFRACTION, Part, RasterPixel, RecordKind,
-};
+pub use crate::raster::environment::EnvironmentLookup;
+use crate::raster::frame::{FrameFacts, record_kinds};
+use crate::raster::inspect::{GpuInspectFragment, INSPECT_MIRROR, INSPECT_REFRACTION, Part, RasterPixel, RecordKind};
+pub use crate::raster::mirror::MirrorLookup;
+pub use crate::raster::refraction::RefractionPath;
+pub use crate::raster::shadow::{ShadowLookup, constant_bias};
 use crate::raster::uniforms::{UNKNOWN_OBJECT, transmittance};
 use crate::raster::{FrameTargets, OUTPUT_FORMAT, Renderer};
-use crate::scene::Scene;
-use crate::settings::{Refraction, RenderSettings, ShadowMethod, TransparencySort};
+use crate::scene::{Light, Scene};
+use crate::settings::{RenderSettings, TransparencySort};
 use crate::trace::Tracer;
 use crate::trace::explain::{RayNode, RayTree, Term};
 
@@ -85,59 +91,12 @@ pub struct RasterSurface {
     pub fresnel: Option<f32>,
 }
 
-/// The path the refraction pass found through glass (`shaders/refraction.wgsl`).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct RefractionPath {
-    /// `environment` or `screen`.
-    pub mode: &'static str,
-    /// Where the ray leaves the glass, found against its back faces (`None`: not found, the
-    /// ray taken to go on unbent).
-    pub exit: Option<Vec3>,
-    /// The direction it leaves in, `t2`.
-    pub direction: Vec3,
-    /// Fresnel's `F` at the exit.
-    pub exit_fresnel: f32,
-    /// Where `L(t2)` was read: `the opaque image` or `the environment cube`.
-    pub source: &'static str,
-    /// `(1 − F1)·kt·Mt·(Im2 + (1 − F2)·kt·Mt·L(t2))`.
-    pub radiance: Vec3,
-}
-
 /// Bump mapping at the pixel: `k`, `Δ` and the slopes `(du, dv) = k·∇f_h`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Bump {
     pub k: f32,
     pub delta: Vec2,
     pub slopes: Vec2,
-}
-
-/// A curved mirror's environment lookup.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct EnvironmentLookup {
-    /// `r = 2(n·v)n − v`, the direction looked up.
-    pub direction: Vec3,
-    /// `cube (dynamic, object's centre)`, `cube (world)`, `sphere` or `latlong`.
-    pub map: String,
-    /// Where a dynamic cube was captured (its object's centre).
-    pub centre: Option<Vec3>,
-    /// The direction the map was read along: `r`, or for a dynamic cube with a local proxy
-    /// (`environment.parallax`) the direction from its centre to where `r` meets the proxy.
-    pub read_along: Vec3,
-    /// The cube face and texel (for cubes), or the map's texel coordinates.
-    pub texel: String,
-    /// `kps·MPS·L(r)`.
-    pub radiance: Vec3,
-}
-
-/// A planar mirror's lookup.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct MirrorLookup {
-    /// The mirrored camera's eye: the camera reflected about the mirror's plane.
-    pub mirrored_eye: Vec3,
-    /// The texel of the mirrored camera's image read: the pixel itself.
-    pub texel: [u32; 2],
-    /// `kps·MPS` times that texel.
-    pub radiance: Vec3,
 }
 
 /// A light at the raster surface.
@@ -149,27 +108,6 @@ pub struct RasterLight {
     pub visibility: Vec3,
     #[serde(flatten)]
     pub shadow: Option<ShadowLookup>,
-}
-
-/// What a shadow lookup read.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ShadowLookup {
-    /// `map` or `projected`.
-    pub method: &'static str,
-    pub layer: Option<u32>,
-    pub texel: Option<[u32; 2]>,
-    pub stored_depth: Option<f32>,
-    pub receiver_depth: Option<f32>,
-    /// The constant depth bias at the stored depth (`depth_bias` steps of the depth format's
-    /// resolution there); the slope-scaled part depends on the occluder's slope.
-    pub bias: Option<f32>,
-    /// The lookup point moved along the normal, in world units.
-    pub normal_offset: Option<f32>,
-    /// The filter's fraction of lit comparisons (1 − the mask for projected shadows).
-    pub lit: f32,
-    /// The map texel's four corners in the world, at the stored depth: where it lies on the
-    /// occluder (or the receiver) the light saw there.
-    pub footprint: Option<[Vec3; 4]>,
 }
 
 /// A transparent surface or a composited volume blended over what was behind it.
@@ -267,7 +205,7 @@ impl<'s> Explainer<'s> {
         let pixel = self.renderer.inspection(gpu, &self.targets).ok_or(ExplainError::Readback)?;
         let rays = trace_pixel(&self.tracer, (x, y));
         let trace = TraceSide { radiance: rays.radiance, terms: rays.terms.clone(), lights: rays.lights.clone(), rays };
-        let raster = raster_side(scene, settings, &pixel);
+        let raster = raster_side(scene, settings, (&pixel, self.renderer.facts()));
         let diagnosis = diagnosis::diagnose(scene, settings, &raster, &trace);
         Ok(Explanation { pixel: [x, y], raster, trace, diagnosis })
     }
@@ -366,7 +304,7 @@ fn kept<'r>(scene: &Scene, settings: &RenderSettings, pixel: &'r RasterPixel) ->
 }
 
 /// The rasterizer's side from its records.
-fn raster_side(scene: &Scene, settings: &RenderSettings, pixel: &RasterPixel) -> RasterSide {
+fn raster_side(scene: &Scene, settings: &RenderSettings, (pixel, facts): (&RasterPixel, &FrameFacts)) -> RasterSide {
     let kept = kept(scene, settings, pixel);
     // What the layers in front of each element let through, nearest last.
     let mut front = vec![Vec3::ONE; kept.layers.len() + 1];
@@ -375,7 +313,7 @@ fn raster_side(scene: &Scene, settings: &RenderSettings, pixel: &RasterPixel) ->
     }
     let mut terms = Vec::new();
     let surface_through = front[0];
-    let surface = kept.surface.map(|record| raster_surface(scene, settings, record, pixel));
+    let surface = kept.surface.map(|record| raster_surface(scene, settings, record, (pixel, facts)));
     let mut lights = Vec::new();
     match kept.surface {
         Some(record) if kind_of(record).is_some_and(|k| k.part == Part::Background) => {
@@ -384,7 +322,7 @@ fn raster_side(scene: &Scene, settings: &RenderSettings, pixel: &RasterPixel) ->
         Some(record) => {
             let name = object_name(scene, record.object).unwrap_or_else(|| "isosurface".into());
             fragment_terms(scene, record, &name, surface_through, &mut terms);
-            lights = raster_lights(scene, settings, record, &pixel.facts);
+            lights = raster_lights(scene, settings, record, facts);
         }
         None => terms.push(Term { name: "background colour".into(), radiance: surface_through * scene.background }),
     }
@@ -447,22 +385,17 @@ fn raster_surface(
     scene: &Scene,
     settings: &RenderSettings,
     record: &GpuInspectFragment,
-    pixel: &RasterPixel,
+    (pixel, facts): (&RasterPixel, &FrameFacts),
 ) -> RasterSurface {
-    let facts = &pixel.facts;
     let kind = kind_of(record).map_or("unknown", |k| k.name);
     let background = kind_of(record).is_some_and(|k| k.part == Part::Background);
     let reflective =
         scene.materials.get(record.material as usize).is_some_and(|m| m.mirror > 0.0 || record.fresnel > 0.0);
     let looked_up = record.kind != INSPECT_MIRROR && record.env_direction != Vec3::ZERO;
-    let environment = (reflective && looked_up && !background).then(|| environment_lookup(settings, record, facts));
-    let mirror = (record.kind == INSPECT_MIRROR).then(|| {
-        // The plane the frame's mirrored camera was reflected about.
-        let eye = scene.camera.eye;
-        let plane = facts.mirrors.iter().find(|(object, _)| *object as u32 == record.object).map(|(_, plane)| plane);
-        let mirrored_eye = plane.map_or(eye, |p| eye - 2.0 * p.distance(eye) * p.normal);
-        MirrorLookup { mirrored_eye, texel: [pixel.pixel.0, pixel.pixel.1], radiance: record.mirror }
-    });
+    let environment = (reflective && looked_up && !background)
+        .then(|| crate::raster::environment::lookup(record, settings, &facts.cubes, facts.bounds));
+    let mirror = (record.kind == INSPECT_MIRROR)
+        .then(|| crate::raster::mirror::lookup(record, &facts.mirrors, scene.camera.eye, pixel.pixel));
     RasterSurface {
         kind,
         object: if background { None } else { object_name(scene, record.object) },
@@ -482,51 +415,9 @@ fn raster_surface(
         }),
         environment,
         mirror,
-        refraction: (record.kind == INSPECT_REFRACTION).then(|| RefractionPath {
-            mode: if settings.transparency.refraction == Refraction::Screen { "screen" } else { "environment" },
-            exit: (record.refraction_found > 0.0).then_some(record.refraction_exit),
-            direction: record.refracted_direction,
-            exit_fresnel: record.fresnel_exit,
-            source: if record.refraction_source > 1.5 { "the opaque image" } else { "the environment cube" },
-            radiance: record.refracted,
-        }),
+        refraction: (record.kind == INSPECT_REFRACTION).then(|| crate::raster::refraction::path(record, settings)),
         fresnel: (record.fresnel > 0.0).then_some(record.fresnel),
     }
-}
-
-fn environment_lookup(settings: &RenderSettings, record: &GpuInspectFragment, facts: &FrameFacts) -> EnvironmentLookup {
-    use crate::settings::EnvironmentMap;
-    let r = record.env_direction.normalize_or_zero();
-    let env = &settings.environment;
-    let dynamic = env.map == EnvironmentMap::Cube && env.dynamic && record.env_layer >= 0;
-    // The point the frame drew the object's cube from, and the bounds of its parallax proxy.
-    let centre = dynamic
-        .then(|| facts.cubes.iter().find(|(object, _)| *object as u32 == record.object).map(|(_, centre)| *centre))
-        .flatten();
-    let read_along = match (centre, facts.bounds) {
-        (Some(centre), Some(bounds)) => {
-            crate::raster::environment::parallax_direction(env.parallax, bounds, record.world, r, centre).normalize()
-        }
-        _ => r,
-    };
-    let (map, texel) = match env.map {
-        EnvironmentMap::Cube => {
-            let size = env.cube_size as f32;
-            let (face, uv) = crate::scene::environment::cube_face_uv(read_along);
-            let faces = ["+X", "−X", "+Y", "−Y", "+Z", "−Z"];
-            let name = if dynamic { "cube (dynamic, captured at the object's centre)" } else { "cube (the world's)" };
-            (
-                name.to_string(),
-                format!("face {} texel ({}, {})", faces[face], (uv.x * size) as u32, (uv.y * size) as u32),
-            )
-        }
-        EnvironmentMap::Sphere => ("sphere map".to_string(), "in view space".to_string()),
-        EnvironmentMap::Latlong => {
-            let uv = crate::scene::environment::latlong_uv(r);
-            ("lat–long map".to_string(), format!("(u, v) = ({:.3}, {:.3})", uv.x, uv.y))
-        }
-    };
-    EnvironmentLookup { direction: r, map, centre, read_along, texel, radiance: record.environment }
 }
 
 fn raster_lights(
@@ -543,70 +434,23 @@ fn raster_lights(
         .iter()
         .enumerate()
         .take(record.lights.len())
+        .filter(|(_, light)| lights_the_surface(scene, settings, record, light))
         .map(|(index, light)| {
             let l = &record.lights[index];
             let casts = shadows.enabled && layout.first_layer.get(index).copied().flatten().is_some();
-            let shadow = casts.then(|| match shadows.method {
-                ShadowMethod::Projected => ShadowLookup {
-                    method: "projected",
-                    layer: None,
-                    texel: None,
-                    stored_depth: None,
-                    receiver_depth: None,
-                    bias: None,
-                    normal_offset: None,
-                    lit: l.lit,
-                    footprint: None,
-                },
-                ShadowMethod::Map => {
-                    let looked = l.layer >= 0;
-                    // A map texel's world size at the point: fixed for orthographic views, growing
-                    // with the distance from the light for perspective ones (as the lookup has it).
-                    let texel_size =
-                        looked.then(|| layout.views.get(l.layer as usize)).flatten().map(|view| {
-                            match light.position() {
-                                Some(position) if view.perspective => view.texel_size * position.distance(record.world),
-                                _ => view.texel_size,
-                            }
-                        });
-                    ShadowLookup {
-                        method: "map",
-                        layer: looked.then_some(l.layer as u32),
-                        texel: looked.then_some([l.texel.x as u32, l.texel.y as u32]),
-                        stored_depth: looked.then_some(l.stored_depth),
-                        receiver_depth: looked.then_some(l.receiver_depth),
-                        bias: looked.then(|| constant_bias(l.stored_depth, shadows.depth_bias)),
-                        normal_offset: texel_size.map(|t| shadows.normal_offset * t),
-                        lit: l.lit,
-                        footprint: looked.then(|| layout.views.get(l.layer as usize)).flatten().map(|view| {
-                            texel_footprint(view.clip_from_world, l.texel, l.stored_depth, shadows.map_size)
-                        }),
-                    }
-                }
-            });
+            let shadow = casts.then(|| crate::raster::shadow::lookup(light, l, record.world, layout, shadows));
             RasterLight { light: index, name: light.name.clone(), visibility: l.visibility, shadow }
         })
         .collect()
 }
 
-/// The world corners of texel `texel` of a `size`² shadow map whose light sees the world through
-/// `clip_from_world`, at depth `depth`.
-fn texel_footprint(clip_from_world: glam::Mat4, texel: Vec2, depth: f32, size: u32) -> [Vec3; 4] {
-    let world_from_clip = clip_from_world.inverse();
-    let corner = |dx: f32, dy: f32| {
-        let uv = (texel + Vec2::new(dx, dy)) / size as f32;
-        world_from_clip.project_point3(Vec3::new(2.0 * uv.x - 1.0, 1.0 - 2.0 * uv.y, depth))
-    };
-    [corner(0.0, 0.0), corner(1.0, 0.0), corner(1.0, 1.0), corner(0.0, 1.0)]
-}
-
-/// The constant part of the hardware depth bias at depth `z` for a 32-bit float depth buffer:
-/// `steps` times the spacing of floats at `z`, `2^(⌊log2 z⌋ − 23)`.
-pub fn constant_bias(z: f32, steps: i32) -> f32 {
-    if z <= 0.0 {
-        return 0.0;
-    }
-    steps as f32 * (2.0f32).powi(z.log2().floor() as i32 - 23)
+/// Whether `light` adds anything to the surface of `record`: it faces it (`n·l > 0`), or it lights
+/// it with its ambient term. The tracer leaves out the same lights (no shadow ray is cast for
+/// them), so both sides list the same ones.
+fn lights_the_surface(scene: &Scene, settings: &RenderSettings, record: &GpuInspectFragment, light: &Light) -> bool {
+    let Some(incidence) = light.incidence(record.world) else { return false };
+    let ambient = scene.materials.get(record.material as usize).is_some_and(|m| m.ka != 0.0) && settings.terms.ambient;
+    incidence.l.dot(record.normal) > 0.0 || ambient
 }
 
 /// The ray-traced pixel's tree, for callers with a tracer of their own.

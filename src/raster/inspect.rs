@@ -10,8 +10,8 @@
 //! level and footprint, bump mapping's slopes, the reflections. Records come in the order the
 //! fragments were drawn. Fragment shaders that write to storage run before the depth test (late
 //! depth), so records of fragments the depth test then rejected are there too; [`RasterPixel`]
-//! says which were blended (`crate::explain` reads them), and [`FrameFacts`] what the frame
-//! decided before it drew (the lights' views, the mirrors' planes, the cubes' centres).
+//! says which were blended (`crate::explain` reads them); the frame keeps what it decided before
+//! it drew (`crate::raster::frame::FrameFacts`).
 //!
 //! Other views (mirrored cameras, cube faces) draw with the plain variants, and frames that
 //! inspect nothing never compile the `INSPECT` variants: normal frames pay nothing.
@@ -19,8 +19,6 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
-use super::mirror::MirrorPlane;
-use super::shadow::views::ShadowLayout;
 use super::uniforms::MAX_LIGHTS;
 use crate::gpu::Gpu;
 
@@ -139,22 +137,6 @@ const HEAD: u64 = std::mem::size_of::<GpuInspectionHead>() as u64;
 const RECORD: u64 = std::mem::size_of::<GpuInspectFragment>() as u64;
 const SIZE: u64 = HEAD + MAX_INSPECTED as u64 * RECORD;
 
-/// What the inspected frame decided before it drew, as its passes used it: the explainer reads
-/// these instead of deciding them again, so what it says is about the frame that was drawn.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct FrameFacts {
-    /// Every shadowed light's views, as the shadow uniform described them (the shadow maps'
-    /// layers, or the channels of the projected mask).
-    pub lights: ShadowLayout,
-    /// The planar mirrors the main view drew with a mirrored camera: each one's object and the
-    /// plane its camera was reflected about.
-    pub mirrors: Vec<(usize, MirrorPlane)>,
-    /// The dynamic environment cubes: each one's object and the point its faces were drawn from.
-    pub cubes: Vec<(usize, Vec3)>,
-    /// The box around the drawn geometry (the shadow fit's and the parallax proxies' bounds).
-    pub bounds: Option<(Vec3, Vec3)>,
-}
-
 /// What the rasterizer computed at one pixel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RasterPixel {
@@ -166,8 +148,6 @@ pub struct RasterPixel {
     /// [`MAX_INSPECTED`] are dropped; `dropped` counts them).
     pub fragments: Vec<GpuInspectFragment>,
     pub dropped: u32,
-    /// What the frame decided before it drew them.
-    pub facts: FrameFacts,
 }
 
 /// The inspection buffer, bound in the lighting group of an inspecting renderer.
@@ -176,8 +156,6 @@ pub struct Inspector {
     readback: wgpu::Buffer,
     /// The pixel inspected by the next frames.
     pub pixel: Option<(u32, u32)>,
-    /// What the last inspected frame decided.
-    pub facts: FrameFacts,
 }
 
 impl Inspector {
@@ -194,7 +172,7 @@ impl Inspector {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Inspector { buffer, readback, pixel: None, facts: FrameFacts::default() }
+        Inspector { buffer, readback, pixel: None }
     }
 
     /// Clears the records before a frame that inspects `pixel`.
@@ -253,6 +231,6 @@ impl Inspector {
         };
         texel.unmap();
         let dropped = head.count.saturating_sub(MAX_INSPECTED as u32);
-        Some(RasterPixel { pixel, radiance, fragments, dropped, facts: self.facts.clone() })
+        Some(RasterPixel { pixel, radiance, fragments, dropped })
     }
 }

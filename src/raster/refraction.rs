@@ -37,6 +37,9 @@ use std::collections::HashMap;
 
 use super::context::{Figure, FrameContext, FrameEncoder};
 use super::geometry::TransparentObject;
+use glam::Vec3;
+use serde::Serialize;
+
 use super::inspect::{GpuInspectFragment, INSPECT_REFRACTION, Part, RecordKind};
 use super::keys::{FrameKey, MaterialKey, constants, pipeline_constants};
 use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
@@ -85,8 +88,38 @@ type FrontKey = (Culled, Refraction, FrameKey, MaterialKey);
 pub const RECORDS: [RecordKind; 1] =
     [RecordKind { code: INSPECT_REFRACTION, name: "refraction", part: Part::Surface, terms: refraction_terms }];
 
+/// The path the refraction pass found through glass (`shaders/refraction.wgsl`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RefractionPath {
+    /// `environment` or `screen`.
+    pub mode: &'static str,
+    /// Where the ray leaves the glass, found against its back faces (`None`: not found, the
+    /// ray taken to go on unbent).
+    pub exit: Option<Vec3>,
+    /// The direction it leaves in, `t2`.
+    pub direction: Vec3,
+    /// Fresnel's `F` at the exit.
+    pub exit_fresnel: f32,
+    /// Where `L(t2)` was read: `the opaque image` or `the environment cube`.
+    pub source: &'static str,
+    /// `(1 − F1)·kt·Mt·(Im2 + (1 − F2)·kt·Mt·L(t2))`.
+    pub radiance: Vec3,
+}
+
+/// The path a refraction record took through the glass, for `mirador explain`.
+pub fn path(record: &GpuInspectFragment, settings: &RenderSettings) -> RefractionPath {
+    RefractionPath {
+        mode: if settings.transparency.refraction == Refraction::Screen { "screen" } else { "environment" },
+        exit: (record.refraction_found > 0.0).then_some(record.refraction_exit),
+        direction: record.refracted_direction,
+        exit_fresnel: record.fresnel_exit,
+        source: if record.refraction_source > 1.5 { "the opaque image" } else { "the environment cube" },
+        radiance: record.refracted,
+    }
+}
+
 /// The light through the glass: `(1 − F1)·kt·Mt·(Im2 + (1 − F2)·kt·Mt·L(t2))`.
-fn refraction_terms(record: &GpuInspectFragment) -> Vec<(&'static str, glam::Vec3)> {
+fn refraction_terms(record: &GpuInspectFragment) -> Vec<(&'static str, Vec3)> {
     vec![("refracted (1 − F1)·kt·Mt·(Im2 + (1 − F2)·kt·Mt·L(t2))", record.refracted)]
 }
 

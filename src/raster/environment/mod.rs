@@ -29,6 +29,9 @@ use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 pub mod pass;
 
+use serde::Serialize;
+
+use super::inspect::GpuInspectFragment;
 use super::targets::HDR_FORMAT;
 use super::uniforms::{
     ENV_CUBE, ENV_LATLONG, ENV_NONE, ENV_SKY, ENV_SPHERE, GpuEnvironment, PARALLAX_BOX, PARALLAX_GROUND,
@@ -774,6 +777,64 @@ pub fn capture_key(scene: &Scene, settings: &RenderSettings) -> u64 {
     };
     format!("{settings:?}").hash(&mut hasher);
     hasher.finish()
+}
+
+/// A curved mirror's environment lookup.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EnvironmentLookup {
+    /// `r = 2(n·v)n − v`, the direction looked up.
+    pub direction: Vec3,
+    /// `cube (dynamic, object's centre)`, `cube (world)`, `sphere` or `latlong`.
+    pub map: String,
+    /// Where a dynamic cube was captured (its object's centre).
+    pub centre: Option<Vec3>,
+    /// The direction the map was read along: `r`, or for a dynamic cube with a local proxy
+    /// (`environment.parallax`) the direction from its centre to where `r` meets the proxy.
+    pub read_along: Vec3,
+    /// The cube face and texel (for cubes), or the map's texel coordinates.
+    pub texel: String,
+    /// `kps·MPS·L(r)`.
+    pub radiance: Vec3,
+}
+
+/// What a curved mirror's record looked up, for `mirador explain`: the direction, the map and its
+/// texel, and for a dynamic cube where the frame drew it from (`cubes`, by object) and the
+/// direction read along through the parallax proxy (around `bounds`).
+pub fn lookup(
+    record: &GpuInspectFragment,
+    settings: &RenderSettings,
+    cubes: &[(usize, Vec3)],
+    bounds: Option<(Vec3, Vec3)>,
+) -> EnvironmentLookup {
+    let r = record.env_direction.normalize_or_zero();
+    let env = &settings.environment;
+    let dynamic = env.map == EnvironmentMap::Cube && env.dynamic && record.env_layer >= 0;
+    // The point the frame drew the object's cube from, and the bounds of its parallax proxy.
+    let centre = dynamic
+        .then(|| cubes.iter().find(|(object, _)| *object as u32 == record.object).map(|(_, centre)| *centre))
+        .flatten();
+    let read_along = match (centre, bounds) {
+        (Some(centre), Some(bounds)) => parallax_direction(env.parallax, bounds, record.world, r, centre).normalize(),
+        _ => r,
+    };
+    let (map, texel) = match env.map {
+        EnvironmentMap::Cube => {
+            let size = env.cube_size as f32;
+            let (face, uv) = crate::scene::environment::cube_face_uv(read_along);
+            let faces = ["+X", "−X", "+Y", "−Y", "+Z", "−Z"];
+            let name = if dynamic { "cube (dynamic, captured at the object's centre)" } else { "cube (the world's)" };
+            (
+                name.to_string(),
+                format!("face {} texel ({}, {})", faces[face], (uv.x * size) as u32, (uv.y * size) as u32),
+            )
+        }
+        EnvironmentMap::Sphere => ("sphere map".to_string(), "in view space".to_string()),
+        EnvironmentMap::Latlong => {
+            let uv = crate::scene::environment::latlong_uv(r);
+            ("lat–long map".to_string(), format!("(u, v) = ({:.3}, {:.3})", uv.x, uv.y))
+        }
+    };
+    EnvironmentLookup { direction: r, map, centre, read_along, texel, radiance: record.environment }
 }
 
 #[cfg(test)]

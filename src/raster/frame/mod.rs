@@ -22,7 +22,8 @@ use glam::Vec3;
 
 use super::context::{Figure, FrameContext, FrameEncoder, FrameReport};
 use super::environment::pass::EnvironmentPass;
-use super::inspect::{FrameFacts, Inspector, RasterPixel, RecordKind};
+use super::inspect::{Inspector, RasterPixel, RecordKind};
+use super::mirror::MirrorPlane;
 use super::mirror::pass::{MirrorPass, volumes as mirror_volumes};
 use super::overlays::{FRUSTUM_COLOUR, Overlays, WIREFRAME_COLOUR, box_edges};
 use super::present::PresentPass;
@@ -30,6 +31,7 @@ use super::refraction::{PreparedRefraction, RefractionPass};
 use super::scene_gpu::{DrawnAlone, SceneGpu, SceneLayouts, SurfaceLayout};
 use super::scene_pass::{MirrorImages, PreparedScene, ScenePass};
 use super::shadow::projected::ProjectedPass;
+use super::shadow::views::ShadowLayout;
 use super::shadow::{ShadowMaps, ShadowPass};
 use super::targets::{FrameTargets, drawn_size};
 use super::transparency::{PreparedTransparency, TransparencyPass};
@@ -43,6 +45,22 @@ use crate::scene::Scene;
 use crate::settings::{MirrorView, RenderSettings};
 use crate::volume::WIREFRAME_CELLS;
 use plan::{FramePlan, plan};
+
+/// What the inspected frame decided before it drew, as its passes used it: the explainer reads
+/// these instead of deciding them again, so what it says is about the frame that was drawn.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FrameFacts {
+    /// Every shadowed light's views, as the shadow uniform described them (the shadow maps'
+    /// layers, or the channels of the projected mask).
+    pub lights: ShadowLayout,
+    /// The planar mirrors the main view drew with a mirrored camera: each one's object and the
+    /// plane its camera was reflected about.
+    pub mirrors: Vec<(usize, MirrorPlane)>,
+    /// The dynamic environment cubes: each one's object and the point its faces were drawn from.
+    pub cubes: Vec<(usize, Vec3)>,
+    /// The box around the drawn geometry (the shadow fit's and the parallax proxies' bounds).
+    pub bounds: Option<(Vec3, Vec3)>,
+}
 
 /// The passes, built once per device and output format, and the scene they draw.
 pub struct Renderer {
@@ -65,6 +83,8 @@ pub struct Renderer {
     view_groups: ViewGroups,
     /// Where an inspecting renderer records what its shaders computed at one pixel.
     inspector: Option<Inspector>,
+    /// What the last inspected frame decided before it drew.
+    facts: FrameFacts,
     /// Submit and time each pass on its own (`render --stats`): slower, but it says where the
     /// frame's time goes.
     pub profile: bool,
@@ -120,6 +140,7 @@ impl Renderer {
             layouts,
             view_groups: ViewGroups::default(),
             inspector: inspect.then(|| Inspector::new(device)),
+            facts: FrameFacts::default(),
             profile: false,
         }
     }
@@ -136,6 +157,12 @@ impl Renderer {
     /// the frame's.
     pub fn inspection(&self, gpu: &Gpu, targets: &FrameTargets) -> Option<RasterPixel> {
         self.inspector.as_ref()?.read(gpu, &targets.hdr.texture)
+    }
+
+    /// What the last inspected frame decided before it drew: what the explainer reads instead of
+    /// deciding it again.
+    pub fn facts(&self) -> &FrameFacts {
+        &self.facts
     }
 
     /// Loads `scene` in place of the last one: uploads it, and every pass forgets what it kept of
@@ -184,7 +211,7 @@ impl Renderer {
         {
             inspector.begin(&gpu.queue, pixel);
             plan.main.key.inspect = true;
-            inspector.facts = facts(&plan, &self.mirrors, &self.environment, self.scene_gpu.geometry.bounds);
+            self.facts = facts(&plan, &self.mirrors, &self.environment, self.scene_gpu.geometry.bounds);
         }
         let layers = (&plan.maps, plan.first_shadow_slot);
         self.shadow.record(gpu, &mut frame, &self.scene_gpu, layers, &settings.shadows);

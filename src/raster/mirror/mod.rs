@@ -39,7 +39,10 @@
 
 use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
+use serde::Serialize;
+
 use super::geometry::{build_mesh, instance_of};
+use super::inspect::GpuInspectFragment;
 use super::view::View;
 
 pub mod pass;
@@ -366,6 +369,31 @@ fn fit_plane(triangles: &[[Vec3; 3]], normals: Vec3) -> Result<PlaneFit, NotPlan
         corners: [at(lo.x, lo.y), at(hi.x, lo.y), at(hi.x, hi.y), at(lo.x, hi.y)],
         area: twice_area / 2.0,
     })
+}
+
+/// A planar mirror's lookup.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MirrorLookup {
+    /// The mirrored camera's eye: the camera reflected about the mirror's plane.
+    pub mirrored_eye: Vec3,
+    /// The texel of the mirrored camera's image read: the pixel itself.
+    pub texel: [u32; 2],
+    /// `kps·MPS` times that texel.
+    pub radiance: Vec3,
+}
+
+/// What a mirror record read, for `mirador explain`: the texel of its mirrored camera's image
+/// (the pixel itself) and that camera's eye, reflected about the plane the frame used (`planes`,
+/// the main view's mirrors by object).
+pub fn lookup(
+    record: &GpuInspectFragment,
+    planes: &[(usize, MirrorPlane)],
+    eye: Vec3,
+    pixel: (u32, u32),
+) -> MirrorLookup {
+    let plane = planes.iter().find(|(object, _)| *object as u32 == record.object).map(|(_, plane)| plane);
+    let mirrored_eye = plane.map_or(eye, |p| eye - 2.0 * p.distance(eye) * p.normal);
+    MirrorLookup { mirrored_eye, texel: [pixel.0, pixel.1], radiance: record.mirror }
 }
 
 #[cfg(test)]

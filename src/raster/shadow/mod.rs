@@ -31,9 +31,12 @@ pub mod projected;
 pub mod views;
 
 use bytemuck::{Pod, Zeroable};
+use glam::{Vec2, Vec3};
+use serde::Serialize;
 
 use super::context::{Figure, FrameEncoder};
 use super::geometry::DrawListId;
+use super::inspect::GpuInspectLight;
 use super::scene_gpu::{SceneGpu, SceneLayouts, VERTEX_BUFFERS};
 use super::targets::DEPTH_FORMAT;
 use super::uniforms::ALPHA_MASK;
@@ -41,7 +44,8 @@ use super::view::{View, ViewSlot};
 use crate::gpu::texture::{GpuTexture, Layers};
 use crate::gpu::uniform::UniformBuffer;
 use crate::gpu::{Gpu, layout};
-use crate::settings::ShadowSettings;
+use crate::scene::Light;
+use crate::settings::{ShadowMethod, ShadowSettings};
 use crate::shaders;
 use views::{MAX_LAYERS, ShadowLayout};
 
@@ -402,4 +406,93 @@ fn vertex_state(module: &wgpu::ShaderModule) -> wgpu::VertexState<'_> {
         compilation_options: Default::default(),
         buffers: &VERTEX_BUFFERS,
     }
+}
+/// What a shadow lookup read.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ShadowLookup {
+    /// `map` or `projected`.
+    pub method: &'static str,
+    pub layer: Option<u32>,
+    pub texel: Option<[u32; 2]>,
+    pub stored_depth: Option<f32>,
+    pub receiver_depth: Option<f32>,
+    /// The constant depth bias at the stored depth (`depth_bias` steps of the depth format's
+    /// resolution there); the slope-scaled part depends on the occluder's slope.
+    pub bias: Option<f32>,
+    /// The lookup point moved along the normal, in world units.
+    pub normal_offset: Option<f32>,
+    /// The filter's fraction of lit comparisons (1 − the mask for projected shadows).
+    pub lit: f32,
+    /// The map texel's four corners in the world, at the stored depth: where it lies on the
+    /// occluder (or the receiver) the light saw there.
+    pub footprint: Option<[Vec3; 4]>,
+}
+
+/// What the shadow lookup of light `light` read at `world` (its record `l`), for `mirador
+/// explain`: for shadow maps the layer, texel, depths, bias and the texel's footprint on the
+/// occluder; for projected shadows the mask; both against the frame's own `layout`.
+pub fn lookup(
+    light: &Light,
+    l: &GpuInspectLight,
+    world: Vec3,
+    layout: &ShadowLayout,
+    settings: &ShadowSettings,
+) -> ShadowLookup {
+    match settings.method {
+        ShadowMethod::Projected => ShadowLookup {
+            method: "projected",
+            layer: None,
+            texel: None,
+            stored_depth: None,
+            receiver_depth: None,
+            bias: None,
+            normal_offset: None,
+            lit: l.lit,
+            footprint: None,
+        },
+        ShadowMethod::Map => {
+            let looked = l.layer >= 0;
+            // A map texel's world size at the point: fixed for orthographic views, growing
+            // with the distance from the light for perspective ones (as the lookup has it).
+            let texel_size =
+                looked.then(|| layout.views.get(l.layer as usize)).flatten().map(|view| match light.position() {
+                    Some(position) if view.perspective => view.texel_size * position.distance(world),
+                    _ => view.texel_size,
+                });
+            ShadowLookup {
+                method: "map",
+                layer: looked.then_some(l.layer as u32),
+                texel: looked.then_some([l.texel.x as u32, l.texel.y as u32]),
+                stored_depth: looked.then_some(l.stored_depth),
+                receiver_depth: looked.then_some(l.receiver_depth),
+                bias: looked.then(|| constant_bias(l.stored_depth, settings.depth_bias)),
+                normal_offset: texel_size.map(|t| settings.normal_offset * t),
+                lit: l.lit,
+                footprint: looked
+                    .then(|| layout.views.get(l.layer as usize))
+                    .flatten()
+                    .map(|view| texel_footprint(view.clip_from_world, l.texel, l.stored_depth, settings.map_size)),
+            }
+        }
+    }
+}
+
+/// The world corners of texel `texel` of a `size`² shadow map whose light sees the world through
+/// `clip_from_world`, at depth `depth`.
+fn texel_footprint(clip_from_world: glam::Mat4, texel: Vec2, depth: f32, size: u32) -> [Vec3; 4] {
+    let world_from_clip = clip_from_world.inverse();
+    let corner = |dx: f32, dy: f32| {
+        let uv = (texel + Vec2::new(dx, dy)) / size as f32;
+        world_from_clip.project_point3(Vec3::new(2.0 * uv.x - 1.0, 1.0 - 2.0 * uv.y, depth))
+    };
+    [corner(0.0, 0.0), corner(1.0, 0.0), corner(1.0, 1.0), corner(0.0, 1.0)]
+}
+
+/// The constant part of the hardware depth bias at depth `z` for a 32-bit float depth buffer:
+/// `steps` times the spacing of floats at `z`, `2^(⌊log2 z⌋ − 23)`.
+pub fn constant_bias(z: f32, steps: i32) -> f32 {
+    if z <= 0.0 {
+        return 0.0;
+    }
+    steps as f32 * (2.0f32).powi(z.log2().floor() as i32 - 23)
 }
