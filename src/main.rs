@@ -13,6 +13,8 @@ use mirador::gpu::texture::GpuTexture;
 use mirador::gpu::{Gpu, Stopwatch, readback};
 use mirador::linear_output::LinearImage;
 use mirador::raster::{FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer, drawn_size};
+use mirador::scene::SceneError;
+use mirador::scene::file::overrides;
 use mirador::settings::AntiAliasing;
 use mirador::trace::accel::AccelKind;
 use mirador::trace::{RadianceImage, RenderControl, Tracer};
@@ -109,7 +111,9 @@ struct SceneArgs {
     /// Image height in pixels (default: the scene camera's).
     #[arg(long)]
     height: Option<u32>,
-    /// Change a render setting, as a dotted key and a TOML value: `--set terms.specular=false`.
+    /// Change a render setting, as a dotted key and a TOML value: `--set terms.specular=false`; or
+    /// a value of the scene file: `camera.fovy=30`, `lights.0.intensity=0.5`, `materials.NAME.ks=0.8`,
+    /// `objects.NAME.center=[0, 1, 0]` (lights and objects by index or name), `world.ambient=[…]`.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
     /// Print the time of each step and what was traced.
@@ -122,6 +126,7 @@ struct ViewArgs {
     /// Scene file (TOML, or a .gltf/.glb/.obj/.ply model). Default: the built-in showcase.
     scene: Option<PathBuf>,
     /// Change a render setting, as a dotted key and a TOML value: `--set shadows.enabled=false`.
+    /// (The scene's own values, `camera.…` and the like, are edited in the panel.)
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
     /// Run this many frames (after the scripted steps), then exit. Scripted runs neither read
@@ -280,11 +285,29 @@ fn explain(args: SceneArgs, trace_args: TraceArgs, [x, y]: [u32; 2], json: Optio
 
 /// Loads the scene (or the built-in showcase), applies `--set` and the size options.
 fn prepare(args: &SceneArgs, clock: &mut Stopwatch) -> anyhow::Result<Scene> {
-    let mut scene = clock.time("scene load", || match &args.scene {
-        Some(path) => Scene::load(path),
-        None => Scene::showcase(),
+    // `camera.…`, `lights.…`, `materials.…`, `objects.…`, `world.…` and `settings.…` override the
+    // scene file's own values before it is read; any other key is a render setting.
+    let (overrides, settings): (Vec<String>, Vec<String>) =
+        args.set.iter().cloned().partition(|a| overrides::is_scene_override(a));
+    let mut scene = clock.time("scene load", || -> anyhow::Result<Scene> {
+        let path = args.scene.clone().unwrap_or_else(|| mirador::scene::builtin_path("showcase.toml"));
+        if overrides.is_empty() {
+            return Ok(Scene::load(&path)?);
+        }
+        let toml = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        if !toml {
+            bail!(
+                "--set {}: {} is a model file; scene overrides (camera, lights, materials, objects, world) need a \
+                 TOML scene: write one that names the model (docs/scene-format.md)",
+                overrides[0],
+                path.display()
+            );
+        }
+        let text =
+            mirador::files::read_to_string(&path).map_err(|source| SceneError::Io { path: path.clone(), source })?;
+        Ok(overrides::parse_with(&text, &path, &overrides)?)
     })?;
-    for assignment in &args.set {
+    for assignment in &settings {
         scene.settings.set(assignment).context("--set")?;
     }
     scene.camera.width = args.width.unwrap_or(scene.camera.width);

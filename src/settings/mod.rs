@@ -142,14 +142,17 @@ impl RenderSettings {
         let mut slot = &mut table;
         let parts: Vec<&str> = key.split('.').collect();
         let (last, path) = parts.split_last().expect("split always yields one part");
+        // An unknown name is answered with the names the section has.
+        let known = |table: &toml::Table| table.keys().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ");
         for part in path {
+            let names = known(slot);
             slot = match slot.get_mut(*part) {
                 Some(toml::Value::Table(inner)) => inner,
-                _ => return Err(rejected("no such settings section".into())),
+                _ => return Err(rejected(format!("no such settings section; the sections are {names}"))),
             };
         }
         if !slot.contains_key(*last) {
-            return Err(rejected("no such setting".into()));
+            return Err(rejected(format!("no such setting; this section has {}", known(slot))));
         }
         slot.insert(last.to_string(), value);
         let updated: RenderSettings = table.try_into().map_err(|e: toml::de::Error| rejected(e.message().into()))?;
@@ -184,7 +187,10 @@ mod tests {
         s.set("exposure = 2.5").unwrap();
         assert!(!s.terms.specular);
         assert_eq!(s.exposure, 2.5);
-        assert!(s.set("terms.glow=true").is_err());
+        let unknown = s.set("terms.glow=true").unwrap_err().to_string();
+        assert!(unknown.contains("`specular`"), "an unknown setting is answered with its section's: {unknown}");
+        let section = s.set("shadow.enabled=true").unwrap_err().to_string();
+        assert!(section.contains("`shadows`"), "an unknown section is answered with the sections: {section}");
         assert!(s.set("exposure=bright").is_err());
         assert!(s.set("exposure=-1").is_err());
         assert!(s.set("exposure").is_err());
