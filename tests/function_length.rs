@@ -6,6 +6,8 @@
 //! `"}"` or a `// {` does not end or open a body, and a lifetime `'a` is not a character. It is
 //! tested on a made-up source too, so it is known to fail on a function one line too long.
 
+mod common;
+
 use std::path::Path;
 
 /// The most lines a function may have.
@@ -149,28 +151,10 @@ fn too_long(source: &str, max: usize) -> Vec<Function> {
     functions(source).into_iter().filter(|f| f.lines > max).collect()
 }
 
-/// Every `.rs` file under `dir`.
-fn sources(dir: &Path) -> Vec<std::path::PathBuf> {
-    let mut files = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(dir) = stack.pop() {
-        for entry in std::fs::read_dir(&dir).expect("reading src") {
-            let path = entry.expect("a directory entry").path();
-            if path.is_dir() {
-                stack.push(path);
-            } else if path.extension().is_some_and(|e| e == "rs") {
-                files.push(path);
-            }
-        }
-    }
-    files.sort();
-    files
-}
-
 #[test]
 fn no_function_in_src_runs_over_100_lines() {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let files = sources(&src);
+    let files = common::rust_sources(&src);
     assert!(files.len() > 50, "found {} files", files.len());
     let mut long = Vec::new();
     let mut count = 0;

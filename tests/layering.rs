@@ -15,6 +15,8 @@
 //! Test code (`#[cfg(test)]` and after) is not read. The checker is tested on made-up files
 //! too, so it is known to fail on an import against the layers.
 
+mod common;
+
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
@@ -52,24 +54,16 @@ type Module = String;
 /// Every module of the source tree under `src` (but `main.rs`), with its source.
 fn modules(src: &Path) -> BTreeMap<Module, String> {
     let mut found = BTreeMap::new();
-    let mut stack = vec![src.to_path_buf()];
-    while let Some(dir) = stack.pop() {
-        for entry in std::fs::read_dir(&dir).expect("reading src") {
-            let path = entry.expect("a directory entry").path();
-            if path.is_dir() {
-                stack.push(path);
-            } else if path.extension().is_some_and(|e| e == "rs") {
-                let relative = path.strip_prefix(src).expect("under src").with_extension("");
-                let mut parts: Vec<String> = relative.iter().map(|p| p.to_string_lossy().into_owned()).collect();
-                if parts == ["main"] {
-                    continue;
-                }
-                if parts.last().is_some_and(|p| p == "mod" || p == "lib") {
-                    parts.pop();
-                }
-                found.insert(parts.join("::"), std::fs::read_to_string(&path).expect("reading a source file"));
-            }
+    for path in common::rust_sources(src) {
+        let relative = path.strip_prefix(src).expect("under src").with_extension("");
+        let mut parts: Vec<String> = relative.iter().map(|p| p.to_string_lossy().into_owned()).collect();
+        if parts == ["main"] {
+            continue;
         }
+        if parts.last().is_some_and(|p| p == "mod" || p == "lib") {
+            parts.pop();
+        }
+        found.insert(parts.join("::"), std::fs::read_to_string(&path).expect("reading a source file"));
     }
     found
 }

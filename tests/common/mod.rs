@@ -285,3 +285,21 @@ pub fn run_probe<I: bytemuck::Pod, O: bytemuck::Pod>(
     let view = staging.slice(..).get_mapped_range().expect("mapped above");
     bytemuck::cast_slice(&view).to_vec()
 }
+
+/// Every `.rs` file under `dir`, for the tests that read the source tree (its layers, its
+/// functions' lengths).
+pub fn rust_sources(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).expect("reading a source folder") {
+            let path = entry.expect("a directory entry").path();
+            if path.is_dir() {
+                stack.push(path);
+            } else if path.extension().is_some_and(|e| e == "rs") {
+                files.push(path);
+            }
+        }
+    }
+    files
+}
