@@ -317,3 +317,40 @@ fn set_overrides_the_scenes_own_values() {
         &bad,
     );
 }
+
+/// A course scene copied out of Mirador's tree still renders (issue 35): what it names is found
+/// in Mirador's own files when it is not beside the copy; a file found nowhere is named with
+/// every place looked, and nothing is written.
+#[test]
+fn a_copied_course_scene_renders_and_a_missing_file_names_every_place_looked() {
+    let dir = scratch("copied-scene");
+    for name in ["mipmaps-floor.toml", "acceleration-teapot.toml", "volume-phantom.toml"] {
+        let copy = dir.join(name);
+        std::fs::copy(asset(&format!("scenes/course/{name}")), &copy).unwrap();
+        let out = dir.join(name).with_extension("png");
+        let output = mirador(&[
+            "render",
+            copy.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--width",
+            "64",
+            "--height",
+            "36",
+        ]);
+        assert!(output.status.success(), "{name}: {}", stderr(&output));
+        assert!(out.exists(), "{name} rendered");
+    }
+    let bad = scratch("copied-scene-bad");
+    let text = std::fs::read_to_string(asset("scenes/course/mipmaps-floor.toml")).unwrap();
+    let scene = bad.join("scene.toml");
+    std::fs::write(&scene, text.replace("checker.png", "nothing.png")).unwrap();
+    let out = bad.join("x.png");
+    let output = mirador(&["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    std::fs::remove_file(&scene).unwrap();
+    assert_fails_cleanly(
+        &output,
+        &["nothing.png", "cannot open", "assets/textures/nothing.png", "looked beside the scene"],
+        &bad,
+    );
+}

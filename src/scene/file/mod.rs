@@ -5,6 +5,7 @@
 //! together (a sphere needs a radius, eye ≠ center) are reported at the table they belong to.
 //! Unknown fields are rejected. Paths are relative to the scene file.
 
+mod locate;
 pub mod overrides;
 mod volume;
 
@@ -650,12 +651,13 @@ impl<'a> Builder<'a> {
     }
 
     fn texture(&mut self, relative: &str, space: ColorSpace, span: Range<usize>) -> Result<TextureId, SceneError> {
-        let path = self.dir.join(relative);
+        let (path, looked) = locate::locate(&self.dir, relative);
         let key = (path.clone(), space == ColorSpace::Srgb);
         if let Some(&id) = self.texture_ids.get(&key) {
             return Ok(id);
         }
-        let texture = texture::load(&path, space).map_err(|e| self.error(e.to_string(), span))?;
+        let texture =
+            texture::load(&path, space).map_err(|e| self.error(locate::with_places(e.to_string(), &looked), span))?;
         let id = TextureId(self.scene.textures.len());
         self.scene.textures.push(texture);
         self.texture_ids.insert(key, id);
@@ -680,26 +682,32 @@ impl<'a> Builder<'a> {
                 "[world.environment] needs exactly one of `sky`, `latlong`, `cube`, `cross`, `sphere`; got {got}"
             )));
         }
-        // An image's own problems name the image; they are placed at the environment's table.
-        let place = |e: SceneError| fail(e.to_string());
+        // An image's own problems name the image; they are placed at the environment's table,
+        // with every place a missing one was looked for.
+        let mut looked = Vec::new();
+        let mut locate = |relative: &str| {
+            let (path, places) = locate::locate(&self.dir, relative);
+            looked.extend(places);
+            path
+        };
         let (source, path) = if let Some(sky) = d.sky {
-            (EnvironmentSource::Sky(self.sky(sky)?), None)
+            (Ok(EnvironmentSource::Sky(self.sky(sky)?)), None)
         } else if let Some(relative) = d.latlong {
-            let path = self.dir.join(relative);
-            (EnvironmentSource::LatLong(environment::load_latlong(&path).map_err(place)?), Some(path))
+            let path = locate(&relative);
+            (environment::load_latlong(&path).map(EnvironmentSource::LatLong), Some(path))
         } else if let Some(relatives) = d.cube {
-            let paths = relatives.map(|r| self.dir.join(r));
-            let faces = environment::load_cube(&paths).map_err(place)?;
-            (EnvironmentSource::Cube(faces), Some(paths[0].clone()))
+            let paths = relatives.map(|r| locate(&r));
+            (environment::load_cube(&paths).map(EnvironmentSource::Cube), Some(paths[0].clone()))
         } else if let Some(relative) = d.cross {
-            let path = self.dir.join(relative);
-            (EnvironmentSource::Cube(environment::load_cross(&path).map_err(place)?), Some(path))
+            let path = locate(&relative);
+            (environment::load_cross(&path).map(EnvironmentSource::Cube), Some(path))
         } else if let Some(relative) = d.sphere {
-            let path = self.dir.join(relative);
-            (EnvironmentSource::Sphere(environment::load_sphere(&path).map_err(place)?), Some(path))
+            let path = locate(&relative);
+            (environment::load_sphere(&path).map(EnvironmentSource::Sphere), Some(path))
         } else {
             unreachable!("exactly one source was checked above")
         };
+        let source = source.map_err(|e| fail(locate::with_places(e.to_string(), &looked)))?;
         Ok(Environment { source, intensity: d.intensity.map_or(1.0, |NonNegative(x)| x), path })
     }
 
@@ -852,7 +860,9 @@ impl<'a> Builder<'a> {
             }
             ObjectType::Gltf => {
                 let relative = d.path.ok_or_else(|| fail("a gltf object needs a `path`".into()))?;
-                let import = super::gltf::import(&self.dir.join(relative)).map_err(|e| fail(e.to_string()))?;
+                let (file, looked) = locate::locate(&self.dir, &relative);
+                let import =
+                    super::gltf::import(&file).map_err(|e| fail(locate::with_places(e.to_string(), &looked)))?;
                 let camera = d.camera.unwrap_or(false).then(|| import.cameras.first().cloned()).flatten();
                 add_model(&mut self.scene, import, world_from_local, d.lights.unwrap_or(true), &name, None);
                 return Ok(
@@ -862,12 +872,12 @@ impl<'a> Builder<'a> {
             ObjectType::Obj | ObjectType::Ply => {
                 let article = if d.kind == ObjectType::Obj { "an" } else { "a" };
                 let relative = d.path.ok_or_else(|| fail(format!("{article} {kind_name} object needs a `path`")))?;
-                let file = self.dir.join(relative);
+                let (file, looked) = locate::locate(&self.dir, &relative);
                 let import = match d.kind {
                     ObjectType::Obj => super::obj::import(&file),
                     _ => super::ply::import(&file),
                 };
-                let import = import.map_err(|e| fail(e.to_string()))?;
+                let import = import.map_err(|e| fail(locate::with_places(e.to_string(), &looked)))?;
                 let material = d.material.map(|m| self.named_material(m)).transpose()?;
                 add_model(&mut self.scene, import, world_from_local, false, &name, material);
                 return Ok(None);

@@ -184,13 +184,16 @@ impl Builder<'_> {
             if voxel_count(dims) <= MAX_VOXELS && voxel_count(dims) > room {
                 return Err(fail(too_many(voxel_count(dims))));
             }
-            let file = self.dir.join(&r.path);
-            let grid = read_raw(&file, &desc).map_err(|e| fail(format!("{}: {e}", file.display())))?;
+            let (file, looked) = super::locate::locate(&self.dir, &r.path);
+            let grid = read_raw(&file, &desc)
+                .map_err(|e| fail(super::locate::with_places(format!("{}: {e}", file.display()), &looked)))?;
             return Ok((grid, None));
         }
         let relative = d.path.as_ref().expect("one source is present");
-        let file = self.dir.join(relative);
-        let grid = read_nrrd(&file).map_err(|e| self.error(format!("{}: NRRD: {e}", file.display()), span.clone()))?;
+        let (file, looked) = super::locate::locate(&self.dir, relative);
+        let grid = read_nrrd(&file).map_err(|e| {
+            self.error(super::locate::with_places(format!("{}: NRRD: {e}", file.display()), &looked), span.clone())
+        })?;
         // A NRRD file's size bounds what reading it took; the sum is checked after.
         if grid.values.len() as u64 > room {
             return Err(self.error(too_many(grid.values.len() as u64), span));
