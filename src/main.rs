@@ -138,7 +138,8 @@ struct ViewArgs {
     screenshot: Option<PathBuf>,
     /// A scripted step, one per frame, in order: `set KEY=VALUE`, `view raster|traced|split|difference`,
     /// `split X`, `orbit DX DY`, `pan DX DY`, `zoom N`, `frame`, `reset`, `navigate orbit|fly`,
-    /// `walk X Y Z`, `pick X Y`, `cursor X Y`, `probe`, `material KEY=VALUE`, `load FILE`, `scale S`,
+    /// `walk X Y Z`, `pick X Y`, `cursor X Y`, `inspect X Y` (both renderers at that pixel, as the
+    /// I key and a click), `probe`, `material KEY=VALUE`, `load FILE`, `scale S`,
     /// `fps N|off`, `help on|off`, `panel on|off`, `overlay on|off`, `wait N`, `wait 2s`,
     /// `wait traced`, `measure`, `screenshot FILE.png`.
     #[arg(long = "step", value_name = "STEP", requires = "frames")]
@@ -304,7 +305,7 @@ fn prepare(args: &SceneArgs, clock: &mut Stopwatch) -> anyhow::Result<Scene> {
             );
         }
         let text =
-            mirador::files::read_to_string(&path).map_err(|source| SceneError::Io { path: path.clone(), source })?;
+            mirador::files::read_to_string(&path).map_err(|cause| SceneError::Io { path: path.clone(), cause })?;
         Ok(overrides::parse_with(&text, &path, &overrides)?)
     })?;
     for assignment in &settings {

@@ -87,6 +87,8 @@ fn a_missing_scene_is_named_and_nothing_is_written() {
     let out = dir.join("out.png");
     let output = mirador(&["render", "no/such/scene.toml", "-o", out.to_str().unwrap()]);
     assert_fails_cleanly(&output, &["no/such/scene.toml", "cannot read"], &dir);
+    let message = stderr(&output);
+    assert_eq!(message.matches("No such file or directory").count(), 1, "the cause said once: {message}");
 }
 
 #[test]

@@ -425,3 +425,20 @@ fn a_glass_sphere_with_transmission_1_is_traced_see_through() {
     let white = tracer.primary(pixels[0], &mut RayCounts::default());
     assert!((white - background).min_element() > 0.15, "kd = 1 would add a white diffuse ball: {white}");
 }
+
+/// A glTF 1.0 file, as JSON or as a version-1 GLB, is refused by its name, not by the shape of
+/// its JSON (issue 35).
+#[test]
+fn gltf_1_0_is_named_as_such() {
+    let json = br#"{"asset": {"version": "1.0"}, "meshes": {"mesh": {"primitives": []}}}"#;
+    let error = mirador::scene::gltf::import_bytes(Path::new("old.gltf"), json).unwrap_err().to_string();
+    assert!(error.contains("glTF 1.0 is not supported (2.0 is)"), "{error}");
+    let mut glb = b"glTF".to_vec();
+    glb.extend(1u32.to_le_bytes());
+    glb.extend(20u32.to_le_bytes());
+    glb.extend([0u8; 8]);
+    let error = mirador::scene::gltf::import_bytes(Path::new("old.glb"), &glb).unwrap_err().to_string();
+    assert!(error.contains("glTF 1.0 is not supported"), "{error}");
+    // 2.0 still reads.
+    load("two_nodes.gltf");
+}

@@ -1051,3 +1051,9 @@ fn the_example_in_the_documentation_loads() {
     assert_close3(ball.world_from_local.transform_point3(Vec3::ZERO), Vec3::new(0.0, 0.8, 0.0), "ball centre");
     assert_eq!(scene.materials[ball.material.0].name, "red");
 }
+
+/// A key given twice is named (issue 35: "duplicate key" alone did not say which).
+#[test]
+fn a_duplicate_key_is_named() {
+    assert_error_at(&lines(&["[camera]", "fovy = 45", "fovy = 50"]), 3, 1, &["duplicate key `fovy`"]);
+}

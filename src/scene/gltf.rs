@@ -238,7 +238,7 @@ pub fn import(path: &Path) -> Result<GltfImport, SceneError> {
     if path.as_os_str().is_empty() {
         return Err(SceneError::Gltf { path: path.to_path_buf(), message: "no file given (the path is empty)".into() });
     }
-    let bytes = super::read_file(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    let bytes = super::read_file(path).map_err(|cause| SceneError::Io { path: path.to_path_buf(), cause })?;
     import_bytes(path, &bytes)
 }
 
@@ -251,6 +251,7 @@ pub fn import_bytes(path: &Path, bytes: &[u8]) -> Result<GltfImport, SceneError>
 
 fn read(path: &Path, bytes: &[u8]) -> Result<GltfImport, String> {
     check_glb_header(bytes)?;
+    check_version(bytes)?;
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice_without_validation(bytes).map_err(describe_gltf_error)?;
     let mut json = document.into_json();
@@ -306,6 +307,23 @@ fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// glTF 1.0 (2015; a GLB of version 1, or `asset.version` "1.x") is a different format, which the
+/// reader would otherwise refuse with a message about the JSON's shape: say what it is.
+fn check_version(bytes: &[u8]) -> Result<(), String> {
+    const REFUSED: &str = "glTF 1.0 is not supported (2.0 is): convert the file, for example by opening \
+        it in Blender and exporting glTF 2.0";
+    if bytes.starts_with(b"glTF") {
+        let version = bytes.get(4..8).map_or(2, |v| u32::from_le_bytes([v[0], v[1], v[2], v[3]]));
+        return if version == 1 { Err(REFUSED.into()) } else { Ok(()) };
+    }
+    let json: Option<serde_json::Value> = serde_json::from_slice(bytes).ok();
+    let version = json.as_ref().and_then(|j| j.get("asset")?.get("version")?.as_str().map(str::to_owned));
+    match version {
+        Some(v) if v.starts_with("1.") || v == "1" => Err(REFUSED.into()),
+        _ => Ok(()),
+    }
 }
 
 /// The `gltf` crate's own validation indexes the accessor list with each primitive's `POSITION`

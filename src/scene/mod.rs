@@ -131,8 +131,10 @@ pub struct Scene {
 /// Why a scene could not be loaded. Every variant names the file it is about.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    #[error("{path}: cannot read the file: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    /// The cause is part of the message (and so not a `source` as well: error chains would print
+    /// it twice).
+    #[error("{path}: cannot read the file: {cause}")]
+    Io { path: PathBuf, cause: std::io::Error },
     #[error("{path}:{line}:{column}: {message}")]
     Syntax { path: PathBuf, line: usize, column: usize, message: String },
     #[error("{path}: {message}")]

@@ -102,7 +102,7 @@ pub fn import(path: &Path) -> Result<ModelImport, SceneError> {
     if path.as_os_str().is_empty() {
         return Err(SceneError::Obj { path: path.to_path_buf(), message: "no file given (the path is empty)".into() });
     }
-    let bytes = super::read_file(path).map_err(|source| SceneError::Io { path: path.to_path_buf(), source })?;
+    let bytes = super::read_file(path).map_err(|cause| SceneError::Io { path: path.to_path_buf(), cause })?;
     import_bytes(path, &bytes)
 }
 

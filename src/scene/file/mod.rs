@@ -37,15 +37,27 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         Some("ply") => return load_bare_model(path, super::ply::import(path)?),
         _ => {}
     }
-    let text = crate::files::read_to_string(path).map_err(|source| SceneError::Io { path: path.into(), source })?;
+    let text = crate::files::read_to_string(path).map_err(|cause| SceneError::Io { path: path.into(), cause })?;
     parse(&text, path)
 }
 
 /// Parses scene text; `path` names the file in messages and anchors relative paths.
 pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
-    let file: SceneFile = toml::from_str(text).map_err(|e| Located::new(e.message(), e.span()).at(path, text))?;
+    let file: SceneFile =
+        toml::from_str(text).map_err(|e| Located::new(syntax_message(&e, text), e.span()).at(path, text))?;
     let mut builder = Builder::new(path, text);
     builder.build(file)
+}
+
+/// The TOML reader's message, with the key named where it names none (`duplicate key` points at
+/// the key but does not say which).
+fn syntax_message(error: &toml::de::Error, text: &str) -> String {
+    let message = error.message();
+    let key = error.span().and_then(|span| text.get(span)).map(str::trim).filter(|k| !k.is_empty());
+    match key {
+        Some(key) if message == "duplicate key" => format!("duplicate key `{key}`"),
+        _ => message.to_string(),
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
