@@ -289,16 +289,29 @@ fn empty_objs_and_objs_without_faces_are_errors() {
     }
 }
 
+/// A missing MTL file or texture file inside a model from elsewhere is a warning naming it, and
+/// the model still shows, in the default material or without the texture (as Blender and
+/// three.js draw it; issue 35); a malformed MTL or a bad number stays an error, as does UTF-16.
 #[test]
-fn a_missing_mtl_or_texture_is_an_error_naming_it() {
+fn a_missing_mtl_or_texture_is_a_warning_and_a_broken_one_an_error() {
     let triangle = "mtllib looks.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl wood\nf 1 2 3\n";
-    obj_error("no-mtl", &[("model.obj", triangle.as_bytes())], &["mtllib `looks.mtl`", "cannot read"]);
-    let message = obj_error(
+    let path = write_files("no-mtl", &[("model.obj", triangle.as_bytes())]);
+    let import = load_obj(&path);
+    let warned = |import: &ModelImport, words: &[&str]| {
+        let found = import.warnings.iter().any(|w| words.iter().all(|word| w.contains(word)));
+        assert!(found, "no warning with {words:?}: {:?}", import.warnings);
+    };
+    warned(&import, &["mtllib `looks.mtl`", "cannot read", "default material"]);
+    assert_eq!(material(&import, &import.objects[0].name).name, obj::DEFAULT_MATERIAL);
+    let path = write_files(
         "no-texture",
-        &[("model.obj", triangle.as_bytes()), ("looks.mtl", b"newmtl wood\nKd 1 1 1\nmap_Kd textures/wood.png\n")],
-        &["material `wood`", "map_Kd", "wood.png"],
+        &[("model.obj", triangle.as_bytes()), ("looks.mtl", b"newmtl wood\nKd 1 0.5 0.25\nmap_Kd textures/wood.png\n")],
     );
-    assert!(message.contains("textures/wood.png"), "the texture's path: {message}");
+    let import = load_obj(&path);
+    warned(&import, &["material `wood`", "map_Kd", "textures/wood.png", "without it"]);
+    let wood = material(&import, &import.objects[0].name);
+    assert_eq!((wood.name.as_str(), wood.texture), ("wood", None), "the material, without its texture");
+    assert_eq!(wood.color, Vec3::new(1.0, 0.5, 0.25));
     obj_error(
         "bad-mtl",
         &[("model.obj", triangle.as_bytes()), ("looks.mtl", b"newmtl wood\nKd 1 1\n")],
@@ -309,6 +322,8 @@ fn a_missing_mtl_or_texture_is_an_error_naming_it() {
         &[("model.obj", triangle.as_bytes()), ("looks.mtl", b"newmtl wood\nKs nan 0 0\n")],
         &["material `wood`", "`Ks`"],
     );
+    let utf16: Vec<u8> = [0xFF, 0xFE].into_iter().chain(triangle.encode_utf16().flat_map(u16::to_le_bytes)).collect();
+    obj_error("utf16", &[("model.obj", &utf16)], &["UTF-16", "save it as UTF-8"]);
 }
 
 // ---------------------------------------------------------------------------------------------

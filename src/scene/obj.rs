@@ -77,9 +77,11 @@
 //! so is a face index that no statement backs (0, a relative index before the first statement, or
 //! one past the last): `tobj` computes offsets from the indices unchecked, and an index near 2⁶³
 //! overflowed inside it (found by fuzzing, `fuzz/`).
-//! An `mtllib` that cannot be read, a malformed MTL statement, and a texture that cannot be read or
-//! decoded are errors, as a missing buffer or image is for glTF: a model whose files are missing
-//! is broken, and saying so names the file to fix. A face referring to a vertex the file does not
+//! An `mtllib` file that is not there and a texture file that is not there are warnings (the
+//! materials drawn in the default material, the material without the texture), as Blender and
+//! three.js draw them: the warning names the file, and the model still shows. A malformed MTL
+//! statement, and a texture that is there but cannot be decoded, are errors: that file is
+//! broken, and saying so names it. A UTF-16 file is named as such. A face referring to a vertex the file does not
 //! have, and a file without a face to draw, are errors too.
 
 use std::cell::RefCell;
@@ -113,6 +115,10 @@ pub fn import_bytes(path: &Path, bytes: &[u8]) -> Result<ModelImport, SceneError
     if bytes.is_empty() {
         return Err(error("the file is empty".into()));
     }
+    // A text editor's "Unicode" is UTF-16, which no OBJ reader reads: say so, rather than "no faces".
+    if bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0xFE, 0xFF]) {
+        return Err(error("the file is UTF-16 text; OBJ is ASCII (save it as UTF-8 or ASCII)".into()));
+    }
     // OBJ is ASCII; old exporters write names and comments in Latin-1, which must not stop it.
     let text = String::from_utf8_lossy(bytes);
     super::without_panics(|| import_text(path, &text)).map_err(error)
@@ -140,6 +146,9 @@ fn import_text(path: &Path, text: &str) -> Result<ModelImport, String> {
         converted: HashMap::new(),
         textures: HashMap::new(),
     };
+    for missing in libraries.iter().filter_map(|l| l.missing.as_ref()) {
+        reader.warn(missing.clone());
+    }
     let known: Vec<&str> = materials.iter().map(|m| m.name.as_str()).collect();
     for (line, name) in &scan.usemtl {
         if !known.contains(&name.as_str()) {
@@ -317,21 +326,33 @@ struct Library {
     file: PathBuf,
     materials: usize,
     problem: Option<String>,
+    /// A library that could not be read at all: its materials are drawn in the default one, as
+    /// Blender and three.js draw them, and this says so.
+    missing: Option<String>,
 }
 
 /// `tobj`'s material loader: reads the library `name` relative to the OBJ file's folder, keeping
 /// the error (which `tobj` would reduce to "open file failed") for the message.
 fn read_library(dir: &Path, name: &Path, libraries: &RefCell<Vec<Library>>) -> tobj::MTLLoadResult {
     let file = dir.join(name);
-    let result = read_mtl(&file).map_err(|e| format!("mtllib `{}`: {e}", name.display()));
     let mut libraries = libraries.borrow_mut();
+    if let Err(e) = super::read_file(&file) {
+        let missing = format!(
+            "mtllib `{}`: cannot read {}: {e}; its materials are drawn in the default material",
+            name.display(),
+            file.display()
+        );
+        libraries.push(Library { file, materials: 0, problem: None, missing: Some(missing) });
+        return Ok((Vec::new(), HashMap::new()));
+    }
+    let result = read_mtl(&file).map_err(|e| format!("mtllib `{}`: {e}", name.display()));
     match result {
         Ok((materials, names)) => {
-            libraries.push(Library { file, materials: materials.len(), problem: None });
+            libraries.push(Library { file, materials: materials.len(), problem: None, missing: None });
             Ok((materials, names))
         }
         Err(problem) => {
-            libraries.push(Library { file, materials: 0, problem: Some(problem) });
+            libraries.push(Library { file, materials: 0, problem: Some(problem), missing: None });
             Err(tobj::LoadError::OpenFileFailed)
         }
     }
@@ -547,15 +568,15 @@ impl Reader<'_> {
 
         let mut wrap = None;
         let diffuse_map = match &m.diffuse_texture {
-            Some(statement) => Some(self.texture_statement(&name, "map_Kd", statement, &dir, ColorSpace::Srgb)?),
+            Some(statement) => self.texture_statement(&name, "map_Kd", statement, &dir, ColorSpace::Srgb)?,
             None => None,
         };
         let bump_map = match &m.normal_texture {
-            Some(statement) => Some(self.texture_statement(&name, "bump", statement, &dir, ColorSpace::Linear)?),
+            Some(statement) => self.texture_statement(&name, "bump", statement, &dir, ColorSpace::Linear)?,
             None => None,
         };
         let normal_map = match m.unknown_param.get("norm") {
-            Some(statement) => Some(self.texture_statement(&name, "norm", statement, &dir, ColorSpace::Linear)?),
+            Some(statement) => self.texture_statement(&name, "norm", statement, &dir, ColorSpace::Linear)?,
             None => None,
         };
         for map in [&diffuse_map, &bump_map, &normal_map].into_iter().flatten() {
@@ -605,7 +626,8 @@ impl Reader<'_> {
         }
     }
 
-    /// Reads the texture a statement names, in `space`, loading each file once per colour space.
+    /// Reads the texture a statement names, in `space`, loading each file once per colour space;
+    /// `None`, with a warning, where the file is not there (as Blender and three.js draw it).
     fn texture_statement(
         &mut self,
         material: &str,
@@ -613,7 +635,7 @@ impl Reader<'_> {
         statement: &str,
         dir: &Path,
         space: ColorSpace,
-    ) -> Result<TextureMap, String> {
+    ) -> Result<Option<TextureMap>, String> {
         let parsed = parse_texture_statement(statement).map_err(|e| format!("`{keyword} {statement}`: {e}"))?;
         if !parsed.ignored.is_empty() {
             self.warn(format!("material `{material}`: {keyword}: ignoring option(s) {}", parsed.ignored.join(", ")));
@@ -622,6 +644,13 @@ impl Reader<'_> {
             self.warn(format!("material `{material}`: {keyword}: -bm applies to bump maps only; ignored"));
         }
         let file = dir.join(&parsed.file);
+        if crate::files::check_regular(&file).is_err() {
+            self.warn(format!(
+                "material `{material}`: {keyword}: cannot read {}; the material is drawn without it",
+                file.display()
+            ));
+            return Ok(None);
+        }
         let key = (file.clone(), space);
         let id = match self.textures.get(&key) {
             Some(&id) => id,
@@ -633,7 +662,7 @@ impl Reader<'_> {
                 id
             }
         };
-        Ok(TextureMap { id, multiplier: parsed.multiplier, clamp: parsed.clamp })
+        Ok(Some(TextureMap { id, multiplier: parsed.multiplier, clamp: parsed.clamp }))
     }
 }
 
