@@ -947,7 +947,7 @@ impl<'d> Importer<'d> {
             return Err(format!("material `{name}` has a factor that is not a finite number"));
         }
         let texture = match pbr.base_color_texture() {
-            Some(info) => Some(self.texture(info.texture().source(), ColorSpace::Srgb)?),
+            Some(info) => self.texture(info.texture().source(), ColorSpace::Srgb)?,
             None => None,
         };
         // One wrap for the whole material: the base colour texture's sampler, else the normal
@@ -958,7 +958,7 @@ impl<'d> Importer<'d> {
             .or_else(|| material.normal_texture().map(|info| info.texture().sampler()));
         let wrap = sampler.map_or([Wrap::Repeat; 2], |s| [wrap_of(s.wrap_s()), wrap_of(s.wrap_t())]);
         let normal_map = match material.normal_texture() {
-            Some(info) => Some((self.texture(info.texture().source(), ColorSpace::Linear)?, info.scale())),
+            Some(info) => self.texture(info.texture().source(), ColorSpace::Linear)?.map(|id| (id, info.scale())),
             None => None,
         };
         // glTF's index of refraction, 1.5 unless `KHR_materials_ior` says otherwise; it sets the
@@ -1009,11 +1009,13 @@ impl<'d> Importer<'d> {
     }
 
     /// The image as a texture read in `space`: the same image may serve as colour (sRGB) and as
-    /// data (linear), and then becomes two textures.
-    fn texture(&mut self, image: gltf::Image<'d>, space: ColorSpace) -> Result<TextureId, String> {
+    /// data (linear), and then becomes two textures. An external image file that is not there is
+    /// a warning and `None` (the material drawn without it, as Blender and three.js draw it); one
+    /// that is there but broken is an error.
+    fn texture(&mut self, image: gltf::Image<'d>, space: ColorSpace) -> Result<Option<TextureId>, String> {
         let index = image.index();
         if let Some(&known) = self.textures.get(&(index, space)) {
-            return Ok(known);
+            return Ok(Some(known));
         }
         // The raw JSON, because the `gltf` crate's `Image::source` unwraps fields a malformed
         // file may lack.
@@ -1037,6 +1039,18 @@ impl<'d> Importer<'d> {
                 }
                 (None, Some(uri)) => {
                     let described = format!("image {index} (`{}`)", shorten(uri));
+                    let missing = match (uri.starts_with("data:") || has_scheme(uri), percent_decode(uri)) {
+                        (false, Some(relative)) => Some(self.base.join(relative)),
+                        _ => None,
+                    }
+                    .filter(|file| crate::files::check_regular(file).is_err());
+                    if let Some(file) = missing {
+                        self.warn(format!(
+                            "{described}: cannot read {}; the material is drawn without it",
+                            file.display()
+                        ));
+                        return Ok(None);
+                    }
                     let bytes = read_uri(uri, &self.base).map_err(|e| format!("image {index}: {e}"))?;
                     let path = match (uri.starts_with("data:"), percent_decode(uri)) {
                         (false, Some(relative)) => self.base.join(relative),
@@ -1062,7 +1076,7 @@ impl<'d> Importer<'d> {
         self.out.textures.push(texture::from_image(&texture_path, decoded, space));
         let id = TextureId(self.out.textures.len() - 1);
         self.textures.insert((index, space), id);
-        Ok(id)
+        Ok(Some(id))
     }
 
     fn light(&mut self, light: &gltf::khr_lights_punctual::Light<'d>, label: &str, world: Mat4) -> Result<(), String> {
