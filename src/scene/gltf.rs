@@ -1043,7 +1043,10 @@ impl<'d> Importer<'d> {
                         (false, Some(relative)) => Some(self.base.join(relative)),
                         _ => None,
                     }
-                    .filter(|file| crate::files::check_regular(file).is_err());
+                    .filter(|file| {
+                        // Not there at all; one that is there but unreadable is the reader's error.
+                        crate::files::check_regular(file).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound)
+                    });
                     if let Some(file) = missing {
                         self.warn(format!(
                             "{described}: cannot read {}; the material is drawn without it",

@@ -336,7 +336,7 @@ struct Library {
 fn read_library(dir: &Path, name: &Path, libraries: &RefCell<Vec<Library>>) -> tobj::MTLLoadResult {
     let file = dir.join(name);
     let mut libraries = libraries.borrow_mut();
-    if let Err(e) = super::read_file(&file) {
+    if let Err(e) = not_found(&file) {
         let missing = format!(
             "mtllib `{}`: cannot read {}: {e}; its materials are drawn in the default material",
             name.display(),
@@ -355,6 +355,15 @@ fn read_library(dir: &Path, name: &Path, libraries: &RefCell<Vec<Library>>) -> t
             libraries.push(Library { file, materials: 0, problem: Some(problem), missing: None });
             Err(tobj::LoadError::OpenFileFailed)
         }
+    }
+}
+
+/// `Err` only where `file` is not there at all (a file that is there but is no regular file, or
+/// cannot be read, is left to the reader's own error).
+fn not_found(file: &Path) -> std::io::Result<()> {
+    match crate::files::check_regular(file) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(e),
+        _ => Ok(()),
     }
 }
 
@@ -644,7 +653,7 @@ impl Reader<'_> {
             self.warn(format!("material `{material}`: {keyword}: -bm applies to bump maps only; ignored"));
         }
         let file = dir.join(&parsed.file);
-        if crate::files::check_regular(&file).is_err() {
+        if not_found(&file).is_err() {
             self.warn(format!(
                 "material `{material}`: {keyword}: cannot read {}; the material is drawn without it",
                 file.display()
