@@ -73,6 +73,12 @@ pub fn check_regular(path: &Path) -> io::Result<()> {
 #[cfg(target_arch = "wasm32")]
 pub use in_memory::{add, check_regular, open};
 
+/// Whether `path` is not there at all: what a model's importer may warn about and draw without
+/// (a file that is there but is no regular file, or cannot be read, is an error of its reader).
+pub fn is_missing(path: &Path) -> bool {
+    check_regular(path).is_err_and(|e| e.kind() == io::ErrorKind::NotFound)
+}
+
 /// The files built into the browser's page, by their paths in the source tree: every file under
 /// `assets/` but the READMEs (`tests/web.rs` checks the list), and the model a course scene
 /// borrows from the tests. [`builtin_bytes`] holds their bytes, in the browser build only.

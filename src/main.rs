@@ -13,7 +13,6 @@ use mirador::gpu::texture::GpuTexture;
 use mirador::gpu::{Gpu, Stopwatch, readback};
 use mirador::linear_output::LinearImage;
 use mirador::raster::{FrameReport, FrameTargets, OUTPUT_FORMAT, Renderer, drawn_size};
-use mirador::scene::SceneError;
 use mirador::scene::file::overrides;
 use mirador::settings::AntiAliasing;
 use mirador::trace::accel::AccelKind;
@@ -290,24 +289,8 @@ fn prepare(args: &SceneArgs, clock: &mut Stopwatch) -> anyhow::Result<Scene> {
     // scene file's own values before it is read; any other key is a render setting.
     let (overrides, settings): (Vec<String>, Vec<String>) =
         args.set.iter().cloned().partition(|a| overrides::is_scene_override(a));
-    let mut scene = clock.time("scene load", || -> anyhow::Result<Scene> {
-        let path = args.scene.clone().unwrap_or_else(|| mirador::scene::builtin_path("showcase.toml"));
-        if overrides.is_empty() {
-            return Ok(Scene::load(&path)?);
-        }
-        let toml = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"));
-        if !toml {
-            bail!(
-                "--set {}: {} is a model file; scene overrides (camera, lights, materials, objects, world) need a \
-                 TOML scene: write one that names the model (docs/scene-format.md)",
-                overrides[0],
-                path.display()
-            );
-        }
-        let text =
-            mirador::files::read_to_string(&path).map_err(|cause| SceneError::Io { path: path.clone(), cause })?;
-        Ok(overrides::parse_with(&text, &path, &overrides)?)
-    })?;
+    let path = args.scene.clone().unwrap_or_else(|| mirador::scene::builtin_path("showcase.toml"));
+    let mut scene = clock.time("scene load", || overrides::load(&path, &overrides))?;
     for assignment in &settings {
         scene.settings.set(assignment).context("--set")?;
     }

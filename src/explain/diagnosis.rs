@@ -64,7 +64,7 @@ fn projected(
 ) -> String {
     let surface = raster.surface.as_ref().and_then(|s| s.object.as_deref());
     let receiver = surface.is_some_and(|surface| {
-        scene.objects.iter().any(|o| o.name == surface && matches!(o.shape, crate::scene::Shape::Plane { .. }))
+        scene.objects.iter().any(|o| o.name == surface && crate::raster::shadow::projected::is_receiver(o))
     });
     let by = occluder.and_then(|h| h.object.clone()).map_or(String::new(), |o| format!(" by `{o}`"));
     let on = surface.map_or("this surface".to_string(), |s| format!("`{s}`"));

@@ -31,6 +31,7 @@ pub use crate::raster::refraction::RefractionPath;
 pub use crate::raster::shadow::{ShadowLookup, constant_bias};
 use crate::raster::uniforms::{UNKNOWN_OBJECT, transmittance};
 use crate::raster::{FrameTargets, OUTPUT_FORMAT, Renderer};
+use crate::scene::shading::lights_surface;
 use crate::scene::{Light, Scene};
 use crate::settings::{RenderSettings, TransparencySort};
 use crate::trace::Tracer;
@@ -444,13 +445,12 @@ fn raster_lights(
         .collect()
 }
 
-/// Whether `light` adds anything to the surface of `record`: it faces it (`n·l > 0`), or it lights
-/// it with its ambient term. The tracer leaves out the same lights (no shadow ray is cast for
-/// them), so both sides list the same ones.
+/// Whether `light` adds anything to the surface of `record`, by the tracer's own rule
+/// ([`lights_surface`]), so both sides list the same lights.
 fn lights_the_surface(scene: &Scene, settings: &RenderSettings, record: &GpuInspectFragment, light: &Light) -> bool {
     let Some(incidence) = light.incidence(record.world) else { return false };
-    let ambient = scene.materials.get(record.material as usize).is_some_and(|m| m.ka != 0.0) && settings.terms.ambient;
-    incidence.l.dot(record.normal) > 0.0 || ambient
+    let ka = scene.materials.get(record.material as usize).map_or(0.0, |m| m.ka);
+    lights_surface(record.normal, incidence.l, ka, settings.terms.into())
 }
 
 /// The ray-traced pixel's tree, for callers with a tracer of their own.

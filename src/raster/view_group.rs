@@ -233,42 +233,31 @@ impl ViewGroups {
         views: &[(&FrameView, &FrameTargets)],
     ) {
         let frame_images = inputs.images();
+        let mut last = std::mem::take(&mut self.kept);
         if self.frame_images.len() != frame_images.len()
             || self.frame_images.iter().zip(frame_images).any(|(a, b)| a != b)
         {
             self.frame_images = frame_images.map(Clone::clone).to_vec();
-            self.kept.clear();
+            last.clear();
         }
-        let mut used = vec![false; self.kept.len()];
+        // This frame's groups: the last frame's where a view's images are the same, new ones
+        // where not; the rest are dropped.
         self.views.clear();
         for (view, targets) in views {
-            let images: Vec<&wgpu::TextureView> = ViewImage::ALL.iter().map(|&i| &targets.images.get(i).view).collect();
-            let found = self.kept.iter().position(|(kept, _)| kept.iter().zip(&images).all(|(a, b)| a == *b));
-            let index = found.unwrap_or_else(|| {
-                self.kept.push((
-                    images.iter().map(|&v| v.clone()).collect(),
-                    group(device, layout, inputs, &targets.images),
-                ));
-                used.push(false);
-                self.kept.len() - 1
-            });
-            used[index] = true;
+            let images: Vec<wgpu::TextureView> =
+                ViewImage::ALL.iter().map(|&i| targets.images.get(i).view.clone()).collect();
+            let index = match self.kept.iter().position(|(kept, _)| *kept == images) {
+                Some(index) => index,
+                None => {
+                    let group = match last.iter().position(|(kept, _)| *kept == images) {
+                        Some(k) => last.swap_remove(k).1,
+                        None => group(device, layout, inputs, &targets.images),
+                    };
+                    self.kept.push((images, group));
+                    self.kept.len() - 1
+                }
+            };
             self.views.push((view.slot, index));
-        }
-        // Drop the unused groups, renumbering the views' indices.
-        let mut renumbered = Vec::with_capacity(used.len());
-        let mut next = 0;
-        for &u in &used {
-            renumbered.push(next);
-            next += usize::from(u);
-        }
-        let mut k = 0;
-        self.kept.retain(|_| {
-            k += 1;
-            used[k - 1]
-        });
-        for (_, index) in &mut self.views {
-            *index = renumbered[*index];
         }
     }
 
@@ -276,15 +265,6 @@ impl ViewGroups {
     pub fn get(&self, view: &FrameView) -> &wgpu::BindGroup {
         let found = self.views.iter().find(|(slot, _)| *slot == view.slot);
         &self.kept[found.expect("ViewGroups::prepare was given every view of the frame").1].1
-    }
-
-    /// The number of groups kept (one per distinct view targets of the last frame).
-    pub fn len(&self) -> usize {
-        self.kept.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.kept.is_empty()
     }
 }
 

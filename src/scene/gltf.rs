@@ -1043,13 +1043,10 @@ impl<'d> Importer<'d> {
                         (false, Some(relative)) => Some(self.base.join(relative)),
                         _ => None,
                     }
-                    .filter(|file| {
-                        // Not there at all; one that is there but unreadable is the reader's error.
-                        crate::files::check_regular(file).is_err_and(|e| e.kind() == std::io::ErrorKind::NotFound)
-                    });
+                    .filter(|file| crate::files::is_missing(file));
                     if let Some(file) = missing {
                         self.warn(format!(
-                            "{described}: cannot read {}; the material is drawn without it",
+                            "{described}: cannot read {}: it is not there; the material is drawn without it",
                             file.display()
                         ));
                         return Ok(None);

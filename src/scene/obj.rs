@@ -336,9 +336,9 @@ struct Library {
 fn read_library(dir: &Path, name: &Path, libraries: &RefCell<Vec<Library>>) -> tobj::MTLLoadResult {
     let file = dir.join(name);
     let mut libraries = libraries.borrow_mut();
-    if let Err(e) = not_found(&file) {
+    if crate::files::is_missing(&file) {
         let missing = format!(
-            "mtllib `{}`: cannot read {}: {e}; its materials are drawn in the default material",
+            "mtllib `{}`: cannot read {}: it is not there; its materials are drawn in the default material",
             name.display(),
             file.display()
         );
@@ -355,15 +355,6 @@ fn read_library(dir: &Path, name: &Path, libraries: &RefCell<Vec<Library>>) -> t
             libraries.push(Library { file, materials: 0, problem: Some(problem), missing: None });
             Err(tobj::LoadError::OpenFileFailed)
         }
-    }
-}
-
-/// `Err` only where `file` is not there at all (a file that is there but is no regular file, or
-/// cannot be read, is left to the reader's own error).
-fn not_found(file: &Path) -> std::io::Result<()> {
-    match crate::files::check_regular(file) {
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(e),
-        _ => Ok(()),
     }
 }
 
@@ -653,9 +644,9 @@ impl Reader<'_> {
             self.warn(format!("material `{material}`: {keyword}: -bm applies to bump maps only; ignored"));
         }
         let file = dir.join(&parsed.file);
-        if not_found(&file).is_err() {
+        if crate::files::is_missing(&file) {
             self.warn(format!(
-                "material `{material}`: {keyword}: cannot read {}; the material is drawn without it",
+                "material `{material}`: {keyword}: cannot read {}: it is not there; the material is drawn without it",
                 file.display()
             ));
             return Ok(None);

@@ -70,6 +70,13 @@ impl Terms {
     pub const ALL: Terms = Terms { ambient: true, diffuse: true, specular: true, emission: true };
 }
 
+/// Whether a light adds anything to a surface: it faces it (`n·l > 0`), or it lights it with its
+/// ambient term `ka·C`. A light that does neither casts no shadow ray in the tracer, and
+/// `mirador explain` lists it on neither side.
+pub fn lights_surface(n: Vec3, l: Vec3, ka: f32, terms: Terms) -> bool {
+    l.dot(n) > 0.0 || (ka != 0.0 && terms.ambient)
+}
+
 /// `n` turned to the viewer's side: the shading normal of a two-sided surface.
 pub fn facing_viewer(n: Vec3, v: Vec3) -> Vec3 {
     if n.dot(v) < 0.0 { -n } else { n }

@@ -67,6 +67,7 @@ use crate::base::Ray;
 use crate::scene::optics::{fresnel, refract, relative_index};
 use crate::scene::shading::{
     SurfaceSample, Terms, direct, direct_terms, emission_and_global_ambient, emitted_and_ambient, facing_viewer,
+    lights_surface,
 };
 use crate::scene::{AlphaMode, Material, Scene};
 use crate::settings::{BumpSettings, BumpView, TextureSettings, VolumeView};
@@ -362,8 +363,7 @@ impl Whitted<'_> {
         let mut rad = emitted_and_ambient(&sample, self.scene.ambient, self.terms);
         for (index, light) in self.scene.lights.iter().enumerate() {
             let Some(incidence) = light.incidence(hit.point) else { continue };
-            let unlit = incidence.l.dot(n) <= 0.0 && (sample.ka == 0.0 || !self.terms.ambient);
-            if unlit {
+            if !lights_surface(n, incidence.l, sample.ka, self.terms) {
                 continue;
             }
             let origin = hit.point + offset * outside;

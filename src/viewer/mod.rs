@@ -31,6 +31,7 @@ pub mod config;
 pub mod frame;
 pub mod hud;
 pub mod inspect;
+pub mod kept;
 pub mod panel;
 pub mod picking;
 pub mod raster_view;

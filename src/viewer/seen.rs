@@ -5,6 +5,7 @@
 
 use glam::Vec2;
 
+use super::kept::Kept;
 use super::picking::SeenDirection;
 use super::scene_state::SceneState;
 use crate::scene::Camera;
@@ -22,8 +23,7 @@ struct Inputs {
 /// The marker's direction, with the pixel it was found at.
 #[derive(Default)]
 pub struct CursorDirection {
-    inputs: Option<Inputs>,
-    seen: Option<(Vec2, SeenDirection)>,
+    kept: Kept<Inputs, (Vec2, SeenDirection)>,
 }
 
 impl CursorDirection {
@@ -31,21 +31,17 @@ impl CursorDirection {
     /// one kept was cast for the same inputs.
     pub fn update(&mut self, scene: &mut SceneState, settings: &RenderSettings, at: Option<(Vec2, (u32, u32))>) {
         let inputs = inputs(scene, settings, at);
-        if inputs == self.inputs {
-            return;
-        }
-        self.seen = inputs.as_ref().map(|i| (i.pixel, scene.seen_direction(i.pixel, i.size)));
-        self.inputs = inputs;
+        self.kept.update(inputs, |i| (i.pixel, scene.seen_direction(i.pixel, i.size)));
     }
 
     /// Whether the kept direction is the one [`Self::update`] would find now.
     pub fn is_current(&self, scene: &SceneState, settings: &RenderSettings, at: Option<(Vec2, (u32, u32))>) -> bool {
-        inputs(scene, settings, at) == self.inputs
+        self.kept.is_current(&inputs(scene, settings, at))
     }
 
     /// The direction and its pixel; `None` when the marker is not shown.
     pub fn shown(&self) -> Option<&(Vec2, SeenDirection)> {
-        self.seen.as_ref()
+        self.kept.get()
     }
 }
 

@@ -22,6 +22,7 @@
 use egui::{Color32, Pos2, Rect, Stroke, pos2, vec2};
 use glam::{Vec2, Vec3};
 
+use super::kept::Kept;
 use super::scene_state::SceneState;
 use crate::RenderSettings;
 use crate::base::Ray;
@@ -182,38 +183,32 @@ struct Inputs {
 /// same.
 #[derive(Default)]
 pub struct CursorProbe {
-    /// What `shown` was made from; `None` when nothing is shown.
-    inputs: Option<Inputs>,
-    shown: Option<Shown>,
+    kept: Kept<Inputs, Shown>,
 }
 
 impl CursorProbe {
     /// Makes the probe at `at` for the current scene and settings, unless it is the one kept.
     pub fn update(&mut self, scene: &mut SceneState, settings: &RenderSettings, at: Option<ProbeAt>) {
         let inputs = inputs(scene, settings, at);
-        if inputs == self.inputs {
-            return;
-        }
-        self.shown = inputs.as_ref().map(|inputs| Shown {
+        self.kept.update(inputs, |inputs| Shown {
             pixel: inputs.at.pixel,
             probe: probe_at(scene, inputs.at.pixel, inputs.at.size, settings),
         });
-        self.inputs = inputs;
     }
 
     /// Whether the kept probe is the one [`CursorProbe::update`] would make now.
     pub fn is_current(&self, scene: &SceneState, settings: &RenderSettings, at: Option<ProbeAt>) -> bool {
-        inputs(scene, settings, at) == self.inputs
+        self.kept.is_current(&inputs(scene, settings, at))
     }
 
     /// What the view shows: `None` when the cursor is off the view or there is no volume to probe.
     pub fn shown(&self) -> Option<&Shown> {
-        self.shown.as_ref()
+        self.kept.get()
     }
 
     /// The probe itself: `None` also where the ray enters no volume.
     pub fn probe(&self) -> Option<&Probe> {
-        self.shown.as_ref().and_then(|shown| shown.probe.as_ref())
+        self.kept.get().and_then(|shown| shown.probe.as_ref())
     }
 }
 

@@ -61,6 +61,12 @@ struct Receiver {
     offset: f32,
 }
 
+/// Whether `object` receives projected shadows: the notes' receivers are planar, here the
+/// scene's `plane` objects.
+pub fn is_receiver(object: &crate::scene::Object) -> bool {
+    matches!(object.shape, Shape::Plane { .. })
+}
+
 fn receivers(scene: &Scene) -> Vec<Receiver> {
     scene
         .objects

@@ -24,6 +24,26 @@ pub fn is_scene_override(assignment: &str) -> bool {
     ROOTS.contains(&key.split('.').next().unwrap_or(""))
 }
 
+/// Reads the scene file at `path` with every override of `assignments` applied, in order; a
+/// model file (no TOML of its own to change) is refused with what to do instead.
+pub fn load(path: &Path, assignments: &[String]) -> Result<Scene, SceneError> {
+    if assignments.is_empty() {
+        return super::load(path);
+    }
+    if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
+        return Err(SceneError::Invalid {
+            path: path.into(),
+            message: format!(
+                "`--set {}`: a model file has no scene values to override (camera, lights, materials, \
+                 objects, world): write a TOML scene that names the model (docs/scene-format.md)",
+                assignments[0]
+            ),
+        });
+    }
+    let text = crate::files::read_to_string(path).map_err(|cause| SceneError::Io { path: path.into(), cause })?;
+    parse_with(&text, path, assignments)
+}
+
 /// Reads the TOML scene `text` (from `path`, which anchors its relative paths) with every
 /// override of `assignments` applied, in order.
 pub fn parse_with(text: &str, path: &Path, assignments: &[String]) -> Result<Scene, SceneError> {
