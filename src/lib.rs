@@ -8,6 +8,7 @@
 //! - [`raster`]: the z-buffer renderer, one pass per technique.
 //! - [`output`]: the output transform both renderers share.
 //! - [`linear_output`]: the radiance before that transform, as OpenEXR.
+//! - [`lab`]: a student's WGSL in place of a technique's own functions, checked and graded.
 //! - [`compare`]: image metrics for golden images and raster-vs-trace comparisons.
 //! - [`viewer`]: the interactive window (winit + egui) over both renderers.
 //! - [`volume`]: scalar fields on voxel grids, classified and ray-cast by both renderers.
@@ -23,6 +24,8 @@ pub mod compare;
 pub mod explain;
 pub mod files;
 pub mod gpu;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod lab;
 pub mod linear_output;
 pub mod output;
 pub mod raster;

@@ -83,6 +83,10 @@ enum Command {
         /// side by side, raster on the left, as one OpenEXR file (32-bit float RGB), atomically.
         #[arg(long, value_name = "FILE.exr")]
         exr: Option<PathBuf>,
+        /// Also write the figures as JSON to this file (`-`: standard output, instead of the
+        /// text): mean FLIP, the worst 32×32 region, PSNR, as `mirador diff --json` gives them.
+        #[arg(long, value_name = "FILE.json")]
+        json: Option<PathBuf>,
     },
     /// Explain one pixel: what each renderer computed there, term by term (the rasterizer's
     /// values read back from the GPU, the tracer's ray tree), and why they differ.
@@ -97,6 +101,68 @@ enum Command {
         /// Write the explanation as JSON to this file (`-`: standard output, instead of the text).
         #[arg(long, value_name = "FILE.json")]
         json: Option<PathBuf>,
+    },
+    /// Labs: write a technique's functions in WGSL and have them checked against Mirador's own and
+    /// the ray tracer (docs/course/labs.md).
+    Lab {
+        #[command(subcommand)]
+        command: LabCommand,
+    },
+    /// Compare two images of the same size: mean FLIP, the worst 32×32 region, and the mean
+    /// under a mask.
+    Diff {
+        /// The correct image (PNG).
+        reference: PathBuf,
+        /// The image to judge (PNG).
+        test: PathBuf,
+        /// Only the pixels where this image (of the same size) is not black count in the masked mean.
+        #[arg(long, value_name = "MASK.png")]
+        mask: Option<PathBuf>,
+        /// Write the figures as JSON to this file (`-`: standard output, instead of the text).
+        #[arg(long, value_name = "FILE.json")]
+        json: Option<PathBuf>,
+    },
+}
+
+#[derive(Subcommand)]
+enum LabCommand {
+    /// The labs, one a line: its name, its chapter and its title.
+    List,
+    /// Write a lab's folder: the student's file (signatures, course comments, neutral bodies),
+    /// the task and the public test scenes.
+    New {
+        /// The lab's name (`mirador lab list`).
+        lab: String,
+        /// The folder to make.
+        dir: PathBuf,
+        /// Write the answer key and the teacher's notes instead of the student's stub.
+        #[arg(long)]
+        solution: bool,
+    },
+    /// Check a lab's folder: the student's WGSL validated, then its known-answer and image tests
+    /// run and scored; writes results.json (Gradescope's format) and report.md there. Exits 0
+    /// when every test passed, 1 otherwise.
+    Check {
+        dir: PathBuf,
+        /// A folder of hidden tests (`*.toml`, the lab's own format) run after the lab's own.
+        #[arg(long, value_name = "DIR")]
+        tests: Option<PathBuf>,
+        /// A points file (`"test name" = points`) in place of the folder's own `[points]`.
+        #[arg(long, value_name = "FILE.toml")]
+        points: Option<PathBuf>,
+        /// The most seconds one test may take; a test that takes longer fails, and the tests
+        /// after it are not run.
+        #[arg(long, value_name = "SECONDS", default_value_t = 30.0)]
+        time_limit: f64,
+    },
+    /// Runs a lab's tests from one on, a JSON line each (what `check` runs under its time limit).
+    #[command(hide = true)]
+    Run {
+        dir: PathBuf,
+        #[arg(long)]
+        from: usize,
+        #[arg(long)]
+        tests: Option<PathBuf>,
     },
 }
 
@@ -199,11 +265,15 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Some(Command::Render { scene, output, exr }) => render(scene, &output, exr.as_deref()),
         Some(Command::Trace { scene, trace: options, output, exr }) => trace(scene, options, &output, exr.as_deref()),
-        Some(Command::Compare { scene, trace, output, raster_out, trace_out, error_out, exr }) => {
-            compare(scene, trace, &output, [raster_out, trace_out, error_out], exr.as_deref())
+        Some(Command::Compare { scene, trace, output, raster_out, trace_out, error_out, exr, json }) => {
+            compare(scene, trace, &output, [raster_out, trace_out, error_out], (exr.as_deref(), json.as_deref()))
         }
         Some(Command::Explain { scene, trace, pixel, json }) => explain(scene, trace, pixel, json.as_deref()),
         Some(Command::View(args)) => view(args),
+        Some(Command::Lab { command }) => return lab(command),
+        Some(Command::Diff { reference, test, mask, json }) => {
+            diff(&reference, &test, mask.as_deref(), json.as_deref())
+        }
         None => view(ViewArgs::default()),
     };
     match result {
@@ -213,6 +283,104 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `mirador lab …`: its own exit status (`check` fails when a test does).
+fn lab(command: LabCommand) -> ExitCode {
+    use mirador::lab::{self, check, folder, report, run};
+    let outcome = match command {
+        LabCommand::List => {
+            for lab in lab::catalog() {
+                println!("{:<18} chapter {:<2} {}", lab.name, lab.chapter, lab.title);
+            }
+            Ok(true)
+        }
+        LabCommand::New { lab, dir, solution } => lab::find(&lab).and_then(|lab| {
+            let written = folder::create(&lab, &dir, solution)?;
+            for path in written {
+                println!("wrote {}", path.display());
+            }
+            Ok(true)
+        }),
+        LabCommand::Check { dir, tests, points, time_limit } => {
+            let time_limit =
+                std::time::Duration::try_from_secs_f64(time_limit).unwrap_or(std::time::Duration::from_secs(30));
+            check::check(&check::Options { dir, hidden: tests, points, time_limit }).map(|report| {
+                print!("{}", report::text(&report));
+                report.passed()
+            })
+        }
+        LabCommand::Run { dir, from, tests } => check::LabFolder::read(&dir).and_then(|folder| {
+            let lab = lab::find(&folder.lab)?;
+            let text = std::fs::read_to_string(dir.join(&lab.file)).map_err(|e| format!("{}: {e}", lab.file))?;
+            let tests = run::tests(&lab, tests.as_deref())?;
+            run::run(&lab, &text, &tests, from, &dir).map(|()| true)
+        }),
+    };
+    match outcome {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::FAILURE,
+        Err(error) => {
+            eprintln!("error: {error}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn diff(reference: &Path, test: &Path, mask: Option<&Path>, json: Option<&Path>) -> anyhow::Result<()> {
+    let read = |path: &Path| -> anyhow::Result<image::RgbaImage> {
+        Ok(image::open(path).with_context(|| format!("{}: cannot read the image", path.display()))?.to_rgba8())
+    };
+    let (a, b) = (read(reference)?, read(test)?);
+    let difference = mirador::compare::difference(&a, &b)
+        .with_context(|| format!("{} and {}", reference.display(), test.display()))?;
+    let mask = match mask {
+        Some(path) => {
+            let m = read(path)?;
+            if m.dimensions() != a.dimensions() {
+                bail!(
+                    "{}: the mask is {}×{}, the images {}×{}",
+                    path.display(),
+                    m.width(),
+                    m.height(),
+                    a.width(),
+                    a.height()
+                );
+            }
+            Some(m.pixels().map(|p| p[0] > 0 || p[1] > 0 || p[2] > 0).collect::<Vec<bool>>())
+        }
+        None => None,
+    };
+    let figures = mirador::compare::Figures::of(&difference.flip_errors, a.width(), a.height(), mask.as_deref());
+    report_figures(&figures, difference.psnr_db, json)
+}
+
+/// Prints FLIP figures, or writes them as JSON (`-`: standard output instead).
+fn report_figures(figures: &mirador::compare::Figures, psnr_db: f64, json: Option<&Path>) -> anyhow::Result<()> {
+    let value = serde_json::json!({
+        "flip_mean": figures.mean,
+        "worst_region": { "flip_mean": figures.worst_region, "x": figures.worst_region_at[0], "y": figures.worst_region_at[1], "side": mirador::compare::REGION },
+        "masked_flip_mean": figures.masked_mean,
+        "psnr_db": if psnr_db.is_finite() { Some(psnr_db) } else { None },
+    });
+    let text = serde_json::to_string_pretty(&value).expect("figures serialise");
+    match json {
+        Some(path) if path.as_os_str() == "-" => println!("{text}"),
+        _ => {
+            let [x, y] = figures.worst_region_at;
+            println!("FLIP mean: {:.5}", figures.mean);
+            println!("worst {0}×{0} region: {1:.5} at ({x}, {y})", mirador::compare::REGION, figures.worst_region);
+            if let Some(masked) = figures.masked_mean {
+                println!("FLIP mean under the mask: {masked:.5}");
+            }
+            println!("PSNR: {psnr_db:.2} dB");
+            if let Some(path) = json {
+                output::write_atomically(text.as_bytes(), path)
+                    .with_context(|| format!("writing {}", path.display()))?;
+            }
+        }
+    }
+    Ok(())
 }
 
 fn view(args: ViewArgs) -> anyhow::Result<()> {
@@ -499,7 +667,7 @@ fn compare(
     trace_args: TraceArgs,
     sheet_path: &Path,
     extra: [Option<PathBuf>; 3],
-    exr_path: Option<&Path>,
+    (exr_path, json): (Option<&Path>, Option<&Path>),
 ) -> anyhow::Result<()> {
     check_png(sheet_path)?;
     for path in extra.iter().flatten() {
@@ -513,9 +681,11 @@ fn compare(
     let traced_radiance = ray_trace(&scene, trace_args.threads, &mut clock, args.stats)?;
     let traced = traced_radiance.to_rgba8(mirador::output::OutputTransform::of(&scene.settings));
     let difference = mirador::compare::difference(&traced, &raster).expect("both images have the camera's size");
-    println!("adapter: {adapter}");
-    println!("FLIP mean: {:.5}", difference.flip_mean);
-    println!("PSNR: {:.2} dB", difference.psnr_db);
+    if json.is_none_or(|path| path.as_os_str() != "-") {
+        println!("adapter: {adapter}");
+    }
+    let figures = mirador::compare::Figures::of(&difference.flip_errors, traced.width(), traced.height(), None);
+    report_figures(&figures, difference.psnr_db, json)?;
     let panels = [
         Panel::new("raster", raster.clone()),
         Panel::new("ray traced", traced.clone()),

@@ -41,55 +41,174 @@ pub const UPSCALE: &str = include_str!("../shaders/upscale.wgsl");
 
 /// Every pass's whole source, by name, for tests that validate them all.
 pub fn passes() -> Vec<(&'static str, String)> {
-    let surface = [("scene", SCENE), ("transparency", TRANSPARENCY), ("refraction", REFRACTION), ("volume", VOLUME)];
-    let others = [
-        ("present", PRESENT),
-        ("mipmap", MIPMAP),
-        ("depth_copy", DEPTH_COPY),
-        ("shadow", SHADOW),
-        ("shadow_projected", SHADOW_PROJECTED),
-        ("overlays", OVERLAYS),
-        ("environment", ENVIRONMENT),
-        ("upscale", UPSCALE),
-    ];
-    let surface = surface.into_iter().map(|(name, pass)| (name, compose_surface(pass)));
-    surface.chain(others.into_iter().map(|(name, pass)| (name, compose(pass)))).collect()
+    Wgsl::builtin().passes()
 }
 
 /// The full source of a pass: the common files, then the pass's own.
 pub fn compose(pass: &str) -> String {
-    compose_after(COMMON.iter(), pass)
+    Wgsl::builtin().compose(pass)
 }
 
 /// The full source of a surface pass: the common files, the surface code, then the pass's own.
 pub fn compose_surface(pass: &str) -> String {
-    compose_after(COMMON.iter().chain(SURFACE), pass)
-}
-
-fn compose_after<'a>(shared: impl Iterator<Item = &'a (&'a str, &'a str)>, pass: &str) -> String {
-    let mut source = String::new();
-    for (name, text) in shared {
-        source.push_str("// ---- ");
-        source.push_str(name);
-        source.push('\n');
-        source.push_str(text);
-        source.push('\n');
-    }
-    source.push_str(pass);
-    source
+    Wgsl::builtin().compose_surface(pass)
 }
 
 pub fn module(device: &wgpu::Device, label: &str, pass: &str) -> wgpu::ShaderModule {
-    device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(compose(pass).into()),
-    })
+    Wgsl::builtin().module(device, label, pass)
 }
 
-/// A surface pass's module ([`compose_surface`]).
-pub fn surface_module(device: &wgpu::Device, label: &str, pass: &str) -> wgpu::ShaderModule {
-    device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(compose_surface(pass).into()),
-    })
+/// The WGSL the passes compile: Mirador's own, or Mirador's with some of its module-scope
+/// declarations put in other hands. That is the lab's seam (src/lab): a student's file defines
+/// the functions of a technique's heart, each pass compiles them in place of Mirador's, and
+/// nothing is rebuilt. WGSL declarations may come in any order, so the replacements are appended
+/// after the pass's own file.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Wgsl {
+    /// The names of Mirador's declarations (functions, constants) left out.
+    replaced: Vec<String>,
+    /// What is compiled in their place, appended to every module.
+    code: String,
+}
+
+impl Wgsl {
+    /// Mirador's own WGSL.
+    pub fn builtin() -> Wgsl {
+        Wgsl::default()
+    }
+
+    /// Mirador's WGSL with the declarations named `replaced` left out and `code` appended.
+    pub fn replacing(replaced: Vec<String>, code: String) -> Wgsl {
+        Wgsl { replaced, code }
+    }
+
+    /// Whether this is Mirador's own WGSL.
+    pub fn is_builtin(&self) -> bool {
+        self.replaced.is_empty() && self.code.is_empty()
+    }
+
+    /// What is appended to every module, at the end of the composed text.
+    pub fn code(&self) -> &str {
+        &self.code
+    }
+
+    /// Every pass's whole source, by name.
+    pub fn passes(&self) -> Vec<(&'static str, String)> {
+        let surface =
+            [("scene", SCENE), ("transparency", TRANSPARENCY), ("refraction", REFRACTION), ("volume", VOLUME)];
+        let others = [
+            ("present", PRESENT),
+            ("mipmap", MIPMAP),
+            ("depth_copy", DEPTH_COPY),
+            ("shadow", SHADOW),
+            ("shadow_projected", SHADOW_PROJECTED),
+            ("overlays", OVERLAYS),
+            ("environment", ENVIRONMENT),
+            ("upscale", UPSCALE),
+        ];
+        let surface = surface.into_iter().map(|(name, pass)| (name, self.compose_surface(pass)));
+        surface.chain(others.into_iter().map(|(name, pass)| (name, self.compose(pass)))).collect()
+    }
+
+    /// The full source of a pass: the common files, then the pass's own.
+    pub fn compose(&self, pass: &str) -> String {
+        self.compose_after(COMMON.iter(), pass)
+    }
+
+    /// The full source of a surface pass: the common files, the surface code, then the pass's own.
+    pub fn compose_surface(&self, pass: &str) -> String {
+        self.compose_after(COMMON.iter().chain(SURFACE), pass)
+    }
+
+    /// The common files alone, then the replacements: what a lab's known-answer tests run
+    /// their function calls in (`extra` is the test's entry point).
+    pub fn compose_common(&self, extra: &str) -> String {
+        self.compose_after(COMMON.iter(), extra)
+    }
+
+    fn compose_after<'a>(&self, shared: impl Iterator<Item = &'a (&'a str, &'a str)>, pass: &str) -> String {
+        let mut source = String::new();
+        for (name, text) in shared {
+            source.push_str("// ---- ");
+            source.push_str(name);
+            source.push('\n');
+            source.push_str(&self.without_replaced(text));
+            source.push('\n');
+        }
+        source.push_str(&self.without_replaced(pass));
+        if !self.code.is_empty() {
+            source.push_str("\n// ---- replaced\n");
+            source.push_str(&self.code);
+        }
+        source
+    }
+
+    fn without_replaced(&self, text: &str) -> String {
+        let mut text = text.to_owned();
+        for name in &self.replaced {
+            while let Some(range) = declaration(&text, name) {
+                text.replace_range(range, "");
+            }
+        }
+        text
+    }
+
+    pub fn module(&self, device: &wgpu::Device, label: &str, pass: &str) -> wgpu::ShaderModule {
+        device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(self.compose(pass).into()),
+        })
+    }
+
+    /// A surface pass's module ([`Self::compose_surface`]).
+    pub fn surface_module(&self, device: &wgpu::Device, label: &str, pass: &str) -> wgpu::ShaderModule {
+        device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(self.compose_surface(pass).into()),
+        })
+    }
+}
+
+/// Where the module-scope declaration `name` lies in `text`: a function from its `fn` line to its
+/// closing brace's line, or a constant from its line to its `;`, each with its line end. The
+/// declaration must begin its line, as every one of Mirador's does.
+pub fn declaration(text: &str, name: &str) -> Option<std::ops::Range<usize>> {
+    let mut offset = 0;
+    for line in text.split_inclusive('\n') {
+        let start = offset;
+        offset += line.len();
+        let Some(rest) = line.strip_prefix("fn ").or_else(|| line.strip_prefix("const ")) else {
+            continue;
+        };
+        let Some(after) = rest.strip_prefix(name) else {
+            continue;
+        };
+        if after.starts_with(|c: char| c.is_alphanumeric() || c == '_') {
+            continue;
+        }
+        let end =
+            if line.starts_with("fn ") { function_end(text, start)? } else { start + text[start..].find(';')? + 1 };
+        let end = text[end..].find('\n').map_or(text.len(), |n| end + n + 1);
+        return Some(start..end);
+    }
+    None
+}
+
+/// The byte after the brace that closes the body of the function starting at `start`.
+fn function_end(text: &str, start: usize) -> Option<usize> {
+    let open = start + text[start..].find('{')?;
+    let mut depth = 0usize;
+    for (i, c) in text[open..].char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' => {
+                depth -= 1;
+                if depth == 0 {
+                    return Some(open + i + 1);
+                }
+            }
+            _ => {}
+        }
+    }
+    None
 }

@@ -38,6 +38,35 @@ fn mip_lod(duv_dx: vec2f, duv_dy: vec2f, size: vec2f, bias: f32) -> f32 {
     return log2(max(length(duv_dx * size), length(duv_dy * size))) + bias;
 }
 
+// Texel (x, y) of level `level`, its coordinates wrapped into the level (the repeat address mode).
+fn texel_repeat(t: texture_2d<f32>, texel: vec2i, level: i32) -> vec4f {
+    let size = vec2i(textureDimensions(t, level));
+    return textureLoad(t, ((texel % size) + size) % size, level);
+}
+
+// Bilinear filtering on one level: the four texels whose centres surround uv, weighed by how
+// near uv lies to each. Texel centres sit at half-integers: uv·size − ½ counts from the first.
+fn bilinear_level(t: texture_2d<f32>, uv: vec2f, level: i32) -> vec4f {
+    let p = uv * vec2f(textureDimensions(t, level)) - 0.5;
+    let base = floor(p);
+    let f = p - base;
+    let i = vec2i(base);
+    let below = mix(texel_repeat(t, i, level), texel_repeat(t, i + vec2i(1, 0), level), f.x);
+    let above = mix(texel_repeat(t, i + vec2i(0, 1), level), texel_repeat(t, i + vec2i(1, 1), level), f.x);
+    return mix(below, above, f.y);
+}
+
+// Trilinear filtering by hand: lod clamped to the chain, bilinear on the levels ⌊lod⌋ and
+// ⌊lod⌋ + 1, blended by lod's fraction. What the sampler does when a lab routes the colour
+// texture through this function (TRILINEAR_BY_HAND in surface.wgsl).
+fn trilinear_sample(t: texture_2d<f32>, uv: vec2f, lod: f32) -> vec4f {
+    let last = f32(textureNumLevels(t) - 1u);
+    let l = clamp(lod, 0.0, last);
+    let lo = floor(l);
+    let hi = min(lo + 1.0, last);
+    return mix(bilinear_level(t, uv, i32(lo)), bilinear_level(t, uv, i32(hi)), l - lo);
+}
+
 // (d_u, d_v) by central differences from f(u+Δ, v), f(u−Δ, v), f(u, v+Δ), f(u, v−Δ):
 // k·(f₊ − f₋)/2Δ per axis.
 fn bump_central_differences(u_plus: f32, u_minus: f32, v_plus: f32, v_minus: f32, delta: vec2f, k: f32) -> vec2f {

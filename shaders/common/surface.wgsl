@@ -206,10 +206,18 @@ fn height_slopes(uv: vec2f, k: f32) -> vec2f {
     );
 }
 
+// Set by a lab (src/lab) whose student writes trilinear filtering: the colour texture is then
+// read by `trilinear_sample` from texel loads at `mip_lod`, not by the sampler.
+const TRILINEAR_BY_HAND = false;
+
 // The surface colour C(p): the material's colour times its texture, or the level-colour view.
 fn surface_color(uv: vec2f, duv_dx: vec2f, duv_dy: vec2f) -> vec3f {
     if !COLOR_TEXTURE {
         return material.color;
+    }
+    if TRILINEAR_BY_HAND {
+        let lod = mip_lod(duv_dx, duv_dy, vec2f(textureDimensions(color_texture)), frame.lod_bias);
+        return material.color * trilinear_sample(color_texture, uv, lod).rgb;
     }
     if LEVEL_COLOUR {
         let size = vec2f(textureDimensions(color_texture));

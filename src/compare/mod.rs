@@ -112,6 +112,70 @@ pub fn channel_difference(reference: &[u8], test: &[u8]) -> (Vec<f32>, f32, Vec<
     (errors, mean, colored)
 }
 
+/// The side, in pixels, of the square regions whose mean error [`Figures::worst_region`] takes.
+pub const REGION: u32 = 32;
+
+/// The figures a grader reads from a per-pixel error map: the whole image's mean dilutes a local
+/// error (a wrong 40×40 patch is 0.7 % of a 640×360 image), the worst region's does not.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Figures {
+    /// The mean over every pixel.
+    pub mean: f32,
+    /// The largest mean over any [`REGION`]×[`REGION`] square (clamped to the image).
+    pub worst_region: f32,
+    /// The top-left corner of that square.
+    pub worst_region_at: [u32; 2],
+    /// The mean over the pixels a mask keeps, when one was given (`None` also when it keeps none).
+    pub masked_mean: Option<f32>,
+}
+
+impl Figures {
+    /// The figures of `errors` (one per pixel, rows from the top); `mask` keeps the pixels where
+    /// it is true. A NaN error makes every figure NaN.
+    pub fn of(errors: &[f32], width: u32, height: u32, mask: Option<&[bool]>) -> Figures {
+        assert_eq!(errors.len(), (width * height) as usize, "one error per pixel");
+        let mean = (errors.iter().map(|&e| f64::from(e)).sum::<f64>() / errors.len().max(1) as f64) as f32;
+        let (worst_region, worst_region_at) = worst_region(errors, width, height, REGION);
+        let masked_mean = mask.and_then(|mask| {
+            let kept: Vec<f64> =
+                errors.iter().zip(mask).filter(|(_, keep)| **keep).map(|(&e, _)| f64::from(e)).collect();
+            (!kept.is_empty()).then(|| (kept.iter().sum::<f64>() / kept.len() as f64) as f32)
+        });
+        Figures { mean, worst_region, worst_region_at, masked_mean }
+    }
+}
+
+/// The largest mean of `errors` over any `side`×`side` square (clamped to the image) and its
+/// top-left corner, from a summed-area table; NaN when any error is NaN, which `f64::max` would
+/// otherwise skip.
+pub fn worst_region(errors: &[f32], width: u32, height: u32, side: u32) -> (f32, [u32; 2]) {
+    if errors.iter().any(|e| e.is_nan()) {
+        return (f32::NAN, [0, 0]);
+    }
+    let (w, h) = (width as usize, height as usize);
+    let (sw, sh) = (side.min(width) as usize, side.min(height) as usize);
+    // table[y][x] holds the sum of errors above and left of pixel (x, y).
+    let mut table = vec![0.0f64; (w + 1) * (h + 1)];
+    for y in 0..h {
+        let mut row = 0.0;
+        for x in 0..w {
+            row += f64::from(errors[y * w + x]);
+            table[(y + 1) * (w + 1) + x + 1] = table[y * (w + 1) + x + 1] + row;
+        }
+    }
+    let at = |x: usize, y: usize| table[y * (w + 1) + x];
+    let (mut worst, mut corner) = (0.0f64, [0, 0]);
+    for y in 0..=h.saturating_sub(sh) {
+        for x in 0..=w.saturating_sub(sw) {
+            let sum = at(x + sw, y + sh) - at(x, y + sh) - at(x + sw, y) + at(x, y);
+            if sum > worst {
+                (worst, corner) = (sum, [x as u32, y as u32]);
+            }
+        }
+    }
+    ((worst / (sw * sh).max(1) as f64) as f32, corner)
+}
+
 /// PSNR of two equally long byte buffers with peak 255.
 pub fn psnr(a: &[u8], b: &[u8]) -> f64 {
     let squared: f64 = a.iter().zip(b).map(|(&x, &y)| (f64::from(x) - f64::from(y)).powi(2)).sum();

@@ -52,7 +52,15 @@ pub struct Headless {
 
 impl Headless {
     pub fn new(gpu: &Gpu, scene: &Scene) -> Headless {
-        let renderer = Renderer::new(gpu, scene, OUTPUT_FORMAT);
+        Headless::with_renderer(gpu, scene, Renderer::new(gpu, scene, OUTPUT_FORMAT))
+    }
+
+    /// A headless renderer whose passes compile `wgsl` (a lab's functions: src/lab).
+    pub fn with_wgsl(gpu: &Gpu, scene: &Scene, wgsl: crate::shaders::Wgsl) -> Headless {
+        Headless::with_renderer(gpu, scene, Renderer::with_wgsl(gpu, scene, OUTPUT_FORMAT, wgsl, false))
+    }
+
+    fn with_renderer(gpu: &Gpu, scene: &Scene, renderer: Renderer) -> Headless {
         let size = (scene.camera.width, scene.camera.height);
         let targets = FrameTargets::new(&gpu.device, drawn_size(size, scene.settings.raster.render_scale));
         let output = GpuTexture::target(&gpu.device, "frame::output", size, OUTPUT_FORMAT);

@@ -161,7 +161,7 @@ impl RefractionPass {
         });
         let layout = shader.layout_with(device, layouts, "refraction::layout", &group_layout);
         RefractionPass {
-            module: SurfaceModule::new(device, "refraction::shader", shaders::REFRACTION),
+            module: SurfaceModule::new(device, shader, "refraction::shader", shaders::REFRACTION),
             group_layout,
             layout,
             back: HashMap::new(),

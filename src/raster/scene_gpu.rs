@@ -19,7 +19,7 @@ use crate::gpu::{Gpu, layout};
 use crate::scene::{ColorSpace, Scene, Wrap};
 use crate::settings::RenderSettings;
 use crate::settings::{TextureFilter, TextureSettings};
-use crate::shaders;
+use crate::shaders::Wgsl;
 use crate::texture::mipmap::Filter;
 
 /// The bind group layouts every scene pass shares.
@@ -62,10 +62,13 @@ impl SceneLayouts {
     }
 }
 
-/// The pipeline layout of groups 0 to 2 that every pass drawing the scene's surfaces shares; a
-/// pass with a group 3 of its own makes its layout with [`Self::layout_with`].
+/// The pipeline layout of groups 0 to 2 that every pass drawing the scene's surfaces shares, and
+/// the WGSL their modules compile (Mirador's own, or with a lab's functions in place of some of
+/// its own: [`Wgsl`]); a pass with a group 3 of its own makes its layout with
+/// [`Self::layout_with`].
 pub struct SurfaceLayout {
     pub layout: wgpu::PipelineLayout,
+    pub wgsl: Wgsl,
 }
 
 /// The vertex buffers of every scene pipeline: the mesh's vertices, and the instances.
@@ -73,13 +76,13 @@ pub const VERTEX_BUFFERS: [Option<wgpu::VertexBufferLayout<'static>>; 2] =
     [Some(Vertex::LAYOUT), Some(GpuInstance::LAYOUT)];
 
 impl SurfaceLayout {
-    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts) -> SurfaceLayout {
+    pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, wgsl: Wgsl) -> SurfaceLayout {
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("scene::layout"),
             bind_group_layouts: &[Some(&layouts.frame), Some(&layouts.material), Some(&layouts.view)],
             immediate_size: 0,
         });
-        SurfaceLayout { layout }
+        SurfaceLayout { layout, wgsl }
     }
 
     /// A pipeline layout of groups 0 to 2 and `group3`.
@@ -99,14 +102,14 @@ impl SurfaceLayout {
 }
 
 /// A surface pass's shader module: the surface code of `shaders/common/surface.wgsl` and the
-/// pass's own file (`src/shaders.rs`, `compose_surface`).
+/// pass's own file (`src/shaders.rs`, `Wgsl::compose_surface`).
 pub struct SurfaceModule {
     pub module: wgpu::ShaderModule,
 }
 
 impl SurfaceModule {
-    pub fn new(device: &wgpu::Device, label: &str, pass: &str) -> SurfaceModule {
-        SurfaceModule { module: shaders::surface_module(device, label, pass) }
+    pub fn new(device: &wgpu::Device, surface: &SurfaceLayout, label: &str, pass: &str) -> SurfaceModule {
+        SurfaceModule { module: surface.wgsl.surface_module(device, label, pass) }
     }
 
     /// The vertex stage every surface pipeline shares (`vs_scene`, its position `@invariant`).

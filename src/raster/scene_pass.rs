@@ -97,7 +97,7 @@ pub type MirrorPart = (Option<Range<u32>>, Option<wgpu::BindGroup>);
 
 impl ScenePass {
     pub fn new(device: &wgpu::Device, layouts: &SceneLayouts, shader: &SurfaceLayout) -> ScenePass {
-        let module = SurfaceModule::new(device, "scene::shader", shaders::SCENE);
+        let module = SurfaceModule::new(device, shader, "scene::shader", shaders::SCENE);
         let prepass_pipeline = |label, fragment| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),

@@ -165,7 +165,7 @@ impl TransparencyPass {
         });
         let peel_layout = shader.layout_with(device, layouts, "transparency::peel_layout", &peel_group_layout);
         TransparencyPass {
-            module: SurfaceModule::new(device, "transparency::shader", shaders::TRANSPARENCY),
+            module: SurfaceModule::new(device, shader, "transparency::shader", shaders::TRANSPARENCY),
             peel_group_layout,
             peel_layout,
             pipelines: HashMap::new(),

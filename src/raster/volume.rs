@@ -275,7 +275,7 @@ impl VolumePass {
             })
         };
         VolumePass {
-            module: SurfaceModule::new(device, "volume::shader", shaders::VOLUME),
+            module: SurfaceModule::new(device, shader, "volume::shader", shaders::VOLUME),
             group_layout,
             layout,
             pipelines: HashMap::new(),

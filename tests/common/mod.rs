@@ -114,32 +114,8 @@ impl GoldenError {
     }
 }
 
-/// The largest mean of `errors` over any `side`×`side` window (clamped to the image), from a
-/// summed-area table; NaN when any error is NaN, which `f64::max` would otherwise skip.
 fn worst_window_mean(errors: &[f32], width: u32, height: u32, side: u32) -> f32 {
-    if errors.iter().any(|e| e.is_nan()) {
-        return f32::NAN;
-    }
-    let (w, h) = (width as usize, height as usize);
-    let (sw, sh) = (side.min(width) as usize, side.min(height) as usize);
-    // table[y][x] holds the sum of errors above and left of pixel (x, y).
-    let mut table = vec![0.0f64; (w + 1) * (h + 1)];
-    for y in 0..h {
-        let mut row = 0.0;
-        for x in 0..w {
-            row += f64::from(errors[y * w + x]);
-            table[(y + 1) * (w + 1) + x + 1] = table[y * (w + 1) + x + 1] + row;
-        }
-    }
-    let at = |x: usize, y: usize| table[y * (w + 1) + x];
-    let mut worst = 0.0f64;
-    for y in 0..=h - sh {
-        for x in 0..=w - sw {
-            let sum = at(x + sw, y + sh) - at(x, y + sh) - at(x + sw, y) + at(x, y);
-            worst = worst.max(sum);
-        }
-    }
-    (worst / (sw * sh) as f64) as f32
+    mirador::compare::worst_region(errors, width, height, side).0
 }
 
 /// The directory of the golden images.

@@ -43,6 +43,7 @@ use crate::gpu::mipmap::MipmapGenerator;
 use crate::output::OutputTransform;
 use crate::scene::Scene;
 use crate::settings::{MirrorView, RenderSettings};
+use crate::shaders::Wgsl;
 use crate::volume::WIREFRAME_CELLS;
 use plan::{FramePlan, plan};
 
@@ -104,20 +105,32 @@ struct Phases<'p> {
 impl Renderer {
     /// The passes, with `scene` loaded.
     pub fn new(gpu: &Gpu, scene: &Scene, output_format: wgpu::TextureFormat) -> Renderer {
-        Renderer::build(gpu, scene, output_format, false)
+        Renderer::build(gpu, scene, output_format, Wgsl::builtin(), false)
+    }
+
+    /// The passes, with `scene` loaded, their surface modules compiled from `wgsl` (a lab's
+    /// student functions in place of Mirador's: src/lab). `inspect` as [`Self::inspecting`].
+    pub fn with_wgsl(
+        gpu: &Gpu,
+        scene: &Scene,
+        output_format: wgpu::TextureFormat,
+        wgsl: Wgsl,
+        inspect: bool,
+    ) -> Renderer {
+        Renderer::build(gpu, scene, output_format, wgsl, inspect)
     }
 
     /// A renderer that can inspect a pixel ([`Self::inspect`]): its view groups carry the
     /// inspection buffer, which needs storage buffers written by fragment shaders (every Vulkan
     /// device; not WebGL).
     pub fn inspecting(gpu: &Gpu, scene: &Scene, output_format: wgpu::TextureFormat) -> Renderer {
-        Renderer::build(gpu, scene, output_format, true)
+        Renderer::build(gpu, scene, output_format, Wgsl::builtin(), true)
     }
 
-    fn build(gpu: &Gpu, scene: &Scene, output_format: wgpu::TextureFormat, inspect: bool) -> Renderer {
+    fn build(gpu: &Gpu, scene: &Scene, output_format: wgpu::TextureFormat, wgsl: Wgsl, inspect: bool) -> Renderer {
         let device = &gpu.device;
         let layouts = SceneLayouts::new(device, inspect);
-        let surface = SurfaceLayout::new(device, &layouts);
+        let surface = SurfaceLayout::new(device, &layouts, wgsl);
         let mipmaps = MipmapGenerator::new(device);
         let mut mirrors = MirrorPass::default();
         let mut environment = EnvironmentPass::new(device);

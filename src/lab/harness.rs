@@ -1,0 +1,261 @@
+//! Known-answer tests: one call of a student's function on tiny inputs, run in a compute shader
+//! with the shared WGSL (and the student's functions in place of Mirador's), its value read
+//! back. Inputs a texture function needs are two tiny textures made here, whose every texel is
+//! known (the values a test expects are worked out by hand from these):
+//!
+//! - `lab_texture`: `texture_2d<f32>`, 4×4 with a full chain of 3 levels. Level 0 holds
+//!   (x, y, (x + y) mod 2, 1) at texel (x, y); level 1 holds (10 + x, 10 + y, 0.5, 1); level 2
+//!   holds (20, 20, 0.5, 1). Levels far apart make a wrong level, weight or texel show at once.
+//! - `lab_depth`: `texture_depth_2d_array`, 4×4, one layer, depth (x + 4y + 1)/20 at texel
+//!   (x, y): 0.05 in the top-left corner to 0.8 in the bottom-right.
+
+use crate::gpu::Gpu;
+use wgpu::util::DeviceExt;
+
+/// The harness's bindings, declared before the entry point.
+pub const BINDINGS: &str = "
+@group(0) @binding(0) var<storage, read_write> lab_out: array<vec4f>;
+@group(0) @binding(1) var lab_texture: texture_2d<f32>;
+@group(0) @binding(2) var lab_depth: texture_depth_2d_array;
+";
+
+const SIDE: u32 = 4;
+
+/// The harness's textures and layout, made once for every call.
+pub struct Harness {
+    layout: wgpu::BindGroupLayout,
+    group: wgpu::BindGroup,
+    output: wgpu::Buffer,
+    staging: wgpu::Buffer,
+}
+
+impl Harness {
+    pub fn new(gpu: &Gpu) -> Harness {
+        let device = &gpu.device;
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty,
+            count: None,
+        };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("lab::harness"),
+            entries: &[
+                entry(
+                    0,
+                    wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: false },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                ),
+                entry(
+                    1,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                ),
+                entry(
+                    2,
+                    wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2Array,
+                        multisampled: false,
+                    },
+                ),
+            ],
+        });
+        let texture = colour_texture(gpu);
+        let depth = depth_texture(gpu);
+        let buffer = |usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lab::harness"),
+                size: 16,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        let output = buffer(wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
+        let staging = buffer(wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ);
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("lab::harness"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: output.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&texture.create_view(&Default::default())),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&depth.create_view(&wgpu::TextureViewDescriptor {
+                        dimension: Some(wgpu::TextureViewDimension::D2Array),
+                        ..Default::default()
+                    })),
+                },
+            ],
+        });
+        Harness { layout, group, output, staging }
+    }
+
+    /// The value of `call` (a `vec4f` expression) in a module of the shared WGSL as `wgsl`
+    /// composes it; a GPU error is the error's text.
+    pub fn call(&self, gpu: &Gpu, wgsl: &crate::shaders::Wgsl, call: &str) -> Result<[f32; 4], String> {
+        let entry =
+            format!("{BINDINGS}\n@compute @workgroup_size(1)\nfn lab_main() {{\n    lab_out[0] = {call};\n}}\n");
+        let source = wgsl.compose_common(&entry);
+        if let Err(error) = naga::front::wgsl::parse_str(&source) {
+            return Err(format!("the test's call `{call}` does not compile: {}", error.message()));
+        }
+        let device = &gpu.device;
+        let run = || {
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("lab::call"),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            });
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("lab::call"),
+                bind_group_layouts: &[Some(&self.layout)],
+                immediate_size: 0,
+            });
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("lab::call"),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some("lab_main"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            let mut encoder = device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                pass.set_pipeline(&pipeline);
+                pass.set_bind_group(0, &self.group, &[]);
+                pass.dispatch_workgroups(1, 1, 1);
+            }
+            encoder.copy_buffer_to_buffer(&self.output, 0, &self.staging, 0, 16);
+            gpu.queue.submit([encoder.finish()]);
+        };
+        gpu.checked(run).map_err(|e| e.to_string())?;
+        self.staging.slice(..).map_async(wgpu::MapMode::Read, |_| ());
+        gpu.wait();
+        let value = {
+            let view = self.staging.slice(..).get_mapped_range().map_err(|e| e.to_string())?;
+            let floats: &[f32] = bytemuck::cast_slice(&view);
+            [floats[0], floats[1], floats[2], floats[3]]
+        };
+        self.staging.unmap();
+        Ok(value)
+    }
+}
+
+/// `lab_texture`: see the module's header.
+fn colour_texture(gpu: &Gpu) -> wgpu::Texture {
+    let texel = |level: u32, x: u32, y: u32| -> [f32; 4] {
+        match level {
+            0 => [x as f32, y as f32, ((x + y) % 2) as f32, 1.0],
+            1 => [10.0 + x as f32, 10.0 + y as f32, 0.5, 1.0],
+            _ => [20.0, 20.0, 0.5, 1.0],
+        }
+    };
+    let mut data = Vec::new();
+    for level in 0..3 {
+        let side = SIDE >> level;
+        for y in 0..side {
+            for x in 0..side {
+                data.extend(texel(level, x, y));
+            }
+        }
+    }
+    gpu.device.create_texture_with_data(
+        &gpu.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("lab_texture"),
+            size: wgpu::Extent3d { width: SIDE, height: SIDE, depth_or_array_layers: 1 },
+            mip_level_count: 3,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::MipMajor,
+        bytemuck::cast_slice(&data),
+    )
+}
+
+/// `lab_depth`, drawn (a depth texture cannot be written from a buffer): a full-screen triangle
+/// whose fragments write their texel's depth.
+fn depth_texture(gpu: &Gpu) -> wgpu::Texture {
+    let device = &gpu.device;
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("lab_depth"),
+        size: wgpu::Extent3d { width: SIDE, height: SIDE, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Depth32Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    });
+    let source = "
+@vertex fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
+    return vec4f(f32(i / 2u) * 4.0 - 1.0, f32(i % 2u) * 4.0 - 1.0, 0.0, 1.0);
+}
+@fragment fn fs(@builtin(position) p: vec4f) -> @builtin(frag_depth) f32 {
+    return (floor(p.x) + 4.0 * floor(p.y) + 1.0) / 20.0;
+}";
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("lab_depth"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("lab_depth"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Always),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs"),
+            compilation_options: Default::default(),
+            targets: &[],
+        }),
+        multiview_mask: None,
+        cache: None,
+    });
+    let view = texture.create_view(&Default::default());
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("lab_depth"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.draw(0..3, 0..1);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    texture
+}

@@ -1,0 +1,267 @@
+//! The student's file: what it replaces, and whether it compiles. Signatures are checked first,
+//! because a wrong one would otherwise be reported where Mirador calls the function, in a file
+//! the student has never seen; then naga parses and validates every surface module with the
+//! student's functions in, and an error in the student's text is given at its own
+//! `file:line:column`.
+
+use super::Lab;
+use crate::shaders::{self, Wgsl};
+
+/// A problem with the student's file, where it is.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Problem {
+    /// 1-based line and column in the student's file; `None` for the file as a whole.
+    pub line: Option<u32>,
+    pub column: Option<u32>,
+    /// The line's text.
+    pub text: Option<String>,
+    pub message: String,
+}
+
+impl Problem {
+    /// `file:line:column: message`, the line under it.
+    pub fn display(&self, file: &str) -> String {
+        match (self.line, self.column, &self.text) {
+            (Some(line), Some(column), Some(text)) => {
+                format!(
+                    "{file}:{line}:{column}: {}\n    {}\n    {}^",
+                    self.message,
+                    text,
+                    " ".repeat(column as usize - 1)
+                )
+            }
+            _ => format!("{file}: {}", self.message),
+        }
+    }
+}
+
+/// The name a declaration declares: `const NAME = …;`, `fn NAME(…`.
+pub fn declared_name(declaration: &str) -> Option<String> {
+    let rest =
+        declaration.trim_start().strip_prefix("const ").or_else(|| declaration.trim_start().strip_prefix("fn "))?;
+    let name: String = rest.trim_start().chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
+    (!name.is_empty()).then_some(name)
+}
+
+/// Mirador's own declaration of the function `name` in the shared WGSL, and the comment lines
+/// right above it.
+pub fn builtin_declaration(name: &str) -> Option<(String, String)> {
+    for (_, text) in shaders::COMMON.iter().chain(shaders::SURFACE) {
+        if let Some(range) = shaders::declaration(text, name) {
+            let before = &text[..range.start];
+            let comments: Vec<&str> = before.lines().rev().take_while(|line| line.starts_with("//")).collect();
+            let comments: String = comments.iter().rev().map(|line| format!("{line}\n")).collect();
+            return Some((comments, text[range].to_owned()));
+        }
+    }
+    None
+}
+
+/// The WGSL the reference image is drawn with: Mirador's own functions, routed as the lab routes
+/// them.
+pub fn reference(lab: &Lab) -> Wgsl {
+    Wgsl::replacing(lab.route_names(), lab.routes.join("\n"))
+}
+
+/// The WGSL the student's image is drawn with: the slots from `student`, the lab's routes after
+/// them. The student's text comes first in what is appended, so its offsets map back to its own.
+pub fn student(lab: &Lab, student: &str) -> Wgsl {
+    let mut replaced: Vec<String> = lab.slots.iter().map(|slot| slot.name.clone()).collect();
+    replaced.extend(lab.route_names());
+    let mut code = student.to_owned();
+    if !code.ends_with('\n') {
+        code.push('\n');
+    }
+    code.push_str(&lab.routes.join("\n"));
+    Wgsl::replacing(replaced, code)
+}
+
+/// Everything wrong with the student's file, empty when every surface module compiles with it.
+pub fn problems(lab: &Lab, text: &str) -> Vec<Problem> {
+    let signatures = signature_problems(lab, text);
+    if !signatures.is_empty() {
+        return signatures;
+    }
+    let Some(mut problem) = compile_problem(lab, text) else {
+        return Vec::new();
+    };
+    if problem.line.is_none() {
+        // naga gave no place: find the function whose own replacement by Mirador's cures it.
+        for slot in &lab.slots {
+            let range = shaders::declaration(text, &slot.name).expect("the signatures were checked");
+            let (_, builtin) = builtin_declaration(&slot.name).expect("a lab's slots are Mirador's functions");
+            let mut cured = text.to_owned();
+            cured.replace_range(range.clone(), &builtin);
+            if compile_problem(lab, &cured).is_none() {
+                let line = text[..range.start].matches('\n').count() as u32 + 1;
+                problem.line = Some(line);
+                problem.column = Some(1);
+                problem.text = text.lines().nth(line as usize - 1).map(str::to_owned);
+                problem.message = format!("in `{}` (naga gives no closer place): {}", slot.name, problem.message);
+                break;
+            }
+        }
+    }
+    vec![problem]
+}
+
+/// naga's first complaint about a surface module or the known-answer harness with `text` in.
+fn compile_problem(lab: &Lab, text: &str) -> Option<Problem> {
+    let wgsl = student(lab, text);
+    let passes = [shaders::SCENE, shaders::TRANSPARENCY, shaders::REFRACTION, shaders::VOLUME];
+    for pass in passes {
+        let composed = wgsl.compose_surface(pass);
+        let start = composed.len() - wgsl.code().len();
+        if let Some(problem) = naga_problem(&composed, start, text) {
+            return Some(problem);
+        }
+    }
+    let harness = wgsl.compose_common(super::harness::BINDINGS);
+    naga_problem(&harness, harness.len() - wgsl.code().len(), text)
+}
+
+/// Each slot's signature against Mirador's: the parameter and result types, names aside.
+fn signature_problems(lab: &Lab, text: &str) -> Vec<Problem> {
+    let mut problems = Vec::new();
+    for slot in &lab.slots {
+        let (_, builtin) = builtin_declaration(&slot.name).expect("a lab's slots are Mirador's functions");
+        let wanted = signature(&builtin);
+        match shaders::declaration(text, &slot.name) {
+            None => problems.push(Problem {
+                line: None,
+                column: None,
+                text: None,
+                message: format!("`{}` is missing: the lab calls `{}`", slot.name, header(&builtin)),
+            }),
+            Some(range) => {
+                let theirs = signature(&text[range.clone()]);
+                if theirs != wanted {
+                    let line = text[..range.start].matches('\n').count() as u32 + 1;
+                    problems.push(Problem {
+                        line: Some(line),
+                        column: Some(1),
+                        text: text.lines().nth(line as usize - 1).map(str::to_owned),
+                        message: format!(
+                            "`{}` must keep its signature `{}` (the parameters' names may change, not their types)",
+                            slot.name,
+                            header(&builtin)
+                        ),
+                    });
+                }
+            }
+        }
+    }
+    problems
+}
+
+/// A function's header, `fn name(…) -> T`, on one line.
+fn header(declaration: &str) -> String {
+    let head = &declaration[..declaration.find('{').unwrap_or(declaration.len())];
+    head.split_whitespace().collect::<Vec<_>>().join(" ").replace("( ", "(").replace(", )", ")").replace(",)", ")")
+}
+
+/// The types of a function's parameters and its result, spelled one way (`vec3<f32>` as
+/// `vec3f`), names and spaces left out.
+fn signature(declaration: &str) -> (Vec<String>, String) {
+    let head = &declaration[..declaration.find('{').unwrap_or(declaration.len())];
+    let (Some(open), Some(close)) = (head.find('('), head.rfind(')')) else {
+        return (Vec::new(), String::new());
+    };
+    let params = split_top_level(&head[open + 1..close])
+        .into_iter()
+        .filter(|p| !p.trim().is_empty())
+        .map(|p| canonical_type(p.split_once(':').map_or("", |(_, t)| t)))
+        .collect();
+    let result = head[close + 1..].trim().strip_prefix("->").map(canonical_type).unwrap_or_default();
+    (params, result)
+}
+
+fn split_top_level(list: &str) -> Vec<&str> {
+    let (mut depth, mut start, mut parts) = (0i32, 0, Vec::new());
+    for (i, c) in list.char_indices() {
+        match c {
+            '<' | '(' => depth += 1,
+            '>' | ')' => depth -= 1,
+            ',' if depth == 0 => {
+                parts.push(&list[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    parts.push(&list[start..]);
+    parts
+}
+
+fn canonical_type(ty: &str) -> String {
+    let mut ty: String = ty.chars().filter(|c| !c.is_whitespace()).collect();
+    for n in 2..=4 {
+        for (scalar, suffix) in [("f32", "f"), ("i32", "i"), ("u32", "u")] {
+            ty = ty.replace(&format!("vec{n}<{scalar}>"), &format!("vec{n}{suffix}"));
+        }
+    }
+    ty
+}
+
+/// naga's first complaint about `composed`, located in the student's `text` when it falls in it
+/// (`text` begins at byte `start` of `composed`).
+fn naga_problem(composed: &str, start: usize, text: &str) -> Option<Problem> {
+    let (message, offset) = match naga::front::wgsl::parse_str(composed) {
+        Err(error) => (error.message().to_owned(), error.location(composed).map(|l| l.offset as usize)),
+        Ok(module) => {
+            let mut validator =
+                naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all());
+            let error = validator.validate(&module).err()?;
+            let mut message = error.as_inner().to_string();
+            let mut cause = std::error::Error::source(error.as_inner());
+            while let Some(inner) = cause {
+                message.push_str(": ");
+                message.push_str(&inner.to_string());
+                cause = inner.source();
+            }
+            (message, error.location(composed).map(|l| l.offset as usize))
+        }
+    };
+    match offset {
+        Some(offset) if offset >= start && offset < start + text.len() => {
+            let within = offset - start;
+            let line = text[..within].matches('\n').count() as u32 + 1;
+            let line_start = text[..within].rfind('\n').map_or(0, |n| n + 1);
+            let column = text[line_start..within].chars().count() as u32 + 1;
+            Some(Problem {
+                line: Some(line),
+                column: Some(column),
+                text: text.lines().nth(line as usize - 1).map(str::to_owned),
+                message,
+            })
+        }
+        Some(offset) => {
+            // In Mirador's code: say in which of its files, so a teacher can tell.
+            let file = composed[..offset]
+                .rfind("// ---- ")
+                .map(|at| composed[at + 8..].lines().next().unwrap_or("").to_owned());
+            let place = file.map_or_else(|| "the pass's own file".to_owned(), |f| format!("shaders/{f}"));
+            Some(Problem {
+                line: None,
+                column: None,
+                text: None,
+                message: format!("{message} (in Mirador's {place}, where it uses your functions)"),
+            })
+        }
+        None => Some(Problem { line: None, column: None, text: None, message }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn types_are_spelled_one_way_and_names_are_ignored() {
+        let a = signature("fn f(n: vec3f, t: texture_2d<f32>, k: f32) -> vec2<f32> {");
+        let b = signature("fn f(normal : vec3<f32>,\n tex: texture_2d<f32>, scale: f32)->vec2f {");
+        assert_eq!(a, b);
+        assert_ne!(a, signature("fn f(n: vec3f, t: texture_2d<f32>) -> vec2f {"));
+        assert_eq!(declared_name("const TRILINEAR_BY_HAND = true;").as_deref(), Some("TRILINEAR_BY_HAND"));
+    }
+}

@@ -1,0 +1,314 @@
+//! The labs (src/lab, docs/course/labs.md) as a student and a teacher meet them: every lab's
+//! answer key scores full marks, its stub fails every known-answer test, each of its known
+//! mistakes fails and is named by the test that caught it; a file that does not compile, has a
+//! wrong signature or never returns ends in a clear message and a report, never a panic or a
+//! hang. And the routes a lab takes instead of the GPU's fixed function draw what the fixed
+//! function draws.
+
+mod common;
+
+use mirador::lab::{self, Lab};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn mirador(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mirador")).args(args).output().expect("running the mirador binary")
+}
+
+/// A fresh lab folder for `lab`, with the answer key when `solution`.
+fn folder(lab: &str, case: &str, solution: bool) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mirador-lab-{lab}-{case}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let dir_text = dir.display().to_string();
+    let mut args = vec!["lab", "new", lab, &dir_text];
+    if solution {
+        args.push("--solution");
+    }
+    let output = mirador(&args);
+    assert!(output.status.success(), "lab new: {}", String::from_utf8_lossy(&output.stderr));
+    dir
+}
+
+/// What `lab check` wrote into `dir/results.json`.
+fn results(dir: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(dir.join("results.json")).expect("lab check writes results.json");
+    serde_json::from_str(&text).expect("results.json is JSON")
+}
+
+fn check(dir: &Path, extra: &[&str]) -> (Output, serde_json::Value) {
+    let dir_text = dir.display().to_string();
+    let mut args = vec!["lab", "check", &dir_text];
+    args.extend(extra);
+    let output = mirador(&args);
+    let code = output.status.code();
+    assert!(matches!(code, Some(0 | 1)), "lab check ended with {code:?}: {}", String::from_utf8_lossy(&output.stderr));
+    let results = results(dir);
+    (output, results)
+}
+
+fn tests_of(results: &serde_json::Value) -> &Vec<serde_json::Value> {
+    results["tests"].as_array().expect("results.json lists its tests")
+}
+
+/// The answer key, the stub and each known mistake of `name`.
+fn battery(name: &str) {
+    let lab: Lab = lab::find(name).expect("a built-in lab");
+    let known = lab.known_answers.len();
+
+    let key = folder(name, "key", true);
+    let (output, key_results) = check(&key, &[]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "the answer key of {name} must pass:\n{stdout}");
+    assert_eq!(key_results["score"], key_results["max_score"], "{stdout}");
+    assert!(key.join("report.md").exists() && key.join("NOTES.md").exists());
+
+    let stub = folder(name, "stub", false);
+    let (output, stub_results) = check(&stub, &[]);
+    assert!(!output.status.success(), "the stub of {name} must fail");
+    for test in &tests_of(&stub_results)[..known] {
+        assert_eq!(test["score"], 0.0, "the stub of {name} scores on {}", test["name"]);
+    }
+
+    for mistake in &lab.mistakes {
+        let dir = folder(name, &mistake.name.replace(|c: char| !c.is_ascii_alphanumeric(), "-"), false);
+        std::fs::write(dir.join(&lab.file), lab.mistaken(mistake)).expect("writing the mistaken file");
+        let (output, results) = check(&dir, &[]);
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(!output.status.success(), "{name}: the mistake `{}` passed every test:\n{stdout}", mistake.name);
+        let named = tests_of(&results).iter().any(|t| t["mistake"] == mistake.name.as_str() && t["score"] == 0.0);
+        assert!(named, "{name}: no failing test names the mistake `{}`:\n{stdout}", mistake.name);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    let _ = std::fs::remove_dir_all(&key);
+    let _ = std::fs::remove_dir_all(&stub);
+}
+
+#[test]
+fn mipmaps_lab() {
+    battery("mipmaps");
+}
+
+#[test]
+fn bump_lab() {
+    battery("bump");
+}
+
+#[test]
+fn shadow_map_lab() {
+    battery("shadow-map");
+}
+
+#[test]
+fn refraction_lab() {
+    battery("refraction");
+}
+
+#[test]
+fn environment_maps_lab() {
+    battery("environment-maps");
+}
+
+/// A broken student file, checked: the message names the place, a report is written, the score
+/// falls short (to 0 when the file does not compile), and the command fails without a panic.
+fn broken(case: &str, edit: impl Fn(&str) -> String, needles: &[&str], extra: &[&str]) -> String {
+    let dir = folder("bump", case, true);
+    let path = dir.join("bump.wgsl");
+    let text = std::fs::read_to_string(&path).expect("the answer key");
+    std::fs::write(&path, edit(&text)).expect("editing the student's file");
+    let (output, results) = check(&dir, extra);
+    let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+    assert!(!output.status.success(), "{case}: a broken file must fail:\n{stdout}");
+    for needle in needles {
+        assert!(stdout.contains(needle), "{case}: the report should say `{needle}`:\n{stdout}");
+    }
+    assert!(results["score"].as_f64() < results["max_score"].as_f64(), "{case}: {stdout}");
+    if stdout.contains("does not compile") {
+        assert_eq!(results["score"], 0.0, "{case}: {stdout}");
+    }
+    assert!(dir.join("report.md").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+    stdout
+}
+
+#[test]
+fn a_syntax_error_is_given_at_the_students_line() {
+    let line_of = |text: &str, needle: &str| text.lines().position(|l| l.contains(needle)).expect("the line") + 1;
+    let key = lab::find("bump").unwrap().solution();
+    let line = line_of(&key, "return k * vec2f(");
+    let out = broken(
+        "syntax",
+        |t| t.replace("return k * vec2f(", "return k * vec2f(("),
+        &[&format!("bump.wgsl:{line}:")],
+        &[],
+    );
+    assert!(out.contains("return k * vec2f(("), "the line is shown:\n{out}");
+}
+
+#[test]
+fn a_type_error_is_given_at_the_students_line() {
+    let key = lab::find("bump").unwrap().solution();
+    let line = key.lines().position(|l| l.contains("let su = tu - dot(tu, n) * n;")).unwrap() + 1;
+    let out =
+        broken("type", |t| t.replace("let su = tu", "let su: vec2f = tu"), &[&format!("bump.wgsl:{line}:9:")], &[]);
+    assert!(out.contains("`su` is expected to be `vec2<f32>`"), "{out}");
+    // An error naga gives no place for is placed at the function it is in.
+    let line = key.lines().position(|l| l.contains("fn perturbed_normal(")).unwrap() + 1;
+    let out = broken(
+        "unplaced",
+        |t| t.replace("let len = length(m);", "let len = length(m) + vec2f(1.0);"),
+        &[&format!("bump.wgsl:{line}:1: in `perturbed_normal`")],
+        &[],
+    );
+    assert!(out.contains("Incompatible operands"), "{out}");
+}
+
+#[test]
+fn a_wrong_signature_is_named_with_the_right_one() {
+    broken(
+        "signature",
+        |t| {
+            t.replace(
+                "fn perturbed_normal(n: vec3f, tu: vec3f, tv: vec3f, du: f32, dv: f32)",
+                "fn perturbed_normal(n: vec3f, tu: vec3f, tv: vec3f, d: vec2f)",
+            )
+        },
+        &["`perturbed_normal` must keep its signature", "du: f32, dv: f32"],
+        &[],
+    );
+    broken(
+        "missing",
+        |t| t.replace("fn perturbed_normal(", "fn perturbed_normal_mine("),
+        &["`perturbed_normal` is missing"],
+        &[],
+    );
+}
+
+/// A loop whose condition never comes true. On a real GPU it would never return; lavapipe ends
+/// every shader invocation's loops after about 65 536 iterations (measured: such a loop returns
+/// x = 65535.7 from x = x + 1), so the loop's body here is long enough that the image tests take
+/// minutes even so. Either way the check stops the test at its time limit and goes on.
+#[test]
+fn a_loop_that_never_ends_is_a_failed_test_not_a_hang() {
+    let start = std::time::Instant::now();
+    let body = "        x = sin(x * 1.3 + cos(x));\n".repeat(100);
+    let out = broken(
+        "endless",
+        |t| {
+            t.replace(
+                "    let su = tu - dot(tu, n) * n;",
+                &format!("    var x = du;\n    loop {{\n{body}        if x > 5.0 {{ break; }}\n    }}\n    let su = tu - dot(tu, n) * n + vec3f(x * 1e-30);"),
+            )
+        },
+        &["did not finish within 8 s", "not run: an earlier test did not finish within 8 s"],
+        &["--time-limit", "8"],
+    );
+    assert!(start.elapsed().as_secs() < 60, "the check must stop the loop: {out}");
+}
+
+#[test]
+fn points_come_from_the_folder_and_hidden_tests_run_after_the_labs_own() {
+    let dir = folder("refraction", "points", true);
+    let config = std::fs::read_to_string(dir.join("lab.toml")).unwrap();
+    let config = config.replace(
+        "\"fresnel: total internal reflection reflects everything\" = 1",
+        "\"fresnel: total internal reflection reflects everything\" = 5",
+    );
+    std::fs::write(dir.join("lab.toml"), config).unwrap();
+    let hidden = dir.join("hidden");
+    std::fs::create_dir_all(&hidden).unwrap();
+    std::fs::write(
+        hidden.join("more.toml"),
+        "[[known]]\nname = \"fresnel: water at normal incidence\"\ncall = \"vec4f(fresnel(1.0, 1.0 / 1.333))\"\nexpect = [0.0204, 0.0204, 0.0204, 0.0204]\ntolerance = 1e-3\npoints = 2\n",
+    )
+    .unwrap();
+    let (output, results) = check(&dir, &["--tests", &hidden.display().to_string()]);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stdout));
+    let tests = tests_of(&results);
+    let tir = tests.iter().find(|t| t["name"] == "fresnel: total internal reflection reflects everything").unwrap();
+    assert_eq!(tir["max_score"], 5.0);
+    let last = tests.last().unwrap();
+    assert_eq!(
+        (last["name"].as_str(), last["score"].as_f64()),
+        (Some("fresnel: water at normal incidence"), Some(2.0))
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_student_file_is_never_overwritten() {
+    let dir = folder("bump", "twice", false);
+    let output = mirador(&["lab", "new", "bump", &dir.display().to_string()]);
+    assert!(!output.status.success());
+    assert!(String::from_utf8_lossy(&output.stderr).contains("already there"));
+    let output = mirador(&["lab", "new", "no-such-lab", &dir.display().to_string()]);
+    assert!(String::from_utf8_lossy(&output.stderr).contains("no lab named `no-such-lab`: the labs are mipmaps, bump"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The routes: texel loads filtered by hand draw what the sampler draws, and the shadow map
+/// compared by hand what the comparison sampler finds, so a lab's reference is the technique
+/// Mirador shows, not a look-alike.
+#[test]
+fn what_a_lab_routes_by_hand_draws_what_the_fixed_function_draws() {
+    use mirador::lab::images;
+    let gpu = common::gpu();
+    for (name, set, bound) in
+        [("mipmaps", vec![], 0.02), ("shadow-map", vec!["shadows.filter=\"none\"".to_owned()], 0.01)]
+    {
+        let lab = lab::find(name).unwrap();
+        let test = lab::ImageTest { set, ..lab.images[0].clone() };
+        let scene = images::scene(&test, None).unwrap();
+        let by_hand = images::raster(gpu, &scene, &lab::source::reference(&lab)).unwrap();
+        let fixed = images::raster(gpu, &scene, &mirador::shaders::Wgsl::builtin()).unwrap();
+        let (figures, _) = images::figures(&fixed, &by_hand);
+        eprintln!(
+            "{name}: by hand against the fixed function: mean {:.5}, worst region {:.5}",
+            figures.mean, figures.worst_region
+        );
+        assert!(figures.mean <= bound && figures.worst_region <= 4.0 * bound, "{name}: {figures:?}");
+        // And the route is taken: the stub's image differs.
+        let stub = images::raster(gpu, &scene, &lab::source::student(&lab, &lab.stub())).unwrap();
+        assert!(
+            images::figures(&fixed, &stub).0.mean > 0.02,
+            "{name}: the stub draws what Mirador draws: is the route taken?"
+        );
+    }
+}
+
+#[test]
+fn diff_reports_the_mean_the_worst_region_and_the_masked_mean() {
+    let dir = std::env::temp_dir().join(format!("mirador-lab-diff-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let a = image::RgbaImage::from_pixel(96, 64, image::Rgba([120, 120, 120, 255]));
+    let mut b = a.clone();
+    for y in 10..30 {
+        for x in 60..90 {
+            b.put_pixel(x, y, image::Rgba([250, 30, 30, 255]));
+        }
+    }
+    let mask =
+        image::RgbaImage::from_fn(
+            96,
+            64,
+            |x, _| if x >= 48 { image::Rgba([255; 4]) } else { image::Rgba([0, 0, 0, 255]) },
+        );
+    for (image, name) in [(&a, "a.png"), (&b, "b.png"), (&mask, "mask.png")] {
+        image.save(dir.join(name)).unwrap();
+    }
+    let path = |name: &str| dir.join(name).display().to_string();
+    let output = mirador(&["diff", &path("a.png"), &path("b.png"), "--mask", &path("mask.png"), "--json", "-"]);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let figures: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let mean = figures["flip_mean"].as_f64().unwrap();
+    let masked = figures["masked_flip_mean"].as_f64().unwrap();
+    let worst = figures["worst_region"]["flip_mean"].as_f64().unwrap();
+    // 600 changed pixels of 6144: the masked half holds them all, and the worst region is
+    // mostly inside the patch.
+    assert!(mean > 0.0 && (masked / mean - 2.0).abs() < 0.05, "mean {mean}, masked {masked}");
+    assert!(worst > 5.0 * mean, "worst region {worst}, mean {mean}");
+    assert!(figures["worst_region"]["x"].as_u64().unwrap() >= 58);
+    let same = mirador(&["diff", &path("a.png"), &path("a.png"), "--json", "-"]);
+    let same: serde_json::Value = serde_json::from_slice(&same.stdout).unwrap();
+    assert_eq!(same["flip_mean"], 0.0);
+    let _ = std::fs::remove_dir_all(&dir);
+}
