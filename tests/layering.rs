@@ -3,7 +3,7 @@
 //!
 //! - the crate's layers, each importing only from those below it:
 //!   `settings | shaders | files | base` ← `output | compare | settings_doc | volume`
-//!   ← `scene | linear_output` ← `texture` ← `trace | gpu` ← `raster` ← `explain` ← `viewer`
+//!   ← `scene | linear_output` ← `texture` ← `trace | gpu` ← `raster` ← `explain | lab` ← `viewer`
 //!   ← `web` (← `main.rs`), where modules of one layer never import each other: `base` holds
 //!   what `scene` and `volume` share (the ray, the material and texture indices), so the scene
 //!   holds volumes and reads their files while `volume` knows nothing of the scene;
@@ -37,6 +37,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("gpu", 4),
     ("raster", 5),
     ("explain", 6),
+    ("lab", 6),
     ("viewer", 7),
     ("web", 8),
 ];

@@ -1,9 +1,10 @@
 //! `mirador lab check DIR`: the student's file validated, then the tests run in a child process
 //! under a time limit each, scored from the points a teacher can edit, and reported.
 
+use super::find;
+use super::report::{Report, TestResult};
 use super::run::{Finding, Test, tests};
-use super::source::{self, Problem};
-use super::{Lab, find};
+use super::source;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader};
@@ -40,43 +41,6 @@ pub struct Options {
     pub points: Option<PathBuf>,
     /// How long one test may take.
     pub time_limit: Duration,
-}
-
-/// One test's result, as Gradescope reads it (`name`, `score`, `max_score`, `output`).
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct TestResult {
-    pub name: String,
-    pub score: f32,
-    pub max_score: f32,
-    pub output: String,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub mistake: Option<String>,
-    #[serde(skip)]
-    pub passed: bool,
-    #[serde(skip)]
-    pub images: Option<[String; 3]>,
-}
-
-/// What a check found.
-pub struct Report {
-    pub lab: Lab,
-    pub problems: Vec<Problem>,
-    pub results: Vec<TestResult>,
-    pub seconds: f64,
-}
-
-impl Report {
-    pub fn score(&self) -> f32 {
-        self.results.iter().map(|r| r.score).sum()
-    }
-
-    pub fn max_score(&self) -> f32 {
-        self.results.iter().map(|r| r.max_score).sum()
-    }
-
-    pub fn passed(&self) -> bool {
-        self.problems.is_empty() && self.results.iter().all(|r| r.passed)
-    }
 }
 
 /// Checks the lab in `options.dir` and writes its reports there.

@@ -2,10 +2,48 @@
 //! with its `name`, `score`, `max_score` and `output`), and `report.md`, a page with each image
 //! test's Correct / Yours / Difference pictures and score.
 
-use super::check::Report;
+use super::Lab;
+use super::source::Problem;
 use crate::output::write_atomically;
 use std::fmt::Write;
 use std::path::Path;
+
+/// One test's result, as Gradescope reads it (`name`, `score`, `max_score`, `output`).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TestResult {
+    pub name: String,
+    pub score: f32,
+    pub max_score: f32,
+    pub output: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mistake: Option<String>,
+    #[serde(skip)]
+    pub passed: bool,
+    #[serde(skip)]
+    pub images: Option<[String; 3]>,
+}
+
+/// What a check found.
+pub struct Report {
+    pub lab: Lab,
+    pub problems: Vec<Problem>,
+    pub results: Vec<TestResult>,
+    pub seconds: f64,
+}
+
+impl Report {
+    pub fn score(&self) -> f32 {
+        self.results.iter().map(|r| r.score).sum()
+    }
+
+    pub fn max_score(&self) -> f32 {
+        self.results.iter().map(|r| r.max_score).sum()
+    }
+
+    pub fn passed(&self) -> bool {
+        self.problems.is_empty() && self.results.iter().all(|r| r.passed)
+    }
+}
 
 /// The terminal's summary.
 pub fn text(report: &Report) -> String {
