@@ -96,6 +96,11 @@ macro_rules! builtin_files {
 
 builtin_files!(
     "assets/environments/sky.hdr",
+    "assets/labs/bump/lab.toml",
+    "assets/labs/environment-maps/lab.toml",
+    "assets/labs/mipmaps/lab.toml",
+    "assets/labs/refraction/lab.toml",
+    "assets/labs/shadow-map/lab.toml",
     "assets/scenes/bumps.toml",
     "assets/scenes/course/acceleration-teapot.toml",
     "assets/scenes/course/aliasing-edges.toml",

@@ -64,10 +64,6 @@ fn shadow_coordinates(clip_from_world: mat4x4f, p: vec3f) -> vec4f {
     return vec4f(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y, ndc.z, 1.0);
 }
 
-// Set by a lab (src/lab) whose student writes the comparison and its filter: the map is then
-// read by `shadow_pcf` from texel loads, not by the sampler's comparisons.
-const SHADOW_BY_HAND = false;
-
 // One comparison of pass 2: 1 where the point (at `depth` in the light's view) is lit, no farther
 // from the light than what the map stored there; 0 where something nearer hid it.
 fn shadow_compare(stored: f32, depth: f32) -> f32 {
@@ -77,6 +73,10 @@ fn shadow_compare(stored: f32, depth: f32) -> f32 {
 // Percentage-closer filtering by hand: the comparisons with the (2r+1)² texels around the one uv
 // falls in, averaged; r = 0 is the nearest texel alone. Compare first, then average: an average
 // of depths compared once is still all lit or all shadowed. Texels beyond the map repeat its edge.
+// Mirador's own filters use the sampler's comparisons (shadow_filtered); a lab (src/lab) whose
+// student writes these two functions routes shadow_filtered through them. Nothing else calls
+// them: WebGL's GLSL cannot load a texel of a depth texture, and a module that only declares
+// them still translates, since only what an entry point reaches is kept.
 fn shadow_pcf(map: texture_depth_2d_array, uv: vec2f, depth: f32, layer: u32, map_size: u32, r: i32) -> f32 {
     let centre = vec2i(floor(uv * f32(map_size)));
     let last = vec2i(i32(map_size) - 1);
@@ -108,11 +108,6 @@ fn shadow_filtered(
     filter_mode: u32,
     map_size: u32,
 ) -> f32 {
-    if SHADOW_BY_HAND {
-        // The grids by hand: one texel, 3×3 for the hardware's and PCF 3×3, 5×5 for the wider.
-        let r = select(select(2, 1, filter_mode == SHADOW_FILTER_PCF3 || filter_mode == SHADOW_FILTER_HARDWARE), 0, filter_mode == SHADOW_FILTER_NONE);
-        return shadow_pcf(map, uv, depth, layer, map_size, r);
-    }
     let size = f32(map_size);
     switch filter_mode {
         case SHADOW_FILTER_NONE: {

@@ -40,7 +40,7 @@ use serde::Deserialize;
 pub struct Lab {
     /// What `mirador lab new NAME` takes.
     pub name: String,
-    /// The course chapter (docs/course/NN-….md) the lab belongs to.
+    /// The number of the course chapter the lab belongs to (its file: [`chapter_file`]).
     pub chapter: u32,
     pub title: String,
     /// The student's file, as `lab new` writes it into the lab's folder.
