@@ -72,7 +72,7 @@ pub struct Tolerance {
 }
 
 /// The side, in pixels, of the windows [`GoldenError::worst_region`] averages over.
-pub const REGION: u32 = 32;
+pub const REGION: u32 = mirador::compare::REGION;
 
 /// How a render differs from its golden, in the statistics a [`Tolerance`] bounds.
 #[derive(Clone, Copy, Debug)]
@@ -84,10 +84,8 @@ pub struct GoldenError {
 impl GoldenError {
     /// The statistics of per-pixel FLIP errors, rows from the top. A NaN error makes both NaN.
     pub fn from_flip(errors: &[f32], width: u32, height: u32) -> GoldenError {
-        assert_eq!(errors.len(), (width * height) as usize, "one error per pixel");
-        let sum: f64 = errors.iter().map(|&e| f64::from(e)).sum();
-        let flip_mean = (sum / errors.len().max(1) as f64) as f32;
-        GoldenError { flip_mean, worst_region: worst_window_mean(errors, width, height, REGION) }
+        let figures = mirador::compare::Figures::of(errors, width, height, None);
+        GoldenError { flip_mean: figures.mean, worst_region: figures.worst_region }
     }
 
     /// Compares two images (`golden` the reference).
@@ -112,10 +110,6 @@ impl GoldenError {
         }
         excesses
     }
-}
-
-fn worst_window_mean(errors: &[f32], width: u32, height: u32, side: u32) -> f32 {
-    mirador::compare::worst_region(errors, width, height, side).0
 }
 
 /// The directory of the golden images.
