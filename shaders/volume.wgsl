@@ -262,11 +262,11 @@ fn composite_fragment(in: VolumeVertex) -> vec4f {
     }
     let s = volume_samples(ray);
     let v = -ray.direction;
-    var colour = vec3f(0.0);
-    var alpha = 0.0;
+    // Premultiplied colour and opacity so far (shaders/common/optics.wgsl).
+    var gathered = vec4f(0.0);
     var taken = 0u;
     for (var i = 0u; i < s.count; i++) {
-        if alpha >= volume.termination {
+        if gathered.a >= volume.termination {
             break;
         }
         taken += 1u;
@@ -274,15 +274,14 @@ fn composite_fragment(in: VolumeVertex) -> vec4f {
         let local = ray.local_origin + t * ray.local_direction;
         var classified = classify(volume_value(local));
         if volume.opacity_correction != 0u {
-            classified.a = 1.0 - pow(1.0 - classified.a, s.length);
+            classified.a = corrected_opacity(classified.a, s.length);
         }
         if classified.a > 0.0 {
             var shaded = classified.rgb;
             if VOLUME_GRADIENT != VOLUME_GRADIENT_OFF {
                 shaded = shade_volume_sample(ray.origin + t * ray.direction, volume_gradient(local), shaded, v, in.clip.xy);
             }
-            colour += (1.0 - alpha) * classified.a * shaded;
-            alpha += (1.0 - alpha) * classified.a;
+            gathered = composite_front_to_back(gathered, vec4f(shaded, classified.a));
         }
     }
     if INSPECT {
@@ -293,7 +292,7 @@ fn composite_fragment(in: VolumeVertex) -> vec4f {
     if volume.view == VOLUME_VIEW_SAMPLES {
         return vec4f(heat_colour(taken), 1.0);
     }
-    return vec4f(colour, alpha);
+    return gathered;
 }
 
 struct IsosurfaceOut {

@@ -101,6 +101,7 @@ builtin_files!(
     "assets/labs/mipmaps/lab.toml",
     "assets/labs/refraction/lab.toml",
     "assets/labs/shadow-map/lab.toml",
+    "assets/labs/volumes/lab.toml",
     "assets/scenes/bumps.toml",
     "assets/scenes/course/acceleration-teapot.toml",
     "assets/scenes/course/aliasing-edges.toml",

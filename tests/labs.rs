@@ -108,6 +108,11 @@ fn environment_maps_lab() {
     battery("environment-maps");
 }
 
+#[test]
+fn volumes_lab() {
+    battery("volumes");
+}
+
 /// A broken student file, checked: the message names the place, a report is written, the score
 /// falls short (to 0 when the file does not compile), and the command fails without a panic.
 fn broken(case: &str, edit: impl Fn(&str) -> String, needles: &[&str], extra: &[&str]) -> String {

@@ -41,3 +41,19 @@ fn fresnel(cos_i_in: f32, eta: f32) -> f32 {
     let r_p = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     return 0.5 * (r_s * r_s + r_p * r_p);
 }
+
+// Light through a volume (docs/course/11-volumes.md), the WGSL twin of src/volume/march.rs.
+
+// A transfer function's opacity α is that of a slab one voxel thick; a sample standing for a
+// slab `length` voxels thick lets (1 − α)^length through, so its opacity is 1 − (1 − α)^length.
+fn corrected_opacity(alpha: f32, length: f32) -> f32 {
+    return 1.0 - pow(1.0 - alpha, length);
+}
+
+// Front-to-back compositing of one sample (colour C_v, opacity α_v in `sample`) behind what the
+// ray has gathered so far (premultiplied colour C_in, opacity α_in in `accumulated`):
+// C_out = C_in + (1 − α_in)·α_v·C_v and α_out = α_in + (1 − α_in)·α_v.
+fn composite_front_to_back(accumulated: vec4f, sample: vec4f) -> vec4f {
+    let seen = (1.0 - accumulated.a) * sample.a;
+    return vec4f(accumulated.rgb + seen * sample.rgb, accumulated.a + seen);
+}
