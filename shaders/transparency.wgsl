@@ -20,6 +20,46 @@ fn transparent_fragment(in: VertexOut) -> vec4f {
     return vec4f(alpha * shade(in), alpha);
 }
 
+// The transparency lab's route (assets/labs/transparency): the blend made by `transparent_blend`
+// (shaders/common/types.wgsl) instead of the GPU's blend state. False in Mirador; the lab's
+// routes set it, and src/raster/transparency.rs then draws every transparent surface twice. A
+// fragment cannot read the pixel behind it, but any blend of the notes' form is affine in it,
+// I' = a + b·I, so two draws make it exactly: the first multiplies what the pixel holds by
+// b = blend(Im, t, 1) − blend(Im, t, 0) (the blend computes dst·src), the second adds
+// a = blend(Im, t, 0) (src + dst).
+const BLEND_BY_HAND = false;
+
+// Im and kt·Mt at a fragment, as the GPU's blend state takes them: kt·Mt is the material's
+// (alpha blending's α·kt·Mt + (1 − α)), or 1 − α alone where α varies per pixel.
+struct BlendInputs {
+    im: vec3f,
+    transmittance: vec3f,
+}
+
+fn blend_inputs(in: VertexOut) -> BlendInputs {
+    let out = transparent_fragment(in);
+    if ALPHA_MODE == ALPHA_BLEND && COLOR_TEXTURE {
+        return BlendInputs(out.rgb, vec3f(1.0 - out.a));
+    }
+    return BlendInputs(out.rgb, material_transmittance(material, out.a));
+}
+
+@fragment
+fn fs_blend_factor(in: VertexOut) -> @location(0) vec4f {
+    let b = blend_inputs(in);
+    return vec4f(transparent_blend(b.im, b.transmittance, vec3f(1.0)) - transparent_blend(b.im, b.transmittance, vec3f(0.0)), 1.0);
+}
+
+@fragment
+fn fs_blend_term(in: VertexOut) -> @location(0) vec4f {
+    return blend_term(in);
+}
+
+fn blend_term(in: VertexOut) -> vec4f {
+    let b = blend_inputs(in);
+    return vec4f(transparent_blend(b.im, b.transmittance, vec3f(0.0)), 1.0);
+}
+
 // Glass that bends light, with Fresnel (terms.fresnel): kt·Mt splits into F·kt·Mt reflected and
 // (1 − F)·kt·Mt let through, and F changes across the surface, so one blend constant cannot
 // carry it. src/raster/transparency.rs draws such glass twice: fs_transparent_transmit
@@ -91,6 +131,15 @@ fn fs_transparent_inspect(in: VertexOut) -> @location(0) vec4f {
     probe.object = in.object;
     let out = transparent_fragment(in);
     probe.alpha = out.a;
+    inspect_record(INSPECT_TRANSPARENT, in.clip, out.rgb);
+    return out;
+}
+
+@fragment
+fn fs_blend_term_inspect(in: VertexOut) -> @location(0) vec4f {
+    probe.object = in.object;
+    let out = blend_term(in);
+    probe.alpha = transparent_fragment(in).a;
     inspect_record(INSPECT_TRANSPARENT, in.clip, out.rgb);
     return out;
 }

@@ -87,6 +87,13 @@ impl Wgsl {
         self.replaced.is_empty() && self.code.is_empty()
     }
 
+    /// Whether a lab routes the technique behind the constant `name` through its slots
+    /// (`const NAME = true;` in place of Mirador's `false`), where a pass must draw differently
+    /// for it (the transparency lab's blend).
+    pub fn routes(&self, name: &str) -> bool {
+        self.replaced.iter().any(|n| n == name) && self.code.contains(&format!("const {name} = true;"))
+    }
+
     /// What is appended to every module, at the end of the composed text.
     pub fn code(&self) -> &str {
         &self.code

@@ -99,6 +99,16 @@ fn shadow_map_lab() {
 }
 
 #[test]
+fn planar_mirrors_lab() {
+    battery("planar-mirrors");
+}
+
+#[test]
+fn transparency_lab() {
+    battery("transparency");
+}
+
+#[test]
 fn refraction_lab() {
     battery("refraction");
 }
@@ -257,9 +267,12 @@ fn a_student_file_is_never_overwritten() {
 fn what_a_lab_routes_by_hand_draws_what_the_fixed_function_draws() {
     use mirador::lab::images;
     let gpu = common::gpu();
-    for (name, set, bound) in
-        [("mipmaps", vec![], 0.02), ("shadow-map", vec!["shadows.filter=\"none\"".to_owned()], 0.01)]
-    {
+    for (name, set, bound) in [
+        ("mipmaps", vec![], 0.02),
+        ("shadow-map", vec!["shadows.filter=\"none\"".to_owned()], 0.01),
+        ("planar-mirrors", vec!["mirrors.depth=1".to_owned()], 0.01),
+        ("transparency", vec![], 0.01),
+    ] {
         let lab = lab::find(name).unwrap();
         let test = lab::ImageTest { set, ..lab.images[0].clone() };
         let scene = images::scene(&test, None).unwrap();

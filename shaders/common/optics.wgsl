@@ -42,6 +42,15 @@ fn fresnel(cos_i_in: f32, eta: f32) -> f32 {
     return 0.5 * (r_s * r_s + r_p * r_p);
 }
 
+// A planar mirror (docs/course/07-planar-mirrors.md): the reflection about the plane
+// n·p + d = 0 (`plane` = (n, d), n of unit length), world to world: p' = p − 2(n·p + d)·n. Its
+// own inverse, with determinant −1. The WGSL twin of `reflection` in src/raster/mirror/mod.rs.
+fn mirror_reflection(plane: vec4f) -> mat4x4f {
+    let n = plane.xyz;
+    let linear = mat3x3f(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0) - 2.0 * mat3x3f(n * n.x, n * n.y, n * n.z);
+    return mat4x4f(vec4f(linear[0], 0.0), vec4f(linear[1], 0.0), vec4f(linear[2], 0.0), vec4f(-2.0 * plane.w * n, 1.0));
+}
+
 // Light through a volume (docs/course/11-volumes.md), the WGSL twin of src/volume/march.rs.
 
 // A transfer function's opacity α is that of a slab one voxel thick; a sample standing for a

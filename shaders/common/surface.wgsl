@@ -86,12 +86,20 @@ struct VertexOut {
     @location(5) @interpolate(flat) object: u32,
 }
 
+// The planar-mirror lab's route (assets/labs/planar-mirrors): a mirrored camera's reflection
+// made at every vertex by `mirror_reflection` (shaders/common/optics.wgsl) instead of in its
+// clip_from_world (src/raster/mirror). False in Mirador; the lab's routes set it.
+const MIRROR_BY_HAND = false;
+
 @vertex
 fn vs_scene(in: VertexIn, instance: Instance) -> VertexOut {
     let world_from_local = instance_world_from_local(instance);
     let world = world_from_local * vec4f(in.position, 1.0);
     var out: VertexOut;
     out.clip = view.clip_from_world * world;
+    if MIRROR_BY_HAND && any(view.clip_plane != vec4f(0.0)) {
+        out.clip = view.clip_from_reflected * (mirror_reflection(view.clip_plane) * world);
+    }
     out.world = world.xyz;
     out.normal = instance_normal_from_local(instance) * in.normal;
     out.uv = in.uv;

@@ -57,6 +57,10 @@ struct View {
     mirrored: u32,
     // Points p with dot(clip_plane.xyz, p) + clip_plane.w < 0 are not drawn; all zero: no plane.
     clip_plane: vec4f,
+    // A mirrored camera's clip_from_world before its last reflection, the one about its
+    // clip_plane: clip_from_world = clip_from_reflected · R(clip_plane). clip_from_world itself
+    // in a view that no mirror made. The planar-mirror lab reflects with the student's R.
+    clip_from_reflected: mat4x4f,
 }
 
 // Group 0, binding 1: what every view of the frame shares: lights and numeric settings. The
@@ -117,6 +121,14 @@ fn material_transmittance(m: Material, alpha: f32) -> vec3f {
         return alpha * m.transmission + vec3f(1.0 - alpha);
     }
     return m.transmission;
+}
+
+// The blend of docs/course/06-transparency.md: a transparent surface's own light Im, plus what it
+// lets through, kt·Mt, of what the pixel held behind it: I = Im + kt·Mt·I. The GPU's blend state
+// computes it in Mirador (src/raster/transparency.rs); the transparency lab routes it through
+// here (BLEND_BY_HAND in shaders/transparency.wgsl).
+fn transparent_blend(im: vec3f, transmittance: vec3f, behind: vec3f) -> vec3f {
+    return im + transmittance * behind;
 }
 
 // Per object, as instance attributes (vertex buffer 1): objects that share a mesh are drawn in one

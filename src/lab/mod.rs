@@ -2,10 +2,11 @@
 //!
 //! A lab (`assets/labs/NAME/lab.toml`) names a few of Mirador's own WGSL functions, its *slots*:
 //! the mip LOD and a trilinear sample made from texel loads, the finite-difference bump normal,
-//! the shadow-map comparison and its PCF, the environment maps' direction → texel maps, Snell
-//! and Fresnel, a volume's opacity correction and front-to-back compositing. The student's file
-//! defines them again with the same signatures; at run time every surface pass compiles the
-//! student's functions in place of Mirador's ([`crate::shaders::Wgsl`]), so nothing is rebuilt. Mirador's own functions are the reference
+//! the shadow-map comparison and its PCF, a transparent surface's blend, Snell and Fresnel, the
+//! mirrored camera's reflection matrix, the environment maps' direction → texel maps, a volume's
+//! opacity correction and front-to-back compositing. The student's file defines them again with
+//! the same signatures; at run time every surface pass compiles the student's functions in place
+//! of Mirador's ([`crate::shaders::Wgsl`]), so nothing is rebuilt. Mirador's own functions are the reference
 //! solution, and the stub is their signatures and comments with neutral bodies, so the three can
 //! never drift apart.
 //!
@@ -176,7 +177,9 @@ const LABS: &[&str] = &[
     include_str!("../../assets/labs/mipmaps/lab.toml"),
     include_str!("../../assets/labs/bump/lab.toml"),
     include_str!("../../assets/labs/shadow-map/lab.toml"),
+    include_str!("../../assets/labs/transparency/lab.toml"),
     include_str!("../../assets/labs/refraction/lab.toml"),
+    include_str!("../../assets/labs/planar-mirrors/lab.toml"),
     include_str!("../../assets/labs/environment-maps/lab.toml"),
     include_str!("../../assets/labs/volumes/lab.toml"),
 ];

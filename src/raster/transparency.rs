@@ -89,6 +89,11 @@ enum Blend {
     Transmit,
     /// Glass weighted by Fresnel, second draw: `Im + F·kt·Mt·L(r)` added.
     Add,
+    /// The transparency lab's blend, by hand (`BLEND_BY_HAND` in shaders/transparency.wgsl),
+    /// first draw: what the pixel holds times the fragment's `b`.
+    ByHandFactor,
+    /// The lab's blend, second draw: the fragment's `a` added.
+    ByHandTerm,
 }
 
 /// Which faces a draw keeps, in the view's terms.
@@ -359,6 +364,9 @@ fn pipeline_keys(ctx: &FrameContext, frame: FrameKey, draw: &Draw, depth: Depth)
     if ctx.settings.terms.fresnel && ctx.scene.materials[material].bends_light() {
         return vec![(Blend::Transmit, faces, depth, frame, key), (Blend::Add, faces, depth, frame, key)];
     }
+    if ctx.surface.wgsl.routes("BLEND_BY_HAND") {
+        return vec![(Blend::ByHandFactor, faces, depth, frame, key), (Blend::ByHandTerm, faces, depth, frame, key)];
+    }
     let blend = if key.alpha_mode == ALPHA_BLEND && key.color_texture { Blend::Coverage } else { Blend::Constant };
     vec![(blend, faces, depth, frame, key)]
 }
@@ -538,8 +546,8 @@ fn blend_state(blend: Blend) -> wgpu::BlendState {
     let (src_factor, dst_factor) = match blend {
         Blend::Constant => (wgpu::BlendFactor::One, wgpu::BlendFactor::Constant),
         Blend::Coverage => (wgpu::BlendFactor::One, wgpu::BlendFactor::OneMinusSrcAlpha),
-        Blend::Transmit => (wgpu::BlendFactor::Zero, wgpu::BlendFactor::Src),
-        Blend::Add => (wgpu::BlendFactor::One, wgpu::BlendFactor::One),
+        Blend::Transmit | Blend::ByHandFactor => (wgpu::BlendFactor::Zero, wgpu::BlendFactor::Src),
+        Blend::Add | Blend::ByHandTerm => (wgpu::BlendFactor::One, wgpu::BlendFactor::One),
     };
     wgpu::BlendState {
         color: wgpu::BlendComponent { src_factor, dst_factor, operation: wgpu::BlendOperation::Add },
@@ -576,6 +584,9 @@ fn shading_pipeline(ctx: &FrameContext, module: &SurfaceModule, key: PipelineKey
                 (Blend::Transmit, _) => "fs_transparent_transmit",
                 (Blend::Add, false) => "fs_transparent_fresnel",
                 (Blend::Add, true) => "fs_transparent_fresnel_inspect",
+                (Blend::ByHandFactor, _) => "fs_blend_factor",
+                (Blend::ByHandTerm, false) => "fs_blend_term",
+                (Blend::ByHandTerm, true) => "fs_blend_term_inspect",
                 (_, false) => "fs_transparent",
                 (_, true) => "fs_transparent_inspect",
             }),

@@ -272,6 +272,7 @@ pub struct GpuView {
     pub view_axis: [f32; 3],
     pub mirrored: u32,
     pub clip_plane: [f32; 4],
+    pub clip_from_reflected: [[f32; 4]; 4],
 }
 
 /// `Environment.source` codes (`ENV_*` in `shaders/common/environment.wgsl`).

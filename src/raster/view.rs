@@ -8,6 +8,7 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
+use super::mirror::{MirrorPlane, reflection};
 use super::uniforms::GpuView;
 use crate::scene::{Camera, Projection};
 
@@ -61,6 +62,18 @@ impl View {
             view_axis: self.view_axis.to_array(),
             mirrored: u32::from(self.mirrored),
             clip_plane: self.clip_plane.unwrap_or(Vec4::ZERO).to_array(),
+            clip_from_reflected: self.clip_from_reflected().to_cols_array_2d(),
+        }
+    }
+
+    /// A mirrored camera's `clip_from_world` before its last reflection, the one about its clip
+    /// plane (a reflection is its own inverse): `clip_from_world = clip_from_reflected · R`.
+    /// `clip_from_world` itself where no mirror made the view. The planar-mirror lab draws with
+    /// it and the student's `R` (`MIRROR_BY_HAND` in shaders/common/surface.wgsl).
+    pub fn clip_from_reflected(&self) -> Mat4 {
+        match self.clip_plane {
+            Some(plane) => self.clip_from_world * reflection(&MirrorPlane { normal: plane.truncate(), d: plane.w }),
+            None => self.clip_from_world,
         }
     }
 }
