@@ -218,6 +218,10 @@ struct ViewArgs {
     /// The window's inner size, WIDTHxHEIGHT (default: as last time, else 1280x720).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     size: Option<[u32; 2]>,
+    /// Lab mode: the lab in this folder (`mirador lab new`), its scene drawn with the student's
+    /// file and redrawn when it is saved; L switches your image, the reference, their difference.
+    #[arg(long, value_name = "DIR", conflicts_with = "scene")]
+    lab: Option<PathBuf>,
 }
 
 fn parse_pixel(text: &str) -> Result<[u32; 2], String> {
@@ -403,6 +407,7 @@ fn view(args: ViewArgs) -> anyhow::Result<()> {
         steps,
         stats: args.stats,
         size: args.size,
+        lab: args.lab,
     })
 }
 

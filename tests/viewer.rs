@@ -61,7 +61,12 @@ fn scratch(name: &str) -> PathBuf {
 /// Where the 3D view sat in each screenshot, from the viewer's `screenshot FILE window WxH view X
 /// Y W H` lines.
 fn views(output: &Output) -> Vec<(PathBuf, [u32; 4])> {
-    String::from_utf8_lossy(&output.stdout)
+    views_in(&String::from_utf8_lossy(&output.stdout))
+}
+
+/// [`views`] from the viewer's standard output as text.
+fn views_in(stdout: &str) -> Vec<(PathBuf, [u32; 4])> {
+    stdout
         .lines()
         .filter_map(|line| {
             let rest = line.strip_prefix("screenshot ")?;
@@ -548,4 +553,103 @@ fn a_window_taken_away_from_outside_ends_the_viewer_without_a_panic() {
             assert!(status != "none" && status != "101", "the display lost ends the viewer (101 is a panic): {what}");
         }
     }
+}
+
+/// Lab mode as a student meets it: the answer key drawn; a saved edit (a known mistake) redraws
+/// the view; a broken edit shows its error over the view, at its line, with no input, and the
+/// last good image stays; the difference view measures the mistake against the reference; a fix
+/// brings back the first image.
+#[test]
+fn lab_mode_redraws_a_saved_edit_shows_a_broken_one_and_recovers() {
+    use std::io::BufRead;
+    let dir = scratch("lab");
+    let lab_dir = dir.join("blend");
+    let binary = env!("CARGO_BIN_EXE_mirador");
+    let made = Command::new(binary).args(["lab", "new", "transparency"]).arg(&lab_dir).arg("--solution").output();
+    assert!(made.expect("lab new").status.success());
+    let file = lab_dir.join("transparency.wgsl");
+    let key = std::fs::read_to_string(&file).expect("the answer key");
+    let mistake = key.replace("return im + transmittance * behind;", "return im + behind;");
+    let broken = key.replace("return im + transmittance * behind;", "return im + transmittance * behind");
+    assert!(mistake != key && broken != key);
+    let shot = |n: u32| dir.join(format!("s{n}.png"));
+    // No frame times over the view: they change from one screenshot to the next.
+    let mut steps = vec!["overlay off".to_owned()];
+    for (n, wait, before) in [
+        (1, "4s", None),
+        (2, "5s", None),
+        (3, "5s", None),
+        (4, "4s", Some("lab difference")),
+        (5, "5s", Some("lab student")),
+    ] {
+        steps.extend(before.map(str::to_owned));
+        steps.push(format!("wait {wait}"));
+        steps.push(format!("screenshot {}", shot(n).display()));
+    }
+    assert!(on_path("xvfb-run"), "install Xvfb (`sudo apt-get install xvfb`) to run the viewer tests");
+    let mut command = Command::new("xvfb-run");
+    command.args(["-a", "-s", "-screen 0 1920x1080x24", binary, "view", "--lab"]).arg(&lab_dir);
+    command.args(["--size", "640x400", "--frames", "2"]);
+    for step in &steps {
+        command.args(["--step", step]);
+    }
+    let mut child = command
+        .env("XDG_CONFIG_HOME", &dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("starting the viewer");
+    // Edit the file as each screenshot is written, as a student saving between looks.
+    let stdout = std::io::BufReader::new(child.stdout.take().expect("the viewer's stdout"));
+    let mut lines = Vec::new();
+    for line in stdout.lines() {
+        let line = line.expect("reading the viewer's output");
+        let edit = match () {
+            _ if line.starts_with(&format!("screenshot {}", shot(1).display())) => Some(&mistake),
+            _ if line.starts_with(&format!("screenshot {}", shot(2).display())) => Some(&broken),
+            _ if line.starts_with(&format!("screenshot {}", shot(4).display())) => Some(&key),
+            _ => None,
+        };
+        if let Some(text) = edit {
+            std::fs::write(&file, text).expect("saving the student's file");
+        }
+        lines.push(line);
+    }
+    let output = child.wait_with_output().expect("the viewer's end");
+    let stdout = lines.join("\n");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success() && !stderr.contains("panicked"), "{stdout}\n{stderr}");
+
+    let shots: Vec<image::RgbaImage> =
+        (1..=5).map(|n| image::open(shot(n)).expect("each screenshot is written").to_rgba8()).collect();
+    let rects = views_in(&stdout);
+    let view = |n: usize| crop(&shots[n - 1], rects[n - 1].1);
+    let error_fill = |image: &image::RgbaImage| {
+        let [r, g, b, _] = mirador::viewer::ui::LAB_ERROR_FILL.to_array();
+        image.pixels().filter(|p| p.0[..3] == [r, g, b]).count()
+    };
+    // A saved edit changes the image.
+    let edited = common::difference(&view(1), &view(2)).flip_mean;
+    assert!(edited > 0.02, "the saved mistake did not change the view (mean FLIP {edited}):\n{stdout}");
+    // A broken edit: its error over the view, at its line, without a click; the mistake's image stays under it.
+    let line = broken.lines().position(|l| l.contains("transmittance * behind")).unwrap() + 1;
+    assert!(
+        stdout.contains("does not compile") && stdout.contains(&format!("transparency.wgsl:{}:", line + 1)),
+        "the broken edit's error should be reported at the line after the missing `;`:\n{stdout}"
+    );
+    assert!(error_fill(&shots[2]) > 2000, "no error box over the view:\n{stdout}");
+    assert_eq!(error_fill(&shots[1]), 0, "an error box before the file broke");
+    // The difference view measures the mistake against the reference.
+    let mean: f32 = stdout
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix("lab: difference against the reference, FLIP mean "))
+        .and_then(|m| m.trim().parse().ok())
+        .expect("the difference view reports its mean");
+    assert!(mean > 0.02, "the mistake differs from the reference: mean {mean}");
+    // The fix recovers the first image, the error gone.
+    assert_eq!(error_fill(&shots[4]), 0, "the error box stayed after the fix");
+    let recovered = common::difference(&view(1), &view(5)).flip_mean;
+    assert!(recovered < 0.005, "the fixed file does not draw the first image (mean FLIP {recovered})");
+    let _ = std::fs::remove_dir_all(&dir);
 }

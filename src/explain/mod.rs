@@ -34,6 +34,7 @@ use crate::raster::{FrameTargets, OUTPUT_FORMAT, Renderer};
 use crate::scene::shading::lights_surface;
 use crate::scene::{Light, Scene};
 use crate::settings::{RenderSettings, TransparencySort};
+use crate::shaders::Wgsl;
 use crate::trace::Tracer;
 use crate::trace::explain::{RayNode, RayTree, Term};
 
@@ -176,6 +177,17 @@ pub struct Explainer<'s> {
 
 impl<'s> Explainer<'s> {
     pub fn new(gpu: &Gpu, scene: &'s Scene, settings: &RenderSettings) -> Result<Explainer<'s>, ExplainError> {
+        Explainer::with_wgsl(gpu, scene, settings, Wgsl::builtin())
+    }
+
+    /// [`Self::new`], the rasterizer's passes compiled from `wgsl` (a lab's student functions:
+    /// the viewer's lab mode explains the student's pixels with them).
+    pub fn with_wgsl(
+        gpu: &Gpu,
+        scene: &'s Scene,
+        settings: &RenderSettings,
+        wgsl: Wgsl,
+    ) -> Result<Explainer<'s>, ExplainError> {
         let flags = gpu.adapter.get_downlevel_capabilities().flags;
         if !flags.contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE) {
             return Err(ExplainError::Unsupported);
@@ -185,7 +197,7 @@ impl<'s> Explainer<'s> {
         let size = (scene.camera.width, scene.camera.height);
         Ok(Explainer {
             scene,
-            renderer: Renderer::inspecting(gpu, scene, OUTPUT_FORMAT),
+            renderer: Renderer::with_wgsl(gpu, scene, OUTPUT_FORMAT, wgsl, true),
             targets: FrameTargets::new(&gpu.device, size),
             output: GpuTexture::target(&gpu.device, "explain::output", size, OUTPUT_FORMAT),
             tracer: Tracer::new(scene, &settings),

@@ -24,6 +24,7 @@ use super::camera_control::{self, CameraInput, Navigation};
 use super::config::ViewerConfig;
 use super::hud::{FrameStats, FrameTimes};
 use super::inspect::Inspection;
+use super::lab::LabMode;
 use super::raster_view::{Drawn, RasterView};
 use super::scene_panel;
 use super::scene_state::SceneState;
@@ -36,6 +37,7 @@ use super::view_mode::{ViewMode, ViewState};
 use super::volume_probe::{CursorProbe, ProbeAt};
 use crate::RenderSettings;
 use crate::scene::{Camera, Light};
+use crate::shaders::Wgsl;
 
 /// How long the camera counts as moving after its last change: the render scale stays low.
 const SETTLE: Duration = Duration::from_millis(250);
@@ -83,6 +85,8 @@ pub struct Viewer {
     /// The inspected pixel, and a pixel to inspect once the view has its size.
     inspection: Option<Inspection>,
     inspect_next: Option<Vec2>,
+    /// Lab mode (`mirador view --lab DIR`): the student's functions drawn, reloaded when saved.
+    pub lab: Option<LabMode>,
 }
 
 /// Scripted steps still to run and the wait in progress.
@@ -112,11 +116,16 @@ impl Viewer {
         config: &ViewerConfig,
         steps: Vec<Step>,
         wake: impl Fn() + Send + 'static,
+        mut lab: Option<LabMode>,
     ) -> Viewer {
         let (settings, warnings) = super::config::apply_settings(&scene.settings, &config.settings);
         let mut scene = SceneState::new(scene);
         scene.scene.settings = settings.clone();
-        let raster = RasterView::new(screen, &scene.scene, scene.revision);
+        let wgsl = lab.as_mut().map_or_else(Wgsl::builtin, |lab| {
+            lab.take_changed();
+            lab.wgsl()
+        });
+        let raster = RasterView::new(screen, &scene.scene, scene.revision, wgsl);
         Viewer {
             scene,
             settings,
@@ -149,6 +158,7 @@ impl Viewer {
             cursor: None,
             inspection: None,
             inspect_next: None,
+            lab,
         }
     }
 
@@ -179,7 +189,13 @@ impl Viewer {
         if reloaded {
             self.notice("scene file changed on disk: reloaded".into());
         }
-        reloaded
+        let lab = self.lab.as_mut().is_some_and(LabMode::poll);
+        reloaded || lab
+    }
+
+    /// When the scene file, or the lab's file, is next due a look.
+    pub fn next_poll(&self) -> Option<Instant> {
+        [self.scene.next_poll(), self.lab.as_ref().map(LabMode::next_poll)].into_iter().flatten().min()
     }
 
     /// What the configuration file should remember now.
@@ -299,6 +315,7 @@ impl Viewer {
             inspection: self.inspection.as_ref(),
             probe: self.probe.shown(),
             seen: self.seen.shown(),
+            lab: self.lab.as_ref().map(LabMode::panel),
         };
         let full = screen.egui.run_ui(raw, |ui| output = ui::draw(ui, &mut model));
         (output, full)
@@ -323,9 +340,21 @@ impl Viewer {
         let filter = if drawn_size == (width, height) { wgpu::FilterMode::Nearest } else { wgpu::FilterMode::Linear };
         (self.scene.scene.camera.width, self.scene.scene.camera.height) = drawn_size;
         let scene = (&self.scene.scene, self.scene.revision);
+        if let Some(lab) = &mut self.lab
+            && lab.take_changed()
+        {
+            self.raster.set_wgsl(&screen.gpu, scene, lab.wgsl());
+        }
         // Each pass is timed on its own only for the overlay, which lists them.
         let drawn = self.raster.render(screen, scene, &self.settings, (self.view.overlay_open, filter));
         (self.scene.scene.camera.width, self.scene.scene.camera.height) = (width, height);
+        if scale == 1.0
+            && let Some(lab) = &mut self.lab
+        {
+            let mut scene = self.scene.scene.clone();
+            scene.settings = self.settings.clone();
+            lab.update_difference(&screen.gpu, &screen.egui, &scene, self.scene.revision);
+        }
         if let Drawn::New(time) = drawn {
             times.raster = Some(time);
         }
@@ -458,6 +487,9 @@ impl Viewer {
         if let Some(pixel) = output.pick {
             self.pick(pixel);
         }
+        if let (Some(shown), Some(lab)) = (output.lab_shown, &mut self.lab) {
+            lab.show(shown);
+        }
         if self.scene.scene.camera != before || output.camera_edited {
             self.moving_until = Some(now + SETTLE);
         }
@@ -505,7 +537,8 @@ impl Viewer {
         let mut scene = self.scene.scene.clone();
         (scene.camera.width, scene.camera.height) = size;
         let at = (pixel.x.max(0.0) as u32, pixel.y.max(0.0) as u32);
-        match Inspection::new(&screen.gpu, &scene, &self.settings, at) {
+        let wgsl = self.lab.as_ref().map_or_else(Wgsl::builtin, LabMode::wgsl);
+        match Inspection::new(&screen.gpu, &scene, &self.settings, at, wgsl) {
             Ok(inspection) => {
                 let summary = inspection.summary();
                 println!("{summary}");
@@ -624,6 +657,10 @@ impl Viewer {
             Step::WaitFor(time) => self.script.wait_until = Some(Instant::now() + time),
             Step::WaitTraced => self.script.wait_traced_since = Some(Instant::now()),
             Step::Screenshot(path) => self.screenshot = Some(path),
+            Step::Lab(shown) => match &mut self.lab {
+                Some(lab) => lab.show(shown),
+                None => bail!("`lab {}`: the viewer is not in lab mode (mirador view --lab DIR)", shown.label()),
+            },
         }
         Ok(())
     }

@@ -13,6 +13,7 @@ pub const KEYS: &[(&str, &str)] = &[
     ("F", "frame the scene"),
     ("R", "reset to the scene's camera"),
     ("1 2 3 4", "view: raster, ray traced, split, difference"),
+    ("L", "lab mode: your image, the reference, their difference"),
     ("click", "pick an object and edit its material"),
     ("I, then click", "inspect a pixel: both renderers' terms, and the tracer's rays drawn in 3D (I again: off)"),
     ("hover a volume", "plot the samples its ray takes (in a lower corner)"),

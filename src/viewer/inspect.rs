@@ -15,6 +15,7 @@ use crate::explain::{Explainer, Explanation};
 use crate::gpu::Gpu;
 use crate::scene::{Camera, Scene};
 use crate::settings::RenderSettings;
+use crate::shaders::Wgsl;
 use crate::trace::explain::{RayKind, RayNode};
 
 pub const PRIMARY: Color32 = Color32::WHITE;
@@ -35,9 +36,16 @@ pub struct Inspection {
 }
 
 impl Inspection {
-    /// Explains `pixel` of `scene` as its camera sees it now (its size: the 3D view's).
-    pub fn new(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, pixel: (u32, u32)) -> anyhow::Result<Inspection> {
-        let explanation = Explainer::new(gpu, scene, settings)?.explain(gpu, pixel)?;
+    /// Explains `pixel` of `scene` as its camera sees it now (its size: the 3D view's), the
+    /// rasterizer's side drawn by passes compiled from `wgsl` (what the view draws with).
+    pub fn new(
+        gpu: &Gpu,
+        scene: &Scene,
+        settings: &RenderSettings,
+        pixel: (u32, u32),
+        wgsl: Wgsl,
+    ) -> anyhow::Result<Inspection> {
+        let explanation = Explainer::with_wgsl(gpu, scene, settings, wgsl)?.explain(gpu, pixel)?;
         let lights = scene.lights.iter().map(|l| (l.name.clone(), l.position())).collect();
         let reach = scene.bounds().map_or(10.0, |(lo, hi)| (hi - lo).length());
         Ok(Inspection { explanation, lights, reach })

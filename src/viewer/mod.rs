@@ -32,6 +32,7 @@ pub mod frame;
 pub mod hud;
 pub mod inspect;
 pub mod kept;
+pub mod lab;
 pub mod panel;
 pub mod picking;
 pub mod raster_view;
@@ -76,6 +77,8 @@ pub struct ViewerOptions {
     pub stats: bool,
     /// The window's inner size in logical pixels (default: remembered, else 1280×720).
     pub size: Option<[u32; 2]>,
+    /// Lab mode: the lab's folder (`mirador lab new`), its scene drawn with the student's file.
+    pub lab: Option<PathBuf>,
 }
 
 impl ViewerOptions {
@@ -83,6 +86,12 @@ impl ViewerOptions {
     /// depend on, or change, what a person last left in the window.
     fn scripted(&self) -> bool {
         self.frames.is_some()
+    }
+
+    /// Whether the remembered configuration is read and written: not by scripted runs, nor in
+    /// lab mode, which starts from the lab's own scene and settings.
+    fn remembers(&self) -> bool {
+        !self.scripted() && self.lab.is_none()
     }
 }
 
@@ -104,7 +113,13 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
     }
     // Load before opening the window: a bad scene or setting on the command line is an error
     // message, not an empty window.
-    let mut scene = scene_state::load(options.scene.as_deref())?;
+    let (lab, mut scene) = match &options.lab {
+        Some(dir) => {
+            let (lab, scene) = open_lab(dir)?;
+            (Some(lab), scene)
+        }
+        None => (None, scene_state::load(options.scene.as_deref())?),
+    };
     for assignment in &options.set {
         scene.settings.set(assignment).context("--set")?;
     }
@@ -116,6 +131,7 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
     let mut app = App {
         options,
         scene: Some(scene),
+        lab,
         proxy,
         running: None,
         outcome: Ok(()),
@@ -136,6 +152,8 @@ struct App {
     options: ViewerOptions,
     /// The scene, until the window opens.
     scene: Option<crate::Scene>,
+    /// Lab mode's state, until the window opens.
+    lab: Option<lab::LabMode>,
     proxy: EventLoopProxy<Wake>,
     running: Option<(Screen, Viewer)>,
     outcome: anyhow::Result<()>,
@@ -149,7 +167,7 @@ struct App {
 
 impl App {
     fn config_path(&self) -> Option<PathBuf> {
-        if self.options.scripted() { None } else { config::config_path() }
+        if self.options.remembers() { config::config_path() } else { None }
     }
 
     fn open(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<()> {
@@ -171,7 +189,7 @@ impl App {
         let wake = move || {
             let _ = proxy.send_event(Wake);
         };
-        let mut viewer = Viewer::new(&mut screen, scene, &config, self.options.steps.clone(), wake);
+        let mut viewer = Viewer::new(&mut screen, scene, &config, self.options.steps.clone(), wake, self.lab.take());
         viewer.notices.extend(notices);
         viewer.scripted = self.options.scripted();
         if self.options.stats {
@@ -313,7 +331,18 @@ impl ApplicationHandler<Wake> for App {
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         // Sleep until the frame asked for or the next look at the scene file, whichever is first.
         let Some((_, viewer)) = &self.running else { return };
-        let wake = [self.next_frame, viewer.scene.next_poll()].into_iter().flatten().min();
+        let wake = [self.next_frame, viewer.next_poll()].into_iter().flatten().min();
         event_loop.set_control_flow(wake.map_or(ControlFlow::Wait, ControlFlow::WaitUntil));
     }
+}
+
+/// The lab in `dir` and its scene (lab mode).
+#[cfg(not(target_arch = "wasm32"))]
+fn open_lab(dir: &std::path::Path) -> anyhow::Result<(lab::LabMode, crate::Scene)> {
+    lab::LabMode::open(dir)
+}
+
+#[cfg(target_arch = "wasm32")]
+fn open_lab(_: &std::path::Path) -> anyhow::Result<(lab::LabMode, crate::Scene)> {
+    anyhow::bail!("the page has no lab mode yet")
 }

@@ -23,6 +23,7 @@ use crate::gpu::Gpu;
 use crate::gpu::texture::GpuTexture;
 use crate::raster::{FrameReport, FrameTargets, Renderer, drawn_size};
 use crate::scene::{Camera, Light};
+use crate::shaders::Wgsl;
 use crate::{RenderSettings, Scene};
 
 /// The format egui samples the image from ([`Composition::Textured`]).
@@ -82,10 +83,12 @@ pub enum Drawn {
 }
 
 impl RasterView {
-    pub fn new(screen: &mut Screen, scene: &Scene, revision: u64) -> RasterView {
+    /// The view of `scene`, drawn by passes compiled from `wgsl` (Mirador's own, or a lab's:
+    /// `super::lab`).
+    pub fn new(screen: &mut Screen, scene: &Scene, revision: u64, wgsl: Wgsl) -> RasterView {
         let gpu = &screen.gpu;
         let format = screen.image_format();
-        let renderer = Renderer::new(gpu, scene, format);
+        let renderer = Renderer::with_wgsl(gpu, scene, format, wgsl, false);
         let placeholder = display_texture(&gpu.device, (1, 1));
         let view = placeholder.create_view(&wgpu::TextureViewDescriptor {
             label: Some("viewer::raster::placeholder_view"),
@@ -105,6 +108,14 @@ impl RasterView {
             bound: None,
             report: FrameReport::default(),
         }
+    }
+
+    /// Draws from now on with passes compiled from `wgsl` (lab mode: the student's functions
+    /// saved, or the reference shown), `scene` of `revision` loaded into them.
+    pub fn set_wgsl(&mut self, gpu: &Gpu, (scene, revision): (&Scene, u64), wgsl: Wgsl) {
+        self.renderer = Renderer::with_wgsl(gpu, scene, self.format, wgsl, false);
+        self.revision = revision;
+        self.drawn = None;
     }
 
     /// The displayed image's egui id ([`Composition::Textured`]).

@@ -29,6 +29,7 @@
 //! measure                       start `--stats`' means at the next frame (else they start
 //!                               after the last step)
 //! screenshot FILE.png           the whole window, written atomically
+//! lab student                   in lab mode: the student's image | reference | difference (L)
 //! ```
 //!
 //! Blank lines and lines starting with `#` are skipped in script files.
@@ -38,6 +39,7 @@ use std::path::{Path, PathBuf};
 use glam::{Vec2, Vec3};
 
 use super::camera_control::Navigation;
+use super::lab::LabShown;
 use super::view_mode::ViewMode;
 
 #[derive(Clone, Debug, PartialEq)]
@@ -70,6 +72,7 @@ pub enum Step {
     WaitTraced,
     Measure,
     Screenshot(PathBuf),
+    Lab(LabShown),
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -107,6 +110,9 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
     Ok(match verb {
         "set" => Step::Set(assignment("set")?),
         "material" => Step::Material(assignment("material")?),
+        "lab" => {
+            Step::Lab(LabShown::parse(args).ok_or_else(|| fail("the lab view is student, reference or difference"))?)
+        }
         "view" => {
             Step::View(ViewMode::parse(args).ok_or_else(|| fail("the view is raster, traced, split or difference"))?)
         }

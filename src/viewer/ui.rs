@@ -10,6 +10,7 @@ use glam::{Vec2, Vec3};
 
 use super::camera_control::{CameraInput, Navigation};
 use super::hud::{self, FrameStats};
+use super::lab::{LabPanel, LabShown};
 use super::panel;
 use super::picking::SeenDirection;
 use super::scene_panel;
@@ -43,6 +44,8 @@ pub struct UiModel<'a> {
     pub probe: Option<&'a volume_probe::Shown>,
     /// The environment's direction under the cursor and its pixel, for the lat–long marker.
     pub seen: Option<&'a (Vec2, SeenDirection)>,
+    /// Lab mode: the lab, what the view shows of it, the student's file's problems.
+    pub lab: Option<LabPanel<'a>>,
 }
 
 /// Requests the UI makes of the frame.
@@ -76,6 +79,8 @@ pub struct UiOutput {
     /// The pixel of the 3D view under the mouse (or a script's cursor), where the next frame
     /// probes the volume ray.
     pub cursor: Option<Vec2>,
+    /// Lab mode: show the student's image, the reference or their difference.
+    pub lab_shown: Option<LabShown>,
 }
 
 /// Draws the whole window.
@@ -129,6 +134,11 @@ fn keys(ctx: &egui::Context, model: &mut UiModel, output: &mut UiOutput) {
                 output.inspection_closed = true;
             }
         }
+        if pressed(Key::L)
+            && let Some(lab) = &model.lab
+        {
+            output.lab_shown = Some(lab.shown.next());
+        }
         if pressed(Key::G) {
             *model.navigation = match model.navigation {
                 Navigation::Orbit => Navigation::Fly,
@@ -151,6 +161,10 @@ fn keys(ctx: &egui::Context, model: &mut UiModel, output: &mut UiOutput) {
 
 fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     ui.heading("Mirador");
+    if let Some(lab) = &model.lab {
+        lab_section(ui, lab, output);
+        ui.separator();
+    }
     ui.horizontal_wrapped(|ui| {
         for mode in ViewMode::ALL {
             ui.selectable_value(&mut model.view.mode, mode, mode.label()).on_hover_text(match mode {
@@ -222,6 +236,31 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     }
 }
 
+/// Lab mode's section: the lab, the student's file, what the view shows, the file's problems.
+fn lab_section(ui: &mut egui::Ui, lab: &LabPanel, output: &mut UiOutput) {
+    ui.label(egui::RichText::new(format!("lab `{}`", lab.name)).strong()).on_hover_text(lab.title);
+    ui.small(format!("{} (redrawn when saved)", lab.file.display()));
+    ui.horizontal(|ui| {
+        for shown in LabShown::ALL {
+            let hint = match shown {
+                LabShown::Student => "Your functions (the last version that compiled). L switches.",
+                LabShown::Reference => "Mirador's own functions: the answer key. L switches.",
+                LabShown::Difference => {
+                    "The FLIP error map between the reference and yours (black: the same). L switches."
+                }
+            };
+            if ui.selectable_label(lab.shown == shown, shown.label()).on_hover_text(hint).clicked() {
+                output.lab_shown = Some(shown);
+            }
+        }
+    });
+    if lab.problems.is_empty() {
+        ui.small("Compiles. `mirador lab check DIR` runs the tests.");
+    } else {
+        ui.colored_label(ui.visuals().error_fg_color, format!("Does not compile: {} drawn.", lab.fallback));
+    }
+}
+
 /// The frame budget while the camera moves: a frame rate to hold and the lowest render scale.
 fn motion_budget(ui: &mut egui::Ui, view: &mut ViewState) {
     use super::budget::{DEFAULT_MOTION_FPS, MOTION_FPS, MOTION_SCALES};
@@ -287,7 +326,15 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     };
     let traced = model.traced.image.as_ref();
     match model.view.mode {
-        ViewMode::Raster => raster(false),
+        ViewMode::Raster => match &model.lab {
+            Some(lab) if lab.shown == LabShown::Difference => match lab.difference {
+                Some((id, _)) => {
+                    painter.image(id, rect, full, Color32::WHITE);
+                }
+                None => raster(true),
+            },
+            _ => raster(false),
+        },
         ViewMode::Traced => match traced {
             Some(shown) => {
                 painter.image(shown.texture.id(), rect, full, Color32::WHITE);
@@ -331,6 +378,19 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     if model.view.overlay_open {
         overlay(ui, model, rect);
     }
+    if let Some(lab) = model.lab.as_ref().filter(|lab| !lab.problems.is_empty()) {
+        let file = lab.file.file_name().map_or(lab.file.display().to_string(), |f| f.to_string_lossy().into_owned());
+        egui::Area::new(egui::Id::unique("mirador::lab_error")).fixed_pos(rect.min + egui::vec2(12.0, 12.0)).show(
+            ui.ctx(),
+            |ui| {
+                egui::Frame::popup(ui.style()).fill(LAB_ERROR_FILL).show(ui, |ui| {
+                    ui.set_max_width(rect.width() - 40.0);
+                    let text = format!("{file} does not compile; {} drawn.\n{}", lab.fallback, lab.problems.join("\n"));
+                    ui.label(egui::RichText::new(text).monospace().color(Color32::WHITE));
+                });
+            },
+        );
+    }
     if let Some(error) = model.scene.error.clone() {
         egui::Area::new(egui::Id::unique("mirador::scene_error")).fixed_pos(rect.min + egui::vec2(12.0, 12.0)).show(
             ui.ctx(),
@@ -349,6 +409,9 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
         );
     }
 }
+
+/// The fill behind a lab file's compile error over the view (tests/viewer.rs looks for it).
+pub const LAB_ERROR_FILL: Color32 = Color32::from_rgb(110, 16, 16);
 
 /// Mouse over the 3D view: drags, wheel and clicks, in pixels of the full-resolution image.
 fn camera_input(ui: &egui::Ui, response: &egui::Response, rect: Rect, ppp: f32, output: &mut UiOutput) {
@@ -470,6 +533,15 @@ fn overlay(ui: &egui::Ui, model: &UiModel, rect: Rect) {
             }
             _ => "\ntraced: starting…".to_string(),
         };
+    }
+    if let Some(lab) = &model.lab {
+        text += &format!("\nlab: {}", lab.shown.label());
+        if lab.shown == LabShown::Difference {
+            text += &match lab.difference {
+                Some((_, mean)) => format!(", {} mean {mean:.4} against the reference", crate::compare::METRIC),
+                None => ", waiting for the image at full scale".to_string(),
+            };
+        }
     }
     if model.view.mode == ViewMode::Difference {
         text += &match &model.traced.difference {

@@ -101,7 +101,7 @@ impl App {
         let mut screen = Screen::new(window, gpu, surface, true)?;
         screen.screenshot_sink = Some(Box::new(page::screenshot_taken));
         let scene = self.scene.take().ok_or_else(|| anyhow::anyhow!("the viewer starts once"))?;
-        let viewer = Viewer::new(&mut screen, scene, &ViewerConfig::default(), Vec::new(), || {});
+        let viewer = Viewer::new(&mut screen, scene, &ViewerConfig::default(), Vec::new(), || {}, None);
         log::info!("adapter: {}", screen.gpu.describe());
         screen.window.request_redraw();
         self.running = Some((screen, viewer));

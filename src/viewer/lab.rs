@@ -1,0 +1,329 @@
+//! The viewer in lab mode (`mirador view --lab DIR`, docs/course/labs.md): the lab's own scene,
+//! drawn with the student's functions, redrawn as soon as the student's file is saved.
+//!
+//! - The file is polled like a scene file (twice a second, without drawing a frame). A saved
+//!   file is checked as `lab check` checks it (signatures, then naga on every surface module):
+//!   when it compiles, the view is drawn with it at once; when it does not, the error is shown
+//!   over the view with its `file:line:column`, and the last version that compiled stays drawn
+//!   (the stub's neutral functions until one does).
+//! - The L key (or the step `lab student|reference|difference`) switches what the view shows:
+//!   the student's functions, Mirador's own (the answer key, routed as the lab routes it), or
+//!   the FLIP error map between the two at the view's size, with its mean.
+//! - Inspecting a pixel (I, then a click) explains the image shown: the student's pixels are
+//!   explained with the student's functions.
+//! - The lab starts from its scene and the settings its first image test sets, never from what
+//!   the viewer remembered of another scene, and remembers nothing when it closes.
+//!
+//! The page has no lab mode yet: there [`LabMode`] has no value.
+
+/// What the view shows in lab mode.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LabShown {
+    /// The scene drawn with the student's functions (the last version that compiled).
+    #[default]
+    Student,
+    /// Drawn with Mirador's own: the answer key.
+    Reference,
+    /// The FLIP error map between the two.
+    Difference,
+}
+
+impl LabShown {
+    pub const ALL: [LabShown; 3] = [LabShown::Student, LabShown::Reference, LabShown::Difference];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            LabShown::Student => "student",
+            LabShown::Reference => "reference",
+            LabShown::Difference => "difference",
+        }
+    }
+
+    pub fn parse(text: &str) -> Option<LabShown> {
+        LabShown::ALL.into_iter().find(|shown| shown.label() == text.trim())
+    }
+
+    /// The next one, for the L key.
+    pub fn next(self) -> LabShown {
+        match self {
+            LabShown::Student => LabShown::Reference,
+            LabShown::Reference => LabShown::Difference,
+            LabShown::Difference => LabShown::Student,
+        }
+    }
+}
+
+/// What the window shows of the lab: the panel's section, the error over the view, the
+/// difference view's image.
+pub struct LabPanel<'a> {
+    pub name: &'a str,
+    pub title: &'a str,
+    pub file: &'a std::path::Path,
+    pub shown: LabShown,
+    pub problems: &'a [String],
+    /// What is drawn while the file does not compile.
+    pub fallback: &'static str,
+    /// The difference view's error map and its mean, once made for the current view.
+    pub difference: Option<(egui::TextureId, f32)>,
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+pub use native::LabMode;
+
+#[cfg(not(target_arch = "wasm32"))]
+mod native {
+    use std::path::{Path, PathBuf};
+    use std::time::{Duration, SystemTime};
+
+    use web_time::Instant;
+
+    use super::LabShown;
+    use crate::gpu::Gpu;
+    use crate::lab::check::LabFolder;
+    use crate::lab::{Lab, source};
+    use crate::raster::Headless;
+    use crate::scene::{Camera, Light};
+    use crate::shaders::Wgsl;
+    use crate::{RenderSettings, Scene};
+
+    /// How often the student's file's modification time is checked.
+    const WATCH_PERIOD: Duration = Duration::from_millis(500);
+
+    pub struct LabMode {
+        pub lab: Lab,
+        /// The student's file.
+        pub file: PathBuf,
+        modified: Option<SystemTime>,
+        checked: Instant,
+        /// The student's functions as last compiled (the stub's neutral bodies until a version
+        /// does), and how many versions compiled so far.
+        student: Wgsl,
+        generation: u64,
+        /// Why the saved file is not the one drawn: each problem at its place, as `lab check`
+        /// prints it. Empty when the file drawn is the file saved.
+        pub problems: Vec<String>,
+        pub shown: LabShown,
+        /// The difference view's image and mean, and what it was made from.
+        pub difference: Option<ShownDifference>,
+        /// The shader the view draws with changed: the frame rebuilds its renderer.
+        changed: bool,
+    }
+
+    pub struct ShownDifference {
+        pub texture: egui::TextureHandle,
+        pub flip_mean: f32,
+        inputs: DifferenceInputs,
+    }
+
+    /// Everything the difference image depends on.
+    #[derive(Clone, PartialEq)]
+    struct DifferenceInputs {
+        camera: Camera,
+        lights: Vec<Light>,
+        settings: RenderSettings,
+        revision: u64,
+        generation: u64,
+    }
+
+    impl LabMode {
+        /// The lab in folder `dir` (made by `mirador lab new`), and the scene it starts from:
+        /// its first image test's, from the folder's `scenes/` where the student has a copy,
+        /// with the settings the test sets.
+        pub fn open(dir: &Path) -> anyhow::Result<(LabMode, Scene)> {
+            let folder = LabFolder::read(dir).map_err(anyhow::Error::msg)?;
+            let lab = crate::lab::find(&folder.lab)
+                .map_err(|e| anyhow::anyhow!("{}: {e}", dir.join("lab.toml").display()))?;
+            let test = lab.images.first().cloned().ok_or_else(|| anyhow::anyhow!("lab {} has no scene", lab.name))?;
+            // `lab new` copies the scenes into the folder's `scenes/`: the student's copy first.
+            let copy = Path::new(&test.scene).file_name().map(|name| Path::new("scenes").join(name));
+            let test = match copy.filter(|path| dir.join(path).exists()) {
+                Some(path) => crate::lab::ImageTest { scene: path.display().to_string(), ..test },
+                None => test,
+            };
+            let scene = crate::lab::images::scene(&test, Some(dir)).map_err(anyhow::Error::msg)?;
+            let file = dir.join(&lab.file);
+            let mut mode = LabMode {
+                student: source::student(&lab, &lab.stub()),
+                lab,
+                modified: None,
+                checked: Instant::now(),
+                file,
+                generation: 0,
+                problems: Vec::new(),
+                shown: LabShown::Student,
+                difference: None,
+                changed: true,
+            };
+            mode.read();
+            Ok((mode, scene))
+        }
+
+        /// Reads and checks the student's file: adopted when it compiles, its problems kept
+        /// otherwise. Returns whether anything on screen changes.
+        fn read(&mut self) -> bool {
+            self.modified = modified(&self.file);
+            let name = self.lab.file.clone();
+            let text = match std::fs::read_to_string(&self.file) {
+                Ok(text) => text,
+                Err(e) => {
+                    self.problems = vec![format!("{}: {e}", self.file.display())];
+                    return true;
+                }
+            };
+            let problems = source::problems(&self.lab, &text);
+            if problems.is_empty() {
+                self.student = source::student(&self.lab, &text);
+                self.generation += 1;
+                self.problems.clear();
+                self.changed = true;
+                println!("lab: {name} compiles; the view draws it");
+            } else {
+                self.problems = problems.iter().map(|p| p.display(&name)).collect();
+                println!("lab: {name} does not compile; the view draws {}\n{}", self.fallback(), self.problems[0]);
+            }
+            true
+        }
+
+        /// Checks the student's file when it changed on disk (polled, cheap); returns whether
+        /// the window must be drawn again.
+        pub fn poll(&mut self) -> bool {
+            if self.checked.elapsed() < WATCH_PERIOD {
+                return false;
+            }
+            self.checked = Instant::now();
+            if modified(&self.file) == self.modified {
+                return false;
+            }
+            self.read()
+        }
+
+        /// What the view draws while the saved file does not compile.
+        fn fallback(&self) -> &'static str {
+            if self.generation == 0 { "the stub's neutral functions" } else { "the last version that compiled" }
+        }
+
+        /// Whether the shader the view draws with changed since the last call.
+        pub fn take_changed(&mut self) -> bool {
+            std::mem::take(&mut self.changed)
+        }
+
+        /// When the file is next due a look.
+        pub fn next_poll(&self) -> Instant {
+            self.checked + WATCH_PERIOD
+        }
+
+        /// What the view draws with: the student's functions, or in the reference view
+        /// Mirador's (the difference view draws the student's under its error map).
+        pub fn wgsl(&self) -> Wgsl {
+            match self.shown {
+                LabShown::Reference => source::reference(&self.lab),
+                LabShown::Student | LabShown::Difference => self.student.clone(),
+            }
+        }
+
+        /// What the window shows of the lab.
+        pub fn panel(&self) -> super::LabPanel<'_> {
+            super::LabPanel {
+                name: &self.lab.name,
+                title: &self.lab.title,
+                file: &self.file,
+                shown: self.shown,
+                problems: &self.problems,
+                fallback: self.fallback(),
+                difference: self.difference.as_ref().map(|d| (d.texture.id(), d.flip_mean)),
+            }
+        }
+
+        /// Shows `shown` from the next frame on.
+        pub fn show(&mut self, shown: LabShown) {
+            if shown != self.shown {
+                self.shown = shown;
+                self.changed = true;
+            }
+        }
+
+        /// In the difference view, the error map between the reference's image and the
+        /// student's of `scene` (at the view's size) unless it already shows them.
+        pub fn update_difference(&mut self, gpu: &Gpu, ctx: &egui::Context, scene: &Scene, revision: u64) {
+            if self.shown != LabShown::Difference {
+                return;
+            }
+            let inputs = DifferenceInputs {
+                camera: scene.camera.clone(),
+                lights: scene.lights.clone(),
+                settings: scene.settings.clone(),
+                revision,
+                generation: self.generation,
+            };
+            if self.difference.as_ref().is_some_and(|d| d.inputs == inputs) {
+                return;
+            }
+            let draw =
+                |wgsl: Wgsl| gpu.checked(|| Headless::with_wgsl(gpu, scene, wgsl).render(gpu, scene, &scene.settings));
+            let (reference, student) = match (draw(source::reference(&self.lab)), draw(self.student.clone())) {
+                (Ok(reference), Ok(student)) => (reference, student),
+                (Err(e), _) | (_, Err(e)) => {
+                    log::warn!("lab difference: {e}");
+                    return;
+                }
+            };
+            let Ok(difference) = crate::compare::difference(&reference, &student) else { return };
+            let map = &difference.error_map;
+            let image =
+                egui::ColorImage::from_rgba_unmultiplied([map.width() as usize, map.height() as usize], map.as_raw());
+            let options = egui::TextureOptions::NEAREST;
+            let texture = match self.difference.take() {
+                Some(mut shown) => {
+                    shown.texture.set(image, options);
+                    shown.texture
+                }
+                None => ctx.load_texture("viewer::lab_difference", image, options),
+            };
+            println!(
+                "lab: difference against the reference, {} mean {:.4}",
+                crate::compare::METRIC,
+                difference.flip_mean
+            );
+            self.difference = Some(ShownDifference { texture, flip_mean: difference.flip_mean, inputs });
+        }
+    }
+
+    fn modified(path: &Path) -> Option<SystemTime> {
+        std::fs::metadata(path).and_then(|m| m.modified()).ok()
+    }
+}
+
+/// The page has no lab mode yet (issue 36): no value of this type exists there.
+#[cfg(target_arch = "wasm32")]
+pub enum LabMode {}
+
+#[cfg(target_arch = "wasm32")]
+impl LabMode {
+    pub fn poll(&mut self) -> bool {
+        match *self {}
+    }
+
+    pub fn next_poll(&self) -> web_time::Instant {
+        match *self {}
+    }
+
+    pub fn wgsl(&self) -> crate::shaders::Wgsl {
+        match *self {}
+    }
+
+    pub fn show(&mut self, _: LabShown) {
+        match *self {}
+    }
+
+    pub fn panel(&self) -> LabPanel<'_> {
+        match *self {}
+    }
+
+    pub fn take_changed(&mut self) -> bool {
+        match *self {}
+    }
+
+    pub fn update_difference(&mut self, _: &crate::gpu::Gpu, _: &egui::Context, _: &crate::Scene, _: u64) {
+        match *self {}
+    }
+}
