@@ -202,11 +202,11 @@ struct ViewArgs {
     #[arg(long, value_name = "FILE", requires = "frames")]
     screenshot: Option<PathBuf>,
     /// A scripted step, one per frame, in order: `set KEY=VALUE`, `view raster|traced|split|difference`,
-    /// `split X`, `orbit DX DY`, `pan DX DY`, `zoom N`, `frame`, `reset`, `navigate orbit|fly`,
+    /// `split X`, `orbit DX DY`, `pan DX DY`, `zoom N`, `frame`, `reset`, `reset settings`, `navigate orbit|fly`,
     /// `walk X Y Z`, `pick X Y`, `cursor X Y`, `inspect X Y` (both renderers at that pixel, as the
     /// I key and a click), `probe`, `material KEY=VALUE`, `load FILE`, `scale S`,
     /// `fps N|off`, `help on|off`, `panel on|off`, `overlay on|off`, `wait N`, `wait 2s`,
-    /// `wait traced`, `measure`, `screenshot FILE.png`.
+    /// `wait traced`, `measure`, `screenshot FILE.png`, `lab student|reference|difference`.
     #[arg(long = "step", value_name = "STEP", requires = "frames")]
     steps: Vec<String>,
     /// A file of steps, one a line (`#` comments); run before any --step.

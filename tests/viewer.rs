@@ -653,3 +653,91 @@ fn lab_mode_redraws_a_saved_edit_shows_a_broken_one_and_recovers() {
     assert!(recovered < 0.005, "the fixed file does not draw the first image (mean FLIP {recovered})");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Settings changed in one scene stay with it: the next scene opens with its own, the first
+/// gets its changes back when opened again, and `reset settings` (the panel's reset) returns to
+/// the scene file's own.
+#[test]
+fn settings_changed_in_one_scene_stay_with_it_and_reset_to_the_scenes_own() {
+    let dir = scratch("per-scene");
+    let text = std::fs::read_to_string(common::asset("scenes/shadows.toml")).expect("the shadows scene");
+    let (a, b) = (dir.join("a.toml"), dir.join("b.toml"));
+    std::fs::write(&a, &text).unwrap();
+    std::fs::write(&b, &text).unwrap();
+    let shot = |name: &str| dir.join(format!("{name}.png"));
+    let steps = [
+        "overlay off".to_string(),
+        "set shadows.enabled=false".to_string(),
+        "wait 2".to_string(),
+        format!("load {}", b.display()),
+        "wait 2".to_string(),
+        format!("screenshot {}", shot("b").display()),
+        format!("load {}", a.display()),
+        "wait 2".to_string(),
+        format!("screenshot {}", shot("a-again").display()),
+        "reset settings".to_string(),
+        "wait 2".to_string(),
+        format!("screenshot {}", shot("a-reset").display()),
+    ];
+    let mut args = vec![a.to_str().unwrap(), "--size", "640x400", "--frames", "2"];
+    for step in &steps {
+        args.extend(["--step", step.as_str()]);
+    }
+    let output = viewer(&args, &dir);
+    succeeded(&output);
+    let rects = views(&output);
+    let view = |name: &str| {
+        let (_, rect) = rects.iter().find(|(p, _)| p == &shot(name)).expect("the screenshot was written");
+        (crop(&image::open(shot(name)).unwrap().to_rgba8(), *rect), *rect)
+    };
+    let headless = |shadows: bool, [_, _, w, h]: [u32; 4]| {
+        let mut scene = Scene::load(&a).expect("the scene loads");
+        scene.camera.width = w;
+        scene.camera.height = h;
+        scene.settings.shadows.enabled = shadows;
+        let gpu = common::gpu();
+        mirador::raster::render_image(gpu, &scene, &scene.settings)
+    };
+    let (b_view, rect) = view("b");
+    let with_shadows = headless(true, rect);
+    let without = headless(false, rect);
+    assert!(common::difference(&with_shadows, &without).flip_mean > 0.01, "the scene must show its shadows");
+    assert!(flip(&with_shadows, &b_view, "per-scene-b", &dir) < MAX_FLIP_MEAN, "b opened with a's change");
+    let (a_view, _) = view("a-again");
+    assert!(flip(&without, &a_view, "per-scene-a", &dir) < MAX_FLIP_MEAN, "a lost its change");
+    let (reset, _) = view("a-reset");
+    assert!(flip(&with_shadows, &reset, "per-scene-reset", &dir) < MAX_FLIP_MEAN, "reset kept the change");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A screenshot asked for right after the camera moves waits for the full-scale image: it is the
+/// image the view settles on, not the low-resolution one drawn while moving.
+#[test]
+fn a_screenshot_after_a_move_waits_for_full_scale() {
+    let dir = scratch("full-scale");
+    let shot = |name: &str| dir.join(format!("{name}.png"));
+    let steps = [
+        "overlay off".to_string(),
+        "fps off".to_string(),
+        "scale 0.25".to_string(),
+        "orbit 60 0".to_string(),
+        format!("screenshot {}", shot("at-once").display()),
+        "wait 1s".to_string(),
+        format!("screenshot {}", shot("settled").display()),
+    ];
+    let scene = common::asset("scenes/seed-simple.toml");
+    let mut args = vec![scene.to_str().unwrap(), "--size", "640x400", "--frames", "2"];
+    for step in &steps {
+        args.extend(["--step", step.as_str()]);
+    }
+    let output = viewer(&args, &dir);
+    succeeded(&output);
+    let rects = views(&output);
+    let view = |name: &str| {
+        let (_, rect) = rects.iter().find(|(p, _)| p == &shot(name)).expect("the screenshot was written");
+        crop(&image::open(shot(name)).unwrap().to_rgba8(), *rect)
+    };
+    let mean = flip(&view("settled"), &view("at-once"), "full-scale", &dir);
+    assert!(mean < MAX_FLIP_MEAN, "the screenshot after the move was taken below full scale (mean FLIP {mean})");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,5 +1,6 @@
 //! What the viewer remembers between runs: the window's size, the view mode and divider, the
-//! frame budget while moving, and the render settings the user changed. Kept as TOML in the
+//! frame budget while moving, and the render settings the user changed, scene by scene. Kept as
+//! TOML in the
 //! user's configuration directory (`$XDG_CONFIG_HOME/mirador/viewer.toml`, else
 //! `~/.config/mirador/viewer.toml`).
 //!
@@ -7,10 +8,14 @@
 //! `render` and `trace` never move a camera, so it is kept here and in the panel's view section,
 //! not in `RenderSettings`, whose every key the headless commands and the scene files share.
 //!
-//! Settings are remembered as the leaves that differ from the scene's own defaults and are put
-//! back one by one through `RenderSettings::set` (the mechanism behind `--set`), so a setting
-//! that was renamed or removed since is dropped with a warning instead of discarding the rest. A
+//! Settings are remembered per scene (its file's path), as the leaves that differ from the
+//! scene's own and are put back one by one through `RenderSettings::set` (the mechanism behind
+//! `--set`), so a setting that was renamed or removed since is dropped with a warning instead of
+//! discarding the rest. A scene opens with its own settings and what was changed in it before,
+//! never with another scene's: shadows turned off in one chapter's scene stay on in the next. A
 //! file that cannot be read or parsed is ignored with a warning: the viewer starts from defaults.
+
+use std::collections::BTreeMap;
 
 use std::path::{Path, PathBuf};
 
@@ -33,8 +38,8 @@ pub struct ViewerConfig {
     pub motion_fps: f32,
     /// The lowest render scale while the camera moves (1 = always full resolution).
     pub motion_scale: f32,
-    /// Render settings that differ from the scene's defaults, as dotted keys.
-    pub settings: toml::Table,
+    /// Render settings changed from each scene's own, as dotted keys, by [`scene_key`].
+    pub scenes: BTreeMap<String, toml::Table>,
 }
 
 impl Default for ViewerConfig {
@@ -45,7 +50,7 @@ impl Default for ViewerConfig {
             split: 0.5,
             motion_fps: DEFAULT_MOTION_FPS,
             motion_scale: DEFAULT_MOTION_SCALE,
-            settings: toml::Table::new(),
+            scenes: BTreeMap::new(),
         }
     }
 }
@@ -57,6 +62,15 @@ pub fn config_path() -> Option<PathBuf> {
         .map(PathBuf::from)
         .or_else(|| std::env::var_os("HOME").filter(|v| !v.is_empty()).map(|home| Path::new(&home).join(".config")))?;
     Some(base.join("mirador").join("viewer.toml"))
+}
+
+/// The key a scene's remembered settings are kept under: its file's full path, or
+/// `(built in)` for the showcase.
+pub fn scene_key(source: Option<&Path>) -> String {
+    match source {
+        Some(path) => std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()).display().to_string(),
+        None => "(built in)".to_string(),
+    }
 }
 
 /// Reads the configuration; a missing file gives the defaults silently, an unreadable or corrupt
@@ -169,13 +183,14 @@ mod tests {
         settings.set("exposure=1.5").unwrap();
         let changes = changed_settings(&settings, &defaults);
         assert_eq!(changes.len(), 3, "{changes:?}");
-        let config = ViewerConfig { settings: changes, mode: ViewMode::Split, ..Default::default() };
+        let scenes = BTreeMap::from([("/course/a.toml".to_string(), changes)]);
+        let config = ViewerConfig { scenes, mode: ViewMode::Split, ..Default::default() };
         let path = temporary("round-trip");
         save(&path, &config).unwrap();
         let (loaded, warning) = load(&path);
         assert_eq!(warning, None);
         assert_eq!(loaded, config);
-        let (restored, warnings) = apply_settings(&defaults, &loaded.settings);
+        let (restored, warnings) = apply_settings(&defaults, &loaded.scenes["/course/a.toml"]);
         assert!(warnings.is_empty(), "{warnings:?}");
         assert_eq!(restored, settings);
     }

@@ -10,7 +10,7 @@
 //! is drawn at the render scale the frame budget picks ([`FrameBudget`]); the frame after it
 //! stops ([`SETTLE`]) is drawn at full scale.
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -21,7 +21,7 @@ use glam::Vec2;
 
 use super::budget::FrameBudget;
 use super::camera_control::{self, CameraInput, Navigation};
-use super::config::ViewerConfig;
+use super::config::{ViewerConfig, scene_key};
 use super::hud::{FrameStats, FrameTimes};
 use super::inspect::Inspection;
 use super::lab::LabMode;
@@ -87,6 +87,8 @@ pub struct Viewer {
     inspect_next: Option<Vec2>,
     /// Lab mode (`mirador view --lab DIR`): the student's functions drawn, reloaded when saved.
     pub lab: Option<LabMode>,
+    /// The settings changed in each scene opened before (`super::config`), by scene key.
+    remembered: BTreeMap<String, toml::Table>,
 }
 
 /// Scripted steps still to run and the wait in progress.
@@ -118,7 +120,9 @@ impl Viewer {
         wake: impl Fn() + Send + 'static,
         mut lab: Option<LabMode>,
     ) -> Viewer {
-        let (settings, warnings) = super::config::apply_settings(&scene.settings, &config.settings);
+        let remembered = config.scenes.clone();
+        let changes = remembered.get(&scene_key(scene.source.as_deref())).cloned().unwrap_or_default();
+        let (settings, warnings) = super::config::apply_settings(&scene.settings, &changes);
         let mut scene = SceneState::new(scene);
         scene.scene.settings = settings.clone();
         let wgsl = lab.as_mut().map_or_else(Wgsl::builtin, |lab| {
@@ -159,6 +163,7 @@ impl Viewer {
             inspection: None,
             inspect_next: None,
             lab,
+            remembered,
         }
     }
 
@@ -187,7 +192,8 @@ impl Viewer {
     pub fn poll_file(&mut self) -> bool {
         let reloaded = self.scene.reload_if_changed(&self.settings);
         if reloaded {
-            self.notice("scene file changed on disk: reloaded".into());
+            let what = if self.scene.error.is_some() { "it does not load; the last scene is kept" } else { "reloaded" };
+            self.notice(format!("scene file changed on disk: {what}"));
         }
         let lab = self.lab.as_mut().is_some_and(LabMode::poll);
         reloaded || lab
@@ -206,16 +212,58 @@ impl Viewer {
             split: self.view.split,
             motion_fps: self.view.motion_fps,
             motion_scale: self.view.motion_scale,
-            settings: super::config::changed_settings(&self.settings, &self.scene.seed_settings),
+            scenes: self.remembered_scenes(),
         }
     }
 
-    /// Opens a scene file (dropped, or from a script), keeping the current settings.
-    pub fn open(&mut self, path: &Path) {
-        if self.scene.load(path, &self.settings) {
-            self.camera_error = None;
-            self.notice(format!("opened {}", path.display()));
+    /// The settings changed in every scene, this one's as they are now.
+    fn remembered_scenes(&self) -> BTreeMap<String, toml::Table> {
+        let mut scenes = self.remembered.clone();
+        let key = scene_key(self.scene.scene.source.as_deref());
+        let changes = self.changed_settings();
+        if changes.is_empty() {
+            scenes.remove(&key);
+        } else {
+            scenes.insert(key, changes);
         }
+        scenes
+    }
+
+    /// The settings that differ from the scene file's own.
+    pub fn changed_settings(&self) -> toml::Table {
+        super::config::changed_settings(&self.settings, &self.scene.seed_settings)
+    }
+
+    /// Opens a scene file (dropped, or from a script) with its own settings and what was changed
+    /// in it before: nothing set in the scene left behind comes along.
+    pub fn open(&mut self, path: &Path) {
+        self.remembered = self.remembered_scenes();
+        if self.scene.load(path, None) {
+            self.camera_error = None;
+            let changes = self.remembered.get(&scene_key(Some(path))).cloned().unwrap_or_default();
+            let (settings, warnings) = super::config::apply_settings(&self.scene.seed_settings, &changes);
+            self.settings = settings;
+            self.scene.scene.settings = self.settings.clone();
+            for warning in warnings {
+                self.notice(warning);
+            }
+            let kept = if changes.is_empty() {
+                String::new()
+            } else {
+                format!(" ({} settings as you left them)", changes.len())
+            };
+            self.notice(format!("opened {}{kept}", path.display()));
+        }
+    }
+
+    /// Every setting back to the scene file's own.
+    fn reset_settings(&mut self) {
+        if self.settings.sphere_segments != self.scene.seed_settings.sphere_segments {
+            self.scene.touch();
+        }
+        self.settings = self.scene.seed_settings.clone();
+        self.scene.scene.settings = self.settings.clone();
+        self.notice("settings reset to the scene's own".into());
     }
 
     fn notice(&mut self, message: String) {
@@ -276,7 +324,7 @@ impl Viewer {
         let moving = self.moving(Instant::now());
         let scale = self.scale(moving);
         let drawn = self.draw_view(screen, scale, &mut times);
-        let presented = self.paint(screen, full, repaint, &mut times)?;
+        let presented = self.paint(screen, full, (repaint, scale), &mut times)?;
         times.frame = start.elapsed();
         times.scale = scale;
         if moving && self.view.motion_fps > 0.0 && matches!(drawn, Drawn::New(_)) {
@@ -299,6 +347,8 @@ impl Viewer {
     fn lay_out(&mut self, screen: &mut Screen) -> (UiOutput, egui::FullOutput) {
         let raw = screen.take_input();
         let raster_id = (screen.composition == Composition::Textured).then(|| self.raster.texture_id());
+        let changed: Vec<String> =
+            self.changed_settings().iter().map(|(key, value)| format!("{key} = {value}")).collect();
         let mut output = UiOutput::default();
         let mut model = UiModel {
             settings: &self.settings,
@@ -316,6 +366,7 @@ impl Viewer {
             probe: self.probe.shown(),
             seen: self.seen.shown(),
             lab: self.lab.as_ref().map(LabMode::panel),
+            changed_settings: &changed,
         };
         let full = screen.egui.run_ui(raw, |ui| output = ui::draw(ui, &mut model));
         (output, full)
@@ -371,11 +422,11 @@ impl Viewer {
         &mut self,
         screen: &mut Screen,
         full: egui::FullOutput,
-        repaint: Option<Duration>,
+        (repaint, scale): (Option<Duration>, f32),
         times: &mut FrameTimes,
     ) -> anyhow::Result<Presented> {
         let paint_start = Instant::now();
-        let screenshot = self.screenshot_due(repaint);
+        let screenshot = self.screenshot_due(repaint, scale);
         let view = match (self.raster.image(), self.view_pixels) {
             (Some((texture, plain)), Some((x, y, w, h))) => Some(ViewImage { texture, plain, rect: [x, y, w, h] }),
             _ => None,
@@ -425,14 +476,15 @@ impl Viewer {
     }
 
     /// The screenshot to write this frame: the one asked for, unless egui is animating (a window
-    /// fading in, a section opening), when it waits for the animation to end, up to
+    /// fading in, a section opening) or the view was drawn below full scale (the camera just
+    /// moved), when it waits for the animation to end and the full-scale image, up to
     /// [`SCREENSHOT_PATIENCE`]. The scripted steps wait with it, so it shows the state the steps
     /// before it set up.
-    fn screenshot_due(&mut self, repaint: Option<Duration>) -> Option<PathBuf> {
+    fn screenshot_due(&mut self, repaint: Option<Duration>, scale: f32) -> Option<PathBuf> {
         self.screenshot.as_ref()?;
         let since = *self.screenshot_waiting.get_or_insert_with(Instant::now);
         let animating = repaint.is_some_and(|delay| delay.is_zero());
-        if animating && since.elapsed() < SCREENSHOT_PATIENCE {
+        if (animating || scale < 1.0) && since.elapsed() < SCREENSHOT_PATIENCE {
             return None;
         }
         self.screenshot_waiting = None;
@@ -476,6 +528,7 @@ impl Viewer {
                     self.screenshot = Some(PathBuf::from(format!("mirador-{seconds}.png")));
                 }
                 Action::DismissError => self.scene.error = None,
+                Action::ResetSettings => self.reset_settings(),
             }
         }
         for assignment in &output.settings {
@@ -622,6 +675,7 @@ impl Viewer {
             }
             Step::Frame => self.frame_scene(),
             Step::Reset => self.reset_camera(),
+            Step::ResetSettings => self.reset_settings(),
             Step::Navigate(navigation) => self.navigation = navigation,
             Step::Pick(pixel) if self.view_pixels.is_none() => {
                 // The view has no size before its first frame: pick on the next one.

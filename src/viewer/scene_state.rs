@@ -67,12 +67,14 @@ impl SceneState {
         }
     }
 
-    /// Replaces the scene with the one at `path`, keeping `settings` and the window's image size;
-    /// on failure keeps the current scene and records the error.
-    pub fn load(&mut self, path: &Path, settings: &RenderSettings) -> bool {
+    /// Replaces the scene with the one at `path` and the window's image size, with `settings`
+    /// (the same scene reloaded) or its own (`None`: another scene); on failure keeps the current
+    /// scene and records the error. Returns whether the scene changed.
+    pub fn load(&mut self, path: &Path, settings: Option<&RenderSettings>) -> bool {
         match Scene::load(path) {
             Ok(scene) => {
-                self.replace(scene, settings);
+                let settings = settings.cloned().unwrap_or_else(|| scene.settings.clone());
+                self.replace(scene, &settings);
                 true
             }
             Err(e) => {
@@ -98,7 +100,8 @@ impl SceneState {
         self.scene.camera.height = height;
     }
 
-    /// Reloads the scene when its file changed on disk since it was loaded (polled, cheap).
+    /// Reloads the scene when its file changed on disk since it was loaded (polled, cheap);
+    /// returns whether the window changes: the scene, or the error of a file saved broken.
     pub fn reload_if_changed(&mut self, settings: &RenderSettings) -> bool {
         let Some(watch) = &mut self.watch else { return false };
         if watch.checked.elapsed() < WATCH_PERIOD {
@@ -112,7 +115,9 @@ impl SceneState {
         watch.modified = now;
         let path = watch.path.clone();
         log::info!("{} changed on disk; reloading", path.display());
-        self.load(&path, settings)
+        let loaded = self.load(&path, Some(settings));
+        // A failed reload changes the window too: its error shows at once, not at the next input.
+        loaded || self.error.is_some()
     }
 
     /// When the scene file's modification time is next due a look (`None`: no file).
@@ -152,5 +157,36 @@ impl SceneState {
     /// The diagonal of the scene's bounds (1 for an empty scene): the scale of fly speeds.
     pub fn size(&self) -> f32 {
         self.bounds.map_or(1.0, |(lo, hi)| (hi - lo).length().max(1e-3))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scene file saved broken is news for the window at once (its error is drawn), not only
+    /// at the next input; the last scene stays.
+    #[test]
+    fn a_scene_file_saved_broken_asks_for_a_frame_and_keeps_the_last_scene() {
+        let dir = std::env::temp_dir().join(format!("mirador-scene-state-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("scene.toml");
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/scenes/seed-simple.toml"))
+            .expect("the seed scene");
+        std::fs::write(&path, &text).unwrap();
+        let scene = Scene::load(&path).expect("the scene loads");
+        let objects = scene.objects.len();
+        let mut state = SceneState::new(scene);
+        let settings = state.scene.settings.clone();
+        std::thread::sleep(WATCH_PERIOD + Duration::from_millis(100));
+        assert!(!state.reload_if_changed(&settings), "nothing changed yet");
+        std::fs::write(&path, format!("{text}\n[camera\n")).unwrap();
+        std::thread::sleep(WATCH_PERIOD + Duration::from_millis(100));
+        assert!(state.reload_if_changed(&settings), "a broken save must ask for a frame");
+        assert!(state.error.as_deref().is_some_and(|e| e.contains("scene.toml")), "{:?}", state.error);
+        assert_eq!(state.scene.objects.len(), objects, "the last scene stays");
+        std::thread::sleep(WATCH_PERIOD + Duration::from_millis(100));
+        assert!(!state.reload_if_changed(&settings), "an unchanged broken file is not news twice");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -9,6 +9,7 @@
 //! orbit 40 -10 | pan 20 0       a mouse drag, in pixels
 //! zoom 2                        wheel steps (positive: closer)
 //! frame | reset                 the F and R keys
+//! reset settings                every setting back to the scene file's own (the panel's reset)
 //! navigate fly | navigate orbit
 //! walk 0 0 1                    fly by (right, up, forward) scene units
 //! pick 320 200                  click the 3D view at this pixel (selects the object)
@@ -73,6 +74,7 @@ pub enum Step {
     Measure,
     Screenshot(PathBuf),
     Lab(LabShown),
+    ResetSettings,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -138,6 +140,7 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
         "walk" => Step::Walk(Vec3::from(numbers::<3>(args).ok_or_else(|| fail("expected right up forward"))?)),
         "frame" => Step::Frame,
         "probe" => Step::Probe,
+        "reset" if args == "settings" => Step::ResetSettings,
         "reset" => Step::Reset,
         "navigate" => Step::Navigate(match args {
             "orbit" => Navigation::Orbit,

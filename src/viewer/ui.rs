@@ -46,6 +46,8 @@ pub struct UiModel<'a> {
     pub seen: Option<&'a (Vec2, SeenDirection)>,
     /// Lab mode: the lab, what the view shows of it, the student's file's problems.
     pub lab: Option<LabPanel<'a>>,
+    /// The settings changed from the scene file's own, as `key = value`.
+    pub changed_settings: &'a [String],
 }
 
 /// Requests the UI makes of the frame.
@@ -55,6 +57,8 @@ pub enum Action {
     Reset,
     Screenshot,
     DismissError,
+    /// Every setting back to the scene file's own.
+    ResetSettings,
 }
 
 /// What the UI gathered this frame.
@@ -207,6 +211,17 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
         });
     });
     output.settings = panel::settings_ui(ui, model.settings);
+    if !model.changed_settings.is_empty() {
+        ui.horizontal(|ui| {
+            let count = model.changed_settings.len();
+            let plural = if count == 1 { "" } else { "s" };
+            ui.small(format!("{count} setting{plural} changed from the scene's"))
+                .on_hover_text(model.changed_settings.join("\n"));
+            if ui.small_button("reset").on_hover_text("Every setting back to what the scene file says.").clicked() {
+                output.actions.push(Action::ResetSettings);
+            }
+        });
+    }
     egui::CollapsingHeader::new(egui::RichText::new("lights").strong()).id_salt("lights").show(ui, |ui| {
         output.lights_edited |= scene_panel::lights_ui(ui, &mut model.scene.scene.lights);
     });
