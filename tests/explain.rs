@@ -454,3 +454,27 @@ fn both_sides_list_the_same_lights() {
     assert_eq!(raster, traced);
     assert_eq!(raster, ["key"], "the fill light lies behind the mirror's surface");
 }
+
+/// FLIP's error map spreads a pixel's error over its neighbours, so its brightest spot may agree
+/// (`mirrors.toml`, pixel (283, 212), beside the red sphere's outline): there `explain` says the
+/// renderers agree and names the nearest pixel that differs, which has a diagnosis of its own.
+/// In a flat area nothing nearby differs and no pixel is named.
+#[test]
+fn where_the_renderers_agree_explain_names_the_nearest_pixel_that_differs() {
+    let scene = Scene::load(&common::asset("scenes/mirrors.toml")).expect("the mirrors scene");
+    let agreeing = explained(&scene, &scene.settings, (283, 212));
+    assert_eq!(agreeing.diagnosis, None, "the pixel asked about agrees");
+    let nearest = agreeing.nearest.clone().expect("a pixel beside it differs");
+    assert!(nearest.distance <= 2.0, "{nearest:?}");
+    assert!(nearest.levels >= mirador::explain::DIFFERS_BY);
+    let [x, y] = nearest.pixel;
+    let differing = explained(&scene, &scene.settings, (x, y));
+    assert!(differing.diagnosis.is_some(), "the pixel named differs, so it has a diagnosis");
+    assert_eq!(differing.nearest, None, "a differing pixel names no other");
+    let text = mirador::explain::text::render(&agreeing);
+    let words = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(words.contains(&format!("the nearest pixel that differs is ({x}, {y})")), "{text}");
+
+    let flat = explained(&scene, &scene.settings, (100, 100));
+    assert_eq!((flat.diagnosis, flat.nearest), (None, None), "nothing near a flat pixel differs");
+}

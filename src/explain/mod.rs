@@ -46,7 +46,29 @@ pub struct Explanation {
     pub trace: TraceSide,
     /// One sentence naming the technique behind the difference, where the radiances differ.
     pub diagnosis: Option<String>,
+    /// Where they agree: the nearest pixel whose displayed colours differ, within
+    /// [`NEAREST_RADIUS`] pixels ([`Nearest`]).
+    pub nearest: Option<Nearest>,
 }
+
+/// A pixel near an agreeing one where the two renderers' displayed colours differ. FLIP's error
+/// map spreads each pixel's error over its neighbours (its filters span a few pixels), so the
+/// brightest spot of `compare`'s map may itself agree; the pixel to explain is this one.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Nearest {
+    pub pixel: [u32; 2],
+    /// Its distance from the pixel asked about, in pixels.
+    pub distance: f32,
+    /// The largest difference of its displayed channels, in levels of 255.
+    pub levels: u8,
+}
+
+/// How far [`Nearest`] looks, in pixels.
+pub const NEAREST_RADIUS: u32 = 8;
+
+/// Displayed channels this many levels (of 255) apart or more differ, for [`Nearest`]: what an
+/// eye sees in a flat area, well above a level of rounding.
+pub const DIFFERS_BY: u8 = 8;
 
 /// The rasterizer at the pixel, as its shaders computed it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -220,7 +242,50 @@ impl<'s> Explainer<'s> {
         let trace = TraceSide { radiance: rays.radiance, terms: rays.terms.clone(), lights: rays.lights.clone(), rays };
         let raster = raster_side(scene, settings, (&pixel, self.renderer.facts()));
         let diagnosis = diagnosis::diagnose(scene, settings, &raster, &trace);
-        Ok(Explanation { pixel: [x, y], raster, trace, diagnosis })
+        let nearest = match diagnosis {
+            Some(_) => None,
+            None => self.nearest_difference(gpu, (x, y))?,
+        };
+        Ok(Explanation { pixel: [x, y], raster, trace, diagnosis, nearest })
+    }
+
+    /// The nearest pixel to `(x, y)`, within [`NEAREST_RADIUS`], whose displayed colours differ
+    /// by [`DIFFERS_BY`] levels or more: the rasterizer's from the frame just drawn, the
+    /// tracer's from its ray through the pixel's centre (as `explain` traces it). Nearest first,
+    /// then the largest difference.
+    fn nearest_difference(&self, gpu: &Gpu, (x, y): (u32, u32)) -> Result<Option<Nearest>, ExplainError> {
+        let (width, height) = (self.scene.camera.width, self.scene.camera.height);
+        let image = crate::gpu::readback::read_rgba8(&gpu.device, &gpu.queue, &self.output.texture)
+            .map_err(|_| ExplainError::Readback)?;
+        let transform = crate::output::OutputTransform::of(&self.settings);
+        let r = NEAREST_RADIUS as i64;
+        let mut around: Vec<(i64, i64)> = (-r..=r)
+            .flat_map(|j| (-r..=r).map(move |i| (i, j)))
+            .filter(|&(i, j)| (i, j) != (0, 0) && i * i + j * j <= r * r)
+            .collect();
+        around.sort_by_key(|&(i, j)| i * i + j * j);
+        let mut best: Option<Nearest> = None;
+        for (i, j) in around {
+            let distance = ((i * i + j * j) as f32).sqrt();
+            if best.as_ref().is_some_and(|b| distance > b.distance) {
+                break;
+            }
+            let (px, py) = (x as i64 + i, y as i64 + j);
+            if px < 0 || py < 0 || px >= width as i64 || py >= height as i64 {
+                continue;
+            }
+            let (px, py) = (px as u32, py as u32);
+            let at = 4 * (py as usize * width as usize + px as usize);
+            let raster = &image[at..at + 3];
+            let mut counts = crate::trace::whitted::RayCounts::default();
+            let traced =
+                transform.to_srgb8(self.tracer.primary(glam::Vec2::new(px as f32 + 0.5, py as f32 + 0.5), &mut counts));
+            let levels = (0..3).map(|c| raster[c].abs_diff(traced[c])).max().unwrap_or(0);
+            if levels >= DIFFERS_BY && best.as_ref().is_none_or(|b| levels > b.levels) {
+                best = Some(Nearest { pixel: [px, py], distance, levels });
+            }
+        }
+        Ok(best)
     }
 }
 

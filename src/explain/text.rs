@@ -307,7 +307,23 @@ pub fn render(explanation: &Explanation) -> String {
     out.push_str("\ndiagnosis\n");
     match &explanation.diagnosis {
         Some(sentence) => wrap(sentence, 2 * COLUMN).iter().for_each(|l| out.push_str(&format!("  {l}\n"))),
-        None => out.push_str("  The two renderers agree here.\n"),
+        None => {
+            out.push_str("  The two renderers agree here.\n");
+            let sentence = match &explanation.nearest {
+                Some(n) => format!(
+                    "FLIP spreads a pixel's error over its neighbours, so an error map can be bright here: the nearest \
+                     pixel that differs is ({}, {}), {:.1} px away (its displayed colours {} levels apart). Explain that \
+                     one.",
+                    n.pixel[0], n.pixel[1], n.distance, n.levels
+                ),
+                None => format!(
+                    "No pixel within {} px differs by {} levels or more.",
+                    super::NEAREST_RADIUS,
+                    super::DIFFERS_BY
+                ),
+            };
+            wrap(&sentence, 2 * COLUMN).iter().for_each(|l| out.push_str(&format!("  {l}\n")));
+        }
     }
     out.push_str("\nthe tracer's ray tree\n");
     out.push_str(&ray_tree(&trace.rays));

@@ -56,7 +56,13 @@ impl Inspection {
         let [x, y] = self.explanation.pixel;
         match &self.explanation.diagnosis {
             Some(diagnosis) => format!("inspected ({x}, {y}): {diagnosis}"),
-            None => format!("inspected ({x}, {y}): the two renderers agree"),
+            None => match &self.explanation.nearest {
+                Some(n) => format!(
+                    "inspected ({x}, {y}): the two renderers agree; the nearest pixel that differs is ({}, {})",
+                    n.pixel[0], n.pixel[1]
+                ),
+                None => format!("inspected ({x}, {y}): the two renderers agree"),
+            },
         }
     }
 }
