@@ -122,6 +122,16 @@ enum Command {
         #[arg(long, value_name = "FILE.json")]
         json: Option<PathBuf>,
     },
+    /// Copy a scene and every file it reads (textures, maps, models, volumes) into a folder of
+    /// your own, the copy naming them there: do an exercise on the copy, the course stays as it
+    /// was. Nothing in the folder is overwritten.
+    Copy {
+        /// The scene file, or a built-in one by its name under assets/scenes
+        /// (`course/shadows-methods.toml`).
+        scene: PathBuf,
+        /// The folder to copy into (made if missing).
+        dir: PathBuf,
+    },
 }
 
 #[derive(Subcommand)]
@@ -278,6 +288,7 @@ fn main() -> ExitCode {
         Some(Command::Diff { reference, test, mask, json }) => {
             diff(&reference, &test, mask.as_deref(), json.as_deref())
         }
+        Some(Command::Copy { scene, dir }) => copy(&scene, &dir),
         None => view(ViewArgs::default()),
     };
     match result {
@@ -287,6 +298,17 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// `mirador copy SCENE DIR`.
+fn copy(scene: &Path, dir: &Path) -> anyhow::Result<()> {
+    let builtin = mirador::scene::builtin_path(&scene.to_string_lossy());
+    let scene = if scene.exists() || !builtin.exists() { scene.to_path_buf() } else { builtin };
+    let copied = mirador::scene::file::copy::copy(&scene, dir).map_err(anyhow::Error::msg)?;
+    for file in &copied.files {
+        println!("wrote {}", dir.join(file).display());
+    }
+    Ok(())
 }
 
 /// `mirador lab …`: its own exit status (`check` fails when a test does).

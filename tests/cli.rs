@@ -356,3 +356,46 @@ fn a_copied_course_scene_renders_and_a_missing_file_names_every_place_looked() {
         &bad,
     );
 }
+
+/// `mirador copy`: a course scene and everything it reads land in a folder of the student's,
+/// named there by the copy, so the copy reads nothing outside the folder (a texture, and a model
+/// with its MTL library) and draws what the course scene draws; a second copy into the same
+/// folder overwrites nothing.
+#[test]
+fn copy_writes_a_scene_and_its_files_into_a_folder_that_reads_nothing_outside() {
+    use mirador::Scene;
+    use mirador::scene::file::copy::files_read;
+    let dir = scratch("copy");
+    for (scene, needs) in
+        [("course/mirror-pair.toml", "textures/checker.png"), ("course/acceleration-teapot.toml", "teapot.mtl")]
+    {
+        let name = Path::new(scene).file_name().unwrap().to_str().unwrap();
+        let folder = dir.join(name.trim_end_matches(".toml"));
+        let output = mirador(&["copy", scene, folder.to_str().unwrap()]);
+        assert!(output.status.success(), "{}", stderr(&output));
+        let copy = folder.join(name);
+        let read = files_read(&copy).expect("the copy loads");
+        assert!(!read.is_empty());
+        for (named, found) in &read {
+            assert!(found.starts_with(&folder), "{scene}: the copy reads `{named}` from {}", found.display());
+        }
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(stdout.contains(needs), "{scene}: {stdout}");
+
+        let original = Scene::load(Path::new(&asset(&format!("scenes/{scene}")))).expect("the course scene");
+        let copied = Scene::load(&copy).expect("the copy");
+        assert_eq!((original.objects.len(), original.textures.len()), (copied.objects.len(), copied.textures.len()));
+        let size = |mut s: Scene| {
+            s.camera.width = 96;
+            s.camera.height = 54;
+            s
+        };
+        let (original, copied) = (size(original), size(copied));
+        let trace = |s: &Scene| mirador::trace::render_image(s, &s.settings);
+        assert!(trace(&original) == trace(&copied), "{scene}: the copy draws another image");
+
+        let again = mirador(&["copy", scene, folder.to_str().unwrap()]);
+        assert!(!again.status.success() && stderr(&again).contains("already exists"), "{}", stderr(&again));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

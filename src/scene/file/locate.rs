@@ -6,7 +6,24 @@
 //! `../../../tests/data/obj/teapot.obj` → `tests/data/obj/teapot.obj`). A file found nowhere is
 //! reported with every place looked.
 
+use std::cell::RefCell;
 use std::path::{Component, Path, PathBuf};
+
+thread_local! {
+    /// The files found while [`recording`] runs on this thread: as the scene names each, and
+    /// where it was read from.
+    static FOUND: RefCell<Option<Vec<(String, PathBuf)>>> = const { RefCell::new(None) };
+}
+
+/// Runs `work` (a scene's loading) and returns what it returned with every file [`locate`]
+/// found for it, as the scene names it and where it lies: what a copy of the scene must carry
+/// (`super::super::copy`).
+pub fn recording<T>(work: impl FnOnce() -> T) -> (T, Vec<(String, PathBuf)>) {
+    FOUND.with(|found| *found.borrow_mut() = Some(Vec::new()));
+    let value = work();
+    let files = FOUND.with(|found| found.borrow_mut().take()).unwrap_or_default();
+    (value, files)
+}
 
 /// The root of the tree this binary was built from (in the browser, the page's built-in files).
 fn mirador_root() -> &'static Path {
@@ -29,7 +46,14 @@ pub fn locate(dir: &Path, relative: &str) -> (PathBuf, Vec<PathBuf>) {
         }
     }
     match candidates.iter().find(|c| crate::files::check_regular(c).is_ok()) {
-        Some(found) => (found.clone(), Vec::new()),
+        Some(found) => {
+            FOUND.with(|files| {
+                if let Some(files) = files.borrow_mut().as_mut() {
+                    files.push((relative.to_owned(), found.clone()));
+                }
+            });
+            (found.clone(), Vec::new())
+        }
         None => (beside, candidates),
     }
 }

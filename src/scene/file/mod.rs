@@ -5,6 +5,7 @@
 //! together (a sphere needs a radius, eye ≠ center) are reported at the table they belong to.
 //! Unknown fields are rejected. Paths are relative to the scene file.
 
+pub mod copy;
 mod locate;
 pub mod overrides;
 mod volume;
