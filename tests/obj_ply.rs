@@ -322,6 +322,15 @@ fn a_missing_mtl_or_texture_is_a_warning_and_a_broken_one_an_error() {
         &[("model.obj", triangle.as_bytes()), ("looks.mtl", b"newmtl wood\nKs nan 0 0\n")],
         &["material `wood`", "`Ks`"],
     );
+    // A `newmtl` without a name (Blender and three.js load such files): named after its line,
+    // with a warning, and the library's other materials still load.
+    let path = write_files(
+        "unnamed-mtl",
+        &[("model.obj", triangle.as_bytes()), ("looks.mtl", b"newmtl\nKd 0 1 0\nnewmtl wood\nKd 1 0.5 0.25\n")],
+    );
+    let import = load_obj(&path);
+    warned(&import, &["mtllib `looks.mtl`", "line 1", "`newmtl` without a name"]);
+    assert_eq!(material(&import, &import.objects[0].name).color, Vec3::new(1.0, 0.5, 0.25));
     let utf16: Vec<u8> = [0xFF, 0xFE].into_iter().chain(triangle.encode_utf16().flat_map(u16::to_le_bytes)).collect();
     obj_error("utf16", &[("model.obj", &utf16)], &["UTF-16", "save it as UTF-8"]);
 }

@@ -79,7 +79,9 @@
 //! overflowed inside it (found by fuzzing, `fuzz/`).
 //! An `mtllib` file that is not there and a texture file that is not there are warnings (the
 //! materials drawn in the default material, the material without the texture), as Blender and
-//! three.js draw them: the warning names the file, and the model still shows. A malformed MTL
+//! three.js draw them: the warning names the file, and the model still shows. So is a `newmtl`
+//! without a name (it is called `unnamed-LINE`, and the library's other materials load). A
+//! malformed MTL
 //! statement, and a texture that is there but cannot be decoded, are errors: that file is
 //! broken, and saying so names it. A UTF-16 file is named as such. A face referring to a vertex the file does not
 //! have, and a file without a face to draw, are errors too.
@@ -146,8 +148,8 @@ fn import_text(path: &Path, text: &str) -> Result<ModelImport, String> {
         converted: HashMap::new(),
         textures: HashMap::new(),
     };
-    for missing in libraries.iter().filter_map(|l| l.missing.as_ref()) {
-        reader.warn(missing.clone());
+    for warning in libraries.iter().flat_map(|l| &l.warnings) {
+        reader.warn(warning.clone());
     }
     let known: Vec<&str> = materials.iter().map(|m| m.name.as_str()).collect();
     for (line, name) in &scan.usemtl {
@@ -326,9 +328,10 @@ struct Library {
     file: PathBuf,
     materials: usize,
     problem: Option<String>,
-    /// A library that could not be read at all: its materials are drawn in the default one, as
-    /// Blender and three.js draw them, and this says so.
-    missing: Option<String>,
+    /// What the library's reading let pass and the model's warnings say: a library that is not
+    /// there (its materials are drawn in the default one, as Blender and three.js draw them), a
+    /// `newmtl` without a name.
+    warnings: Vec<String>,
 }
 
 /// `tobj`'s material loader: reads the library `name` relative to the OBJ file's folder, keeping
@@ -342,30 +345,55 @@ fn read_library(dir: &Path, name: &Path, libraries: &RefCell<Vec<Library>>) -> t
             name.display(),
             file.display()
         );
-        libraries.push(Library { file, materials: 0, problem: None, missing: Some(missing) });
+        libraries.push(Library { file, materials: 0, problem: None, warnings: vec![missing] });
         return Ok((Vec::new(), HashMap::new()));
     }
     let result = read_mtl(&file).map_err(|e| format!("mtllib `{}`: {e}", name.display()));
     match result {
-        Ok((materials, names)) => {
-            libraries.push(Library { file, materials: materials.len(), problem: None, missing: None });
+        Ok((materials, names, warnings)) => {
+            let warnings = warnings.into_iter().map(|w| format!("mtllib `{}`: {w}", name.display())).collect();
+            libraries.push(Library { file, materials: materials.len(), problem: None, warnings });
             Ok((materials, names))
         }
         Err(problem) => {
-            libraries.push(Library { file, materials: 0, problem: Some(problem), missing: None });
+            libraries.push(Library { file, materials: 0, problem: Some(problem), warnings: Vec::new() });
             Err(tobj::LoadError::OpenFileFailed)
         }
     }
 }
 
-fn read_mtl(file: &Path) -> Result<(Vec<tobj::Material>, HashMap<String, usize>), String> {
+/// The materials of an MTL file, by name, and what was let pass (a `newmtl` without a name:
+/// named after its line, as Blender reads it, so the file still loads).
+type Mtl = (Vec<tobj::Material>, HashMap<String, usize>, Vec<String>);
+
+fn read_mtl(file: &Path) -> Result<Mtl, String> {
     let bytes = super::read_file(file).map_err(|e| format!("cannot read {}: {e}", file.display()))?;
-    let text = expand_grey_colours(&String::from_utf8_lossy(&bytes))?;
+    let (text, warnings) = name_unnamed_materials(&String::from_utf8_lossy(&bytes));
+    let text = expand_grey_colours(&text)?;
     let mut cursor = Cursor::new(text.as_bytes());
-    tobj::load_mtl_buf(&mut cursor).map_err(|e| {
+    let (materials, names) = tobj::load_mtl_buf(&mut cursor).map_err(|e| {
         let line = line_of(&text, cursor.position());
         format!("{}: line {line}: {}", file.display(), describe_mtl_error(e))
-    })
+    })?;
+    Ok((materials, names, warnings))
+}
+
+/// Each `newmtl` without a name named `unnamed-LINE`, with a warning: nothing can `usemtl` it,
+/// but the rest of the library loads.
+fn name_unnamed_materials(text: &str) -> (String, Vec<String>) {
+    let mut warnings = Vec::new();
+    let mut out = String::with_capacity(text.len());
+    for (index, line) in text.lines().enumerate() {
+        if line.split_whitespace().collect::<Vec<_>>() == ["newmtl"] {
+            let name = format!("unnamed-{}", index + 1);
+            warnings.push(format!("line {}: `newmtl` without a name; called `{name}`", index + 1));
+            out.push_str(&format!("newmtl {name}\n"));
+        } else {
+            out.push_str(line);
+            out.push('\n');
+        }
+    }
+    (out, warnings)
 }
 
 fn describe_mtl_error(error: tobj::LoadError) -> String {
