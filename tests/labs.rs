@@ -330,3 +330,107 @@ fn diff_reports_the_mean_the_worst_region_and_the_masked_mean() {
     assert_eq!(same["flip_mean"], 0.0);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The mutants of an answer key that no test can tell from it, each with why: a change at a
+/// boundary the inputs never meet exactly, or on a value the inputs keep in range.
+const EQUIVALENT_MUTANTS: &[(&str, &str)] = &[
+    // The overflow guard's boundary: len is never exactly 3e38.
+    ("bump", "if !(len > 0.0) || len >= 3.0e38 {"),
+    // n' exactly perpendicular to n: the tilt would have to be infinite.
+    ("bump", "return select(perturbed, -perturbed, dot(perturbed, n) <= 0.0);"),
+    // α = 0 exactly gives u = 1, the same column as u = 0 (the map repeats).
+    ("environment-maps", "if alpha <= 0.0 {"),
+    // n is normalized: n.y stays in [−1, 1].
+    ("environment-maps", "return vec2f(alpha / (2.0 * PI), acos(clamp(n.y, -2.0, 1.0)) / PI);"),
+    ("environment-maps", "return vec2f(alpha / (2.0 * PI), acos(clamp(n.y, -1.0, 2.0)) / PI);"),
+    // A point exactly in the light's plane (w = 0).
+    ("shadow-map", "if clip.w < 0.0 {"),
+    // The window is symmetric: centre − (x, y) visits the texels centre + (x, y) does.
+    ("shadow-map", "let texel = clamp(centre - vec2i(x, y), vec2i(0), last);"),
+    // Unit vectors: cos θ_i never exceeds 1.
+    ("refraction", "let cos_i = clamp(dot(n, v), 0.0, 2.0);"),
+    ("refraction", "let cos_i = clamp(cos_i_in, 0.0, 2.0);"),
+    // Exactly at the critical angle (sin²θ_t = 1): a grazing ray, or none.
+    ("refraction", "if sin2_t >= 1.0 {"),
+    // Exactly at the critical angle both branches give 1 (r_s = r_p = 1).
+    ("refraction", "if sin2_t > 1.0 {"),
+];
+
+/// Every one-operator or one-constant change of an answer key's code (comments and signatures
+/// aside): `+ − * /` swapped, comparisons loosened or tightened, `min`/`max` and `floor`/`ceil`
+/// swapped, the constants 0, ½, 1, 2 changed, a unary minus dropped. Each mutant is the key's
+/// text with one change, and the line it changed.
+fn mutants(key: &str) -> Vec<(String, String)> {
+    const SWAPS: &[(&str, &str)] = &[
+        (" + ", " - "),
+        (" - ", " + "),
+        (" * ", " / "),
+        (" / ", " * "),
+        (" < ", " <= "),
+        (" <= ", " < "),
+        (" > ", " >= "),
+        (" >= ", " > "),
+        ("min(", "max("),
+        ("max(", "min("),
+        ("floor(", "ceil("),
+        ("2.0", "1.0"),
+        ("1.0", "2.0"),
+        ("0.5", "1.0"),
+        ("0.0", "1.0"),
+    ];
+    let mut out = Vec::new();
+    let mut offset = 0;
+    for line in key.split_inclusive('\n') {
+        let code = line.trim();
+        if !(code.is_empty() || code.starts_with("//") || code.starts_with("fn ")) {
+            let mut changes: Vec<(usize, usize, &str)> = Vec::new();
+            for (from, to) in SWAPS {
+                changes.extend(line.match_indices(from).map(|(at, _)| (at, from.len(), *to)));
+            }
+            let bytes = line.as_bytes();
+            for (at, _) in line.match_indices('-') {
+                let before = at.checked_sub(1).map(|i| bytes[i]);
+                let after = bytes.get(at + 1).copied();
+                if matches!(before, Some(b'(' | b',' | b' '))
+                    && after.is_some_and(|c| c.is_ascii_alphanumeric() || c == b'(')
+                {
+                    changes.push((at, 1, ""));
+                }
+            }
+            for (at, len, to) in changes {
+                let mut text = key.to_owned();
+                text.replace_range(offset + at..offset + at + len, to);
+                let changed = text[offset..].lines().next().unwrap_or("").trim().to_owned();
+                out.push((text, changed));
+            }
+        }
+        offset += line.len();
+    }
+    out
+}
+
+/// Mutation testing of every lab: each mutant of the answer key must fail `lab check`, unless it
+/// is one of the [`EQUIVALENT_MUTANTS`]. About 200 checks: run it when a lab or its tests change.
+#[test]
+#[ignore = "a sweep of about 15 minutes: cargo test --test labs -- --ignored every_mutant"]
+fn every_mutant_of_every_answer_key_fails_its_checks() {
+    let mut survivors = Vec::new();
+    let mut count = 0;
+    for lab in lab::catalog() {
+        let dir = folder(&lab.name, "mutant", true);
+        let file = dir.join(&lab.file);
+        let key = std::fs::read_to_string(&file).expect("the answer key");
+        for (text, line) in mutants(&key) {
+            count += 1;
+            std::fs::write(&file, &text).expect("writing the mutant");
+            let (output, _) = check(&dir, &[]);
+            let equivalent = EQUIVALENT_MUTANTS.contains(&(lab.name.as_str(), line.as_str()));
+            if output.status.success() && !equivalent {
+                survivors.push(format!("{}: {line}", lab.name));
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    eprintln!("{count} mutants, {} survived", survivors.len());
+    assert!(survivors.is_empty(), "mutants that pass every test:\n{}", survivors.join("\n"));
+}
