@@ -159,6 +159,7 @@ impl Screen {
             surface.configure(&gpu.device, &config);
         }
         let egui = egui::Context::default();
+        egui.set_fonts(course_fonts());
         let max_texture_side = gpu.device.limits().max_texture_dimension_2d as usize;
         let input = egui_winit::State::new(
             egui.clone(),
@@ -575,5 +576,36 @@ impl PendingImage {
             let (width, height) = self.pending.size();
             image::RgbaImage::from_raw(width, height, pixels).expect("one RGBA8 texel per pixel")
         }))
+    }
+}
+
+/// egui's fonts with its monospace face (Hack) as the proportional face's first fallback: the
+/// course's notation in the panel's tooltips (`A ⊗ C`, `‖n‖`) is in Hack, not in Ubuntu-Light,
+/// and showed as empty boxes.
+pub fn course_fonts() -> egui::FontDefinitions {
+    let mut fonts = egui::FontDefinitions::default();
+    if let Some(proportional) = fonts.families.get_mut(&egui::FontFamily::Proportional) {
+        proportional.insert(1.min(proportional.len()), "Hack".to_owned());
+    }
+    fonts
+}
+
+#[cfg(test)]
+mod tests {
+    /// Every character the panel's tooltips (the settings' documentation) and the help window
+    /// show has a glyph in the proportional face or its fallbacks.
+    #[test]
+    fn the_course_notation_has_glyphs() {
+        let definitions = super::course_fonts();
+        let mut fonts = egui::epaint::text::Fonts::new(egui::epaint::text::TextOptions::default(), definitions);
+        let mut text = crate::settings_doc::scene_format_table();
+        for (key, what) in super::super::hud::KEYS {
+            text.push_str(key);
+            text.push_str(what);
+        }
+        text.push_str("⊗‖");
+        let font = egui::FontId::proportional(13.0);
+        let missing: String = text.chars().filter(|c| !c.is_control() && !fonts.has_glyph(&font, *c)).collect();
+        assert!(missing.is_empty(), "no glyph for {missing:?}");
     }
 }
