@@ -9,7 +9,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-use super::context::{FrameContext, FrameEncoder};
+use super::context::{Figure, FrameContext, FrameEncoder};
 use super::scene_gpu::SceneLayouts;
 use super::shadow::ShadowMaps;
 use super::shadow::views::ShadowLayout;
@@ -54,11 +54,14 @@ impl Overlays {
             return;
         }
         if settings.view == ShadowView::Map {
-            let layer = settings.view_layer.min(layout.views.len() as u32 - 1);
+            // A layer past the last shows the last; the figures say which, of how many.
+            let layers = layout.views.len() as u32;
+            let layer = settings.view_layer.min(layers - 1);
             let ratio = layout.views[layer as usize].depth_ratio;
             let map_view = self.map_view.get_or_init(|| MapView::new(ctx.device(), &self.module));
             map_view.record(ctx, frame, maps.depth, (layer, ratio), targets);
-            frame.end("overlays", &[]);
+            let figures = [("map layer shown", Figure::Count(layer.into())), ("layers", Figure::Count(layers.into()))];
+            frame.end("overlays", &figures);
         }
         if settings.show_frusta {
             let volumes: Vec<[Vec3; 8]> = (0..layout.views.len()).map(|layer| layout.corners(layer)).collect();

@@ -28,8 +28,9 @@ choices! {
     pub enum MirrorView {
         /// The scene, its mirrors showing their reflections.
         Off,
-        /// The first mirror camera's own image, full screen: the scene seen from behind the
-        /// mirror, mirrored, with nothing in front of the mirror plane's far side.
+        /// The first mirror camera's own image, alone: the scene seen from behind the mirror,
+        /// mirrored, with nothing in front of the mirror plane's far side; drawn in the window
+        /// of the screen the mirror covers (the camera draws nothing else).
         Image,
         /// Each mirrored camera's view volume drawn into the scene: its near face lies on the
         /// mirror.

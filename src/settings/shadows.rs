@@ -50,7 +50,8 @@ section! {
         /// Teaching view: the shadow map's depths, or its texels as they land on the receivers.
         view: ShadowView = ShadowView::Off,
         /// Which shadow map layer the `map` view shows (a point light has six, one per cube
-        /// face).
+        /// face, in the order +x, −x, +y, −y, +z, −z); past the last layer, the last. `--stats`
+        /// and the viewer's frame times give the layer shown and how many there are.
         #[values(slider(0.0, 95.0))]
         view_layer: u32 = 0,
         /// Draw each shadowed light's view volume (the frustum pass 1 renders) into the scene.
