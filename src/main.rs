@@ -275,6 +275,7 @@ struct TraceArgs {
 
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    stop_quietly_when_the_reader_stops();
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Render { scene, output, exr }) => render(scene, &output, exr.as_deref()),
@@ -298,6 +299,21 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// A reader that stops reading (`mirador lab list | head -1`) closes the pipe, and Rust's print
+/// macros then panic. Like other command-line tools, Mirador stops quietly instead, with the
+/// status a shell gives a writer the closed pipe ends (128 + SIGPIPE).
+fn stop_quietly_when_the_reader_stops() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let payload = info.payload();
+        let message = payload.downcast_ref::<String>().map(String::as_str).or(payload.downcast_ref::<&str>().copied());
+        if message.is_some_and(|m| m.starts_with("failed printing to stdout") && m.contains("Broken pipe")) {
+            std::process::exit(141);
+        }
+        default(info);
+    }));
 }
 
 /// `mirador copy SCENE DIR`.

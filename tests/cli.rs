@@ -399,3 +399,19 @@ fn copy_writes_a_scene_and_its_files_into_a_folder_that_reads_nothing_outside() 
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A reader that stops reading (`mirador lab list | head -1`) ends the command quietly, with the
+/// status a closed pipe gives, not a panic.
+#[test]
+fn a_closed_pipe_ends_the_output_quietly() {
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
+    let output = Command::new(env!("CARGO_BIN_EXE_mirador"))
+        .args(["lab", "list"])
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .expect("running the mirador binary");
+    assert!(!stderr(&output).contains("panicked"), "{}", stderr(&output));
+    assert_eq!(output.status.code(), Some(141));
+}
