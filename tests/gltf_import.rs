@@ -448,3 +448,31 @@ fn gltf_1_0_is_named_as_such() {
     // 2.0 still reads.
     load("two_nodes.gltf");
 }
+
+/// A glTF object in a scene may name one of the scene's materials: every part of the model is
+/// drawn in it (a downloaded model as an exercise's mirror), and its own materials are left out.
+#[test]
+fn a_gltf_object_may_take_a_scene_material() {
+    let text = r#"
+        [materials.chrome]
+        color = [0.05, 0.05, 0.05]
+        mirror = 0.9
+        [[objects]]
+        name = "model"
+        type = "gltf"
+        path = "glass_sphere.gltf"
+        material = "chrome"
+    "#;
+    let scene = mirador::scene::file::parse(text, &fixture("chrome.toml")).unwrap_or_else(|e| panic!("{e}"));
+    let chrome = scene.materials.iter().position(|m| m.name == "chrome").expect("the scene's material");
+    let parts: Vec<_> = scene.objects.iter().filter(|o| o.name.starts_with("model/")).collect();
+    assert!(!parts.is_empty());
+    assert!(parts.iter().all(|o| o.material.0 == chrome), "every part in the scene's material");
+    assert!(!scene.materials.iter().any(|m| m.name == "glass"), "the model's own materials are left out");
+    let unknown = mirador::scene::file::parse(
+        &text.replace("material = \"chrome\"", "material = \"gold\""),
+        &fixture("chrome.toml"),
+    )
+    .expect_err("an unknown material");
+    assert!(unknown.to_string().contains("chrome"), "the error lists the names that exist: {unknown}");
+}

@@ -830,7 +830,7 @@ impl<'a> Builder<'a> {
             ObjectType::Plane => &["size", "uv_scale", "material"],
             ObjectType::Torus => &["major_radius", "minor_radius", "material"],
             ObjectType::RoundedBox => &["half_extents", "radius", "material"],
-            ObjectType::Gltf => &["path", "lights", "camera"],
+            ObjectType::Gltf => &["path", "lights", "camera", "material"],
             ObjectType::Obj | ObjectType::Ply => &["path", "material"],
         };
         if let Some((field, _)) = fields.iter().find(|(f, present)| *present && !allowed.contains(f)) {
@@ -877,7 +877,8 @@ impl<'a> Builder<'a> {
                 let import =
                     super::gltf::import(&file).map_err(|e| fail(locate::with_places(e.to_string(), &looked)))?;
                 let camera = d.camera.unwrap_or(false).then(|| import.cameras.first().cloned()).flatten();
-                add_model(&mut self.scene, import, world_from_local, d.lights.unwrap_or(true), &name, None);
+                let material = d.material.map(|m| self.named_material(m)).transpose()?;
+                add_model(&mut self.scene, import, world_from_local, d.lights.unwrap_or(true), &name, material);
                 return Ok(
                     camera.map(|c| GltfCamera { world_from_camera: world_from_local * c.world_from_camera, ..c })
                 );
