@@ -1,18 +1,21 @@
 //! Image metrics: FLIP (NVIDIA's perceptual difference, the metric wgpu's own image tests use),
 //! PSNR, and a false-colour error map. Used by the golden-image tests and, with the ray tracer,
-//! by `mirador compare`.
+//! by `mirador compare`, the viewer's difference view and the page's.
 //!
-//! FLIP is NVIDIA's C++ library, which does not build for the browser: there the difference view
-//! shows the largest channel difference of each pixel instead ([`METRIC`] names which).
+//! FLIP is `flip-rs`, a Rust port of NVIDIA's version 1.7, at NVIDIA's C++ tool's viewing
+//! distance ([`PIXELS_PER_DEGREE`]): on Mirador's own images its error maps are NVIDIA's, bit for
+//! bit (tests/flip_parity.rs).
 
 #[cfg(not(target_arch = "wasm32"))]
 pub mod sheet;
 
 /// The metric [`Difference::flip_mean`] and the error map hold, as the viewer labels it.
-#[cfg(not(target_arch = "wasm32"))]
 pub const METRIC: &str = "FLIP";
-#[cfg(target_arch = "wasm32")]
-pub const METRIC: &str = "largest channel difference";
+
+/// The viewing distance FLIP assumes, in pixels per degree of visual angle: the value of
+/// NVIDIA's C++ tool (67, a 0.7 m wide 4K monitor seen from 0.7 m, rounded), which Mirador's
+/// thresholds were measured with.
+pub const PIXELS_PER_DEGREE: f32 = 67.0;
 
 use image::RgbaImage;
 
@@ -77,39 +80,23 @@ pub fn difference_beyond(reference: &RgbaImage, test: &RgbaImage, levels: u8) ->
 
 /// The FLIP error of each pixel of `test` against `reference` (RGB bytes), their mean, and the
 /// errors through the magma colour map.
-#[cfg(not(target_arch = "wasm32"))]
 fn per_pixel_error(w: u32, h: u32, reference: &[u8], test: &[u8]) -> (Vec<f32>, f32, Vec<u8>) {
-    let error = nv_flip::flip(
-        nv_flip::FlipImageRgb8::with_data(w, h, reference),
-        nv_flip::FlipImageRgb8::with_data(w, h, test),
-        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
-    );
-    let mean = nv_flip::FlipPool::from_image(&error).mean();
-    (error.to_vec(), mean, error.apply_color_lut(&nv_flip::magma_lut()).to_vec())
-}
-
-/// In the browser: [`channel_difference`].
-#[cfg(target_arch = "wasm32")]
-fn per_pixel_error(_: u32, _: u32, reference: &[u8], test: &[u8]) -> (Vec<f32>, f32, Vec<u8>) {
-    channel_difference(reference, test)
-}
-
-/// The largest channel difference of each pixel of two RGB byte buffers, in [0, 1], their mean,
-/// and the differences coloured black through red to yellow: the browser's difference view, where
-/// FLIP does not build (`web/test.sh` checks the page's map against this one).
-pub fn channel_difference(reference: &[u8], test: &[u8]) -> (Vec<f32>, f32, Vec<u8>) {
-    let errors: Vec<f32> = reference
-        .chunks_exact(3)
-        .zip(test.chunks_exact(3))
-        .map(|(r, t)| r.iter().zip(t).map(|(&r, &t)| r.abs_diff(t)).max().unwrap_or(0) as f32 / 255.0)
-        .collect();
-    let ramp = |e: f32| {
-        [(3.0 * e).min(1.0), (3.0 * e - 1.0).clamp(0.0, 1.0), (3.0 * e - 2.0).clamp(0.0, 1.0)]
-            .map(|c| (c * 255.0) as u8)
+    let image = |bytes: &[u8]| {
+        flip_rs::RgbImage::new(w as usize, h as usize, bytes.to_vec()).expect("w × h RGB triples, w, h > 0")
     };
-    let mean = errors.iter().sum::<f32>() / errors.len().max(1) as f32;
-    let colored = errors.iter().flat_map(|&e| ramp(e)).collect();
+    let error = flip_rs::ldr_flip(&image(reference), &image(test), PIXELS_PER_DEGREE)
+        .expect("images of one size, finite bytes, a valid viewing distance");
+    // The pooled mean, as NVIDIA's tool pools it.
+    let mean = error.statistics().mean;
+    let errors = error.into_pixels();
+    let colored = errors.iter().flat_map(|&e| magma(e)).collect();
     (errors, mean, colored)
+}
+
+/// The magma colour of an error in [0, 1], as 8-bit sRGB: black, through purple and orange, to
+/// light yellow.
+pub fn magma(error: f32) -> [u8; 3] {
+    flip_rs::MAGMA[(error.clamp(0.0, 1.0) * 255.0 + 0.5) as usize].map(|c| (c * 255.0 + 0.5) as u8)
 }
 
 /// The side, in pixels, of the square regions whose mean error [`Figures::worst_region`] takes.

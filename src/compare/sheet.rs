@@ -81,17 +81,15 @@ pub fn sheet(panels: &[Panel]) -> RgbaImage {
 /// A horizontal colour bar for the FLIP error map, from 0 (black) to 1 (light yellow), with its
 /// two end values written beside it, `width` pixels wide.
 pub fn flip_legend(width: u32) -> RgbaImage {
-    let lut = nv_flip::magma_lut();
-    let colors = lut.to_vec();
-    let entries = (colors.len() / 3) as u32;
+    let entries = flip_rs::MAGMA.len() as u32;
     let (bar_height, height) = (14u32, 40u32);
     let mut legend = RgbaImage::from_pixel(width, height, BACKGROUND);
     let (left, right) = (24u32, width.saturating_sub(24).max(25));
     for x in left..right {
         let t = (x - left) as f32 / (right - left - 1).max(1) as f32;
-        let k = ((t * (entries - 1) as f32).round() as u32 * 3) as usize;
+        let [r, g, b] = super::magma((t * (entries - 1) as f32).round() / (entries - 1) as f32);
         for y in 4..4 + bar_height {
-            legend.put_pixel(x, y, Rgba([colors[k], colors[k + 1], colors[k + 2], 255]));
+            legend.put_pixel(x, y, Rgba([r, g, b, 255]));
         }
     }
     draw_text(&mut legend, "0", left as f32 - 14.0, 2.0, 16.0, TEXT);

@@ -175,13 +175,7 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
                 ViewMode::Raster => "The z-buffer rasterizer, every frame.",
                 ViewMode::Traced => "The Whitted ray tracer, refined in the background.",
                 ViewMode::Split => "Raster left, ray traced right of a divider you can drag: the same pixels.",
-                ViewMode::Difference => {
-                    if cfg!(target_arch = "wasm32") {
-                        "The largest channel difference of each pixel between the two (black: identical)."
-                    } else {
-                        "The FLIP error map between the two (black: identical)."
-                    }
-                }
+                ViewMode::Difference => "The FLIP error map between the two (black: identical).",
             });
         }
     });

@@ -10,8 +10,7 @@
 //! - The tracer works in slices between frames on the page's one thread
 //!   (`crate::viewer::traced`).
 //! - Files come from memory ([`crate::files`]): the built-in assets, and the files the page hands
-//!   over ([`page`]). The difference view shows the largest channel difference, not FLIP
-//!   ([`crate::compare::METRIC`]).
+//!   over ([`page`]). The difference view shows FLIP, as natively (`flip-rs`, pure Rust).
 //! - No configuration file is remembered, and the scene is not watched for changes.
 
 mod page;
