@@ -104,7 +104,16 @@ fn gpu_structs_match_their_wgsl_twins_field_by_field() {
         &scene,
         "View",
         size_of::<GpuView>(),
-        &fields!(GpuView { clip_from_world, world_from_clip, eye, orthographic, view_axis, mirrored, clip_plane }),
+        &fields!(GpuView {
+            clip_from_world,
+            world_from_clip,
+            eye,
+            orthographic,
+            view_axis,
+            mirrored,
+            clip_plane,
+            clip_from_reflected
+        }),
     );
     check_struct(
         &scene,

@@ -511,8 +511,8 @@ fn a_field_that_does_not_apply_to_the_type_is_rejected() {
     assert_error_at(&text, 4, 1, &["`radius` does not apply to a box"]);
     let text = with_camera(&["[[objects]]", "type = \"sphere\"", "size = [1, 1]"]);
     assert_error_at(&text, 4, 1, &["`size` does not apply to a sphere"]);
-    let text = with_camera(&["[[objects]]", "type = \"gltf\"", "path = \"m.glb\"", "material = \"red\""]);
-    assert_error_at(&text, 4, 1, &["`material` does not apply to a gltf"]);
+    let text = with_camera(&["[[objects]]", "type = \"gltf\"", "path = \"m.glb\"", "radius = 1"]);
+    assert_error_at(&text, 4, 1, &["`radius` does not apply to a gltf"]);
     let text = with_camera(&["[[objects]]", "type = \"rounded_box\"", "center = [0, 0, 0]"]);
     assert_error_at(&text, 4, 1, &["`center` does not apply to a rounded_box"]);
 }

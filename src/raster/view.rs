@@ -8,7 +8,6 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
-use super::mirror::{MirrorPlane, reflection};
 use super::uniforms::GpuView;
 use crate::scene::{Camera, Projection};
 
@@ -25,6 +24,11 @@ pub struct View {
     pub mirrored: bool,
     /// Points `p` with `plane·(p, 1) < 0` are not drawn.
     pub clip_plane: Option<Vec4>,
+    /// A mirrored camera's `clip_from_world` before its last reflection, the one about its clip
+    /// plane: `clip_from_world = clip_from_reflected · R`. `clip_from_world` itself where no
+    /// mirror made the view. The planar-mirror lab draws with it and the student's `R`
+    /// (`MIRROR_BY_HAND` in shaders/common/surface.wgsl).
+    pub clip_from_reflected: Mat4,
 }
 
 impl View {
@@ -37,6 +41,7 @@ impl View {
             view_axis: camera.frame().ze,
             mirrored: false,
             clip_plane: None,
+            clip_from_reflected: camera.clip_from_world(),
         }
     }
 
@@ -50,6 +55,7 @@ impl View {
             view_axis: Vec3::Z,
             mirrored: false,
             clip_plane: None,
+            clip_from_reflected: clip_from_world,
         }
     }
 
@@ -62,18 +68,7 @@ impl View {
             view_axis: self.view_axis.to_array(),
             mirrored: u32::from(self.mirrored),
             clip_plane: self.clip_plane.unwrap_or(Vec4::ZERO).to_array(),
-            clip_from_reflected: self.clip_from_reflected().to_cols_array_2d(),
-        }
-    }
-
-    /// A mirrored camera's `clip_from_world` before its last reflection, the one about its clip
-    /// plane (a reflection is its own inverse): `clip_from_world = clip_from_reflected · R`.
-    /// `clip_from_world` itself where no mirror made the view. The planar-mirror lab draws with
-    /// it and the student's `R` (`MIRROR_BY_HAND` in shaders/common/surface.wgsl).
-    pub fn clip_from_reflected(&self) -> Mat4 {
-        match self.clip_plane {
-            Some(plane) => self.clip_from_world * reflection(&MirrorPlane { normal: plane.truncate(), d: plane.w }),
-            None => self.clip_from_world,
+            clip_from_reflected: self.clip_from_reflected.to_cols_array_2d(),
         }
     }
 }

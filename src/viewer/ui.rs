@@ -387,6 +387,12 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     if model.view.overlay_open {
         overlay(ui, model, rect);
     }
+    error_boxes(ui, model, rect, output);
+}
+
+/// The problems over the 3D view, top left: a lab file that does not compile, a scene that does
+/// not load (with a dismiss button).
+fn error_boxes(ui: &mut egui::Ui, model: &UiModel, rect: Rect, output: &mut UiOutput) {
     if let Some(lab) = model.lab.as_ref().filter(|lab| !lab.problems.is_empty()) {
         let file = lab.file.file_name().map_or(lab.file.display().to_string(), |f| f.to_string_lossy().into_owned());
         egui::Area::new(egui::Id::unique("mirador::lab_error")).fixed_pos(rect.min + egui::vec2(12.0, 12.0)).show(

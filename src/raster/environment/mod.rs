@@ -116,13 +116,15 @@ pub fn cube_face_view(centre: Vec3, face: usize, near: f32, far: f32) -> View {
         Vec4::new(0.0, 0.0, far / (near - far), -1.0),
         Vec4::new(0.0, 0.0, near * far / (near - far), 0.0),
     );
+    let clip_from_world = clip_from_view * view_from_world;
     View {
-        clip_from_world: clip_from_view * view_from_world,
+        clip_from_world,
         eye: centre,
         orthographic: false,
         view_axis: -forward,
         mirrored: eye_frame.determinant() < 0.0,
         clip_plane: None,
+        clip_from_reflected: clip_from_world,
     }
 }
 

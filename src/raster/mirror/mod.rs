@@ -107,14 +107,16 @@ pub fn reflection(plane: &MirrorPlane) -> Mat4 {
 /// Perspective and orthographic views alike.
 pub fn mirrored_view(view: &View, plane: &MirrorPlane) -> View {
     let reflected_from_world = reflection(plane);
-    let clip_from_world = view.clip_from_world * reflected_from_world;
+    let clip_from_world = oblique_near_plane(view.clip_from_world * reflected_from_world, plane.as_vec4());
     View {
-        clip_from_world: oblique_near_plane(clip_from_world, plane.as_vec4()),
+        clip_from_world,
         eye: reflected_from_world.transform_point3(view.eye),
         orthographic: view.orthographic,
         view_axis: reflected_from_world.transform_vector3(view.view_axis),
         mirrored: !view.mirrored,
         clip_plane: Some(plane.as_vec4()),
+        // A reflection is its own inverse.
+        clip_from_reflected: clip_from_world * reflected_from_world,
     }
 }
 
