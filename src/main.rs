@@ -200,8 +200,10 @@ struct SceneArgs {
 struct ViewArgs {
     /// Scene file (TOML, or a .gltf/.glb/.obj/.ply model). Default: the built-in showcase.
     scene: Option<PathBuf>,
-    /// Change a render setting, as a dotted key and a TOML value: `--set shadows.enabled=false`.
-    /// (The scene's own values, `camera.…` and the like, are edited in the panel.)
+    /// Change a render setting or a value of the scene file, as a dotted key and a TOML value:
+    /// `--set shadows.enabled=false`, `--set camera.fovy=30`, `--set lights.0.intensity=0.5`,
+    /// `--set materials.NAME.ks=0.8` (kept when the file is reloaded). The script's `set` step
+    /// takes the same.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
     /// Run this many frames (after the scripted steps), then exit. Scripted runs neither read

@@ -741,3 +741,42 @@ fn a_screenshot_after_a_move_waits_for_full_scale() {
     assert!(mean < MAX_FLIP_MEAN, "the screenshot after the move was taken below full scale (mean FLIP {mean})");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--set` and the script's `set` reach the scene's own values in the viewer as they do in
+/// `render`: the window shows what `render` draws with the same overrides, and a value the scene
+/// file refuses is reported without a panic, the scene kept.
+#[test]
+fn scene_values_set_in_the_viewer_are_drawn_as_render_draws_them() {
+    let dir = scratch("scene-values");
+    let scene = common::asset("scenes/seed-simple.toml");
+    let shot = dir.join("set.png");
+    let steps = [
+        "overlay off".to_string(),
+        "set world.ambient=[0.6, 0.6, 0.6]".to_string(),
+        "wait 2".to_string(),
+        format!("screenshot {}", shot.display()),
+    ];
+    let mut args = vec![scene.to_str().unwrap(), "--set", "camera.fovy=30", "--size", "640x400", "--frames", "2"];
+    for step in &steps {
+        args.extend(["--step", step.as_str()]);
+    }
+    let output = viewer(&args, &dir);
+    succeeded(&output);
+    let (_, rect) = views(&output).into_iter().find(|(p, _)| p == &shot).expect("the screenshot");
+    let window = crop(&image::open(&shot).unwrap().to_rgba8(), rect);
+    let headless = |overrides: &[&str]| {
+        let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        let mut scene = mirador::scene::file::overrides::load(&scene, &overrides).expect("the overrides apply");
+        (scene.camera.width, scene.camera.height) = (rect[2], rect[3]);
+        mirador::raster::render_image(common::gpu(), &scene, &scene.settings)
+    };
+    let set = headless(&["camera.fovy=30", "world.ambient=[0.6, 0.6, 0.6]"]);
+    assert!(flip(&set, &window, "scene-values", &dir) < MAX_FLIP_MEAN, "the window is not `render` with the overrides");
+    assert!(common::difference(&headless(&[]), &window).flip_mean > 0.02, "the overrides changed nothing");
+    // A value the file refuses ends a scripted run with the file's own message.
+    let scene_arg = scene.to_str().unwrap();
+    let refused = viewer(&[scene_arg, "--frames", "2", "--step", "set lights.9.intensity=1"], &dir);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(!refused.status.success() && stderr.contains("lights.9"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -238,6 +238,8 @@ impl Viewer {
     /// in it before: nothing set in the scene left behind comes along.
     pub fn open(&mut self, path: &Path) {
         self.remembered = self.remembered_scenes();
+        // Overrides belong to the scene they were set in.
+        let overrides = std::mem::take(&mut self.scene.overrides);
         if self.scene.load(path, None) {
             self.camera_error = None;
             let changes = self.remembered.get(&scene_key(Some(path))).cloned().unwrap_or_default();
@@ -253,6 +255,8 @@ impl Viewer {
                 format!(" ({} settings as you left them)", changes.len())
             };
             self.notice(format!("opened {}{kept}", path.display()));
+        } else {
+            self.scene.overrides = overrides;
         }
     }
 
@@ -549,6 +553,15 @@ impl Viewer {
     }
 
     fn set(&mut self, assignment: &str) {
+        if crate::scene::file::overrides::is_scene_override(assignment) {
+            // The camera keeps the view's size, which the file does not know.
+            let size = (self.scene.scene.camera.width, self.scene.scene.camera.height);
+            if self.scene.set_value(assignment, &self.settings) {
+                (self.scene.scene.camera.width, self.scene.scene.camera.height) = size;
+                self.notice(format!("scene value set: {assignment}"));
+            }
+            return;
+        }
         match self.settings.set(assignment) {
             Ok(()) => {
                 if self.settings.sphere_segments != self.scene.scene.settings.sphere_segments {
@@ -659,6 +672,12 @@ impl Viewer {
         let Some(step) = self.script.steps.pop_front() else { return Ok(()) };
         log::info!("step: {step:?}");
         match step {
+            Step::Set(assignment) if crate::scene::file::overrides::is_scene_override(&assignment) => {
+                self.set(&assignment);
+                if let Some(error) = self.scene.error.take() {
+                    bail!("step `set {assignment}`: {error}");
+                }
+            }
             Step::Set(assignment) => {
                 self.settings.set(&assignment).with_context(|| format!("step `set {assignment}`"))?;
                 self.set(&assignment);

@@ -113,14 +113,18 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
     }
     // Load before opening the window: a bad scene or setting on the command line is an error
     // message, not an empty window.
+    // `--set` takes the scene's own values (`camera.fovy=30`) and render settings alike.
+    let (values, settings): (Vec<String>, Vec<String>) =
+        options.set.iter().cloned().partition(|a| crate::scene::file::overrides::is_scene_override(a));
     let (lab, mut scene) = match &options.lab {
-        Some(dir) => {
+        Some(dir) if values.is_empty() => {
             let (lab, scene) = open_lab(dir)?;
             (Some(lab), scene)
         }
-        None => (None, scene_state::load(options.scene.as_deref())?),
+        Some(_) => anyhow::bail!("--set {}: in lab mode the scene is the lab's; --set takes settings only", values[0]),
+        None => (None, scene_state::load(options.scene.as_deref(), &values)?),
     };
-    for assignment in &options.set {
+    for assignment in &settings {
         scene.settings.set(assignment).context("--set")?;
     }
     let event_loop = EventLoop::<Wake>::with_user_event().build().map_err(|e| {
@@ -131,6 +135,7 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
     let mut app = App {
         options,
         scene: Some(scene),
+        overrides: values,
         lab,
         proxy,
         running: None,
@@ -154,6 +159,8 @@ struct App {
     scene: Option<crate::Scene>,
     /// Lab mode's state, until the window opens.
     lab: Option<lab::LabMode>,
+    /// `--set`'s overrides of the scene's own values, kept by the scene for its reloads.
+    overrides: Vec<String>,
     proxy: EventLoopProxy<Wake>,
     running: Option<(Screen, Viewer)>,
     outcome: anyhow::Result<()>,
@@ -191,6 +198,7 @@ impl App {
         };
         let mut viewer = Viewer::new(&mut screen, scene, &config, self.options.steps.clone(), wake, self.lab.take());
         viewer.notices.extend(notices);
+        viewer.scene.overrides = std::mem::take(&mut self.overrides);
         viewer.scripted = self.options.scripted();
         if self.options.stats {
             println!("adapter: {}", screen.gpu.describe());

@@ -30,6 +30,9 @@ pub struct SceneState {
     pub bounds: Option<(glam::Vec3, glam::Vec3)>,
     picker: Option<Picker>,
     watch: Option<Watch>,
+    /// Overrides of the scene file's own values (`--set camera.fovy=30`, the script's `set`),
+    /// applied again whenever the file is read.
+    pub overrides: Vec<String>,
 }
 
 struct Watch {
@@ -42,12 +45,10 @@ fn modified(path: &Path) -> Option<SystemTime> {
     std::fs::metadata(path).and_then(|m| m.modified()).ok()
 }
 
-/// Loads `path`, or the built-in showcase.
-pub fn load(path: Option<&Path>) -> Result<Scene, crate::scene::SceneError> {
-    match path {
-        Some(path) => Scene::load(path),
-        None => Scene::showcase(),
-    }
+/// Loads `path`, or the built-in showcase, with `overrides` of its own values applied.
+pub fn load(path: Option<&Path>, overrides: &[String]) -> Result<Scene, crate::scene::SceneError> {
+    let builtin = crate::scene::builtin_path("showcase.toml");
+    crate::scene::file::overrides::load(path.unwrap_or(&builtin), overrides)
 }
 
 impl SceneState {
@@ -64,6 +65,7 @@ impl SceneState {
             bounds,
             picker: None,
             watch,
+            overrides: Vec::new(),
         }
     }
 
@@ -71,7 +73,7 @@ impl SceneState {
     /// (the same scene reloaded) or its own (`None`: another scene); on failure keeps the current
     /// scene and records the error. Returns whether the scene changed.
     pub fn load(&mut self, path: &Path, settings: Option<&RenderSettings>) -> bool {
-        match Scene::load(path) {
+        match crate::scene::file::overrides::load(path, &self.overrides) {
             Ok(scene) => {
                 let settings = settings.cloned().unwrap_or_else(|| scene.settings.clone());
                 self.replace(scene, &settings);
@@ -93,7 +95,9 @@ impl SceneState {
     fn replace(&mut self, scene: Scene, settings: &RenderSettings) {
         let (width, height) = (self.scene.camera.width, self.scene.camera.height);
         let revision = self.revision + 1;
+        let overrides = std::mem::take(&mut self.overrides);
         *self = SceneState::new(scene);
+        self.overrides = overrides;
         self.revision = revision;
         self.scene.settings = settings.clone();
         self.scene.camera.width = width;
@@ -123,6 +127,22 @@ impl SceneState {
     /// When the scene file's modification time is next due a look (`None`: no file).
     pub fn next_poll(&self) -> Option<Instant> {
         self.watch.as_ref().map(|watch| watch.checked + WATCH_PERIOD)
+    }
+
+    /// Overrides one of the scene file's own values (`camera.fovy=30`, `lights.key.intensity=0.5`)
+    /// and reads the file again with it, keeping `settings`; an override the file refuses is
+    /// dropped and its error shown, the scene as it was.
+    pub fn set_value(&mut self, assignment: &str, settings: &RenderSettings) -> bool {
+        let Some(path) = self.scene.source.clone() else {
+            self.error = Some(format!("`{assignment}`: this scene has no file to override"));
+            return false;
+        };
+        self.overrides.push(assignment.to_owned());
+        let loaded = self.load(&path, Some(settings));
+        if !loaded {
+            self.overrides.pop();
+        }
+        loaded
     }
 
     /// Marks geometry or materials as changed.

@@ -3,7 +3,8 @@
 //! window. Each step names something the panel or a key does:
 //!
 //! ```text
-//! set shadows.enabled=false     a render setting, as `--set` takes it
+//! set shadows.enabled=false     a render setting or a scene value (camera.fovy=30), as `--set`
+//!                               takes them
 //! view split                    raster | traced | split | difference
 //! split 0.3                     the divider, as a fraction of the view's width
 //! orbit 40 -10 | pan 20 0       a mouse drag, in pixels

@@ -61,7 +61,7 @@ pub fn start() {
         Err(e) => return page::show_error(&format!("Mirador cannot start: {e}")),
     };
     page::set_proxy(event_loop.create_proxy());
-    let scene = match crate::viewer::scene_state::load(None) {
+    let scene = match crate::viewer::scene_state::load(None, &[]) {
         Ok(scene) => scene,
         Err(e) => return page::show_error(&format!("the built-in scene does not load: {e}")),
     };
