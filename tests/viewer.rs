@@ -87,6 +87,25 @@ fn succeeded(output: &Output) {
     );
 }
 
+/// The viewer on `scene` in a 640×400 window with `extra` arguments, running `steps`; it must
+/// succeed.
+fn scripted(scene: &Path, extra: &[&str], steps: &[String], dir: &Path) -> Output {
+    let mut args = vec![scene.to_str().expect("a UTF-8 path"), "--size", "640x400", "--frames", "2"];
+    args.extend(extra);
+    for step in steps {
+        args.extend(["--step", step.as_str()]);
+    }
+    let output = viewer(&args, dir);
+    succeeded(&output);
+    output
+}
+
+/// The 3D view of the screenshot at `path` that `output` wrote, and where it sat in the window.
+fn view_in(output: &Output, path: &Path) -> (image::RgbaImage, [u32; 4]) {
+    let (_, rect) = views(output).into_iter().find(|(p, _)| p == path).expect("the screenshot was written");
+    (crop(&image::open(path).expect("the screenshot").to_rgba8(), rect), rect)
+}
+
 fn crop(image: &image::RgbaImage, [x, y, w, h]: [u32; 4]) -> image::RgbaImage {
     image::imageops::crop_imm(image, x, y, w, h).to_image()
 }
@@ -679,17 +698,8 @@ fn settings_changed_in_one_scene_stay_with_it_and_reset_to_the_scenes_own() {
         "wait 2".to_string(),
         format!("screenshot {}", shot("a-reset").display()),
     ];
-    let mut args = vec![a.to_str().unwrap(), "--size", "640x400", "--frames", "2"];
-    for step in &steps {
-        args.extend(["--step", step.as_str()]);
-    }
-    let output = viewer(&args, &dir);
-    succeeded(&output);
-    let rects = views(&output);
-    let view = |name: &str| {
-        let (_, rect) = rects.iter().find(|(p, _)| p == &shot(name)).expect("the screenshot was written");
-        (crop(&image::open(shot(name)).unwrap().to_rgba8(), *rect), *rect)
-    };
+    let output = scripted(&a, &[], &steps, &dir);
+    let view = |name: &str| view_in(&output, &shot(name));
     let headless = |shadows: bool, [_, _, w, h]: [u32; 4]| {
         let mut scene = Scene::load(&a).expect("the scene loads");
         scene.camera.width = w;
@@ -725,18 +735,8 @@ fn a_screenshot_after_a_move_waits_for_full_scale() {
         "wait 1s".to_string(),
         format!("screenshot {}", shot("settled").display()),
     ];
-    let scene = common::asset("scenes/seed-simple.toml");
-    let mut args = vec![scene.to_str().unwrap(), "--size", "640x400", "--frames", "2"];
-    for step in &steps {
-        args.extend(["--step", step.as_str()]);
-    }
-    let output = viewer(&args, &dir);
-    succeeded(&output);
-    let rects = views(&output);
-    let view = |name: &str| {
-        let (_, rect) = rects.iter().find(|(p, _)| p == &shot(name)).expect("the screenshot was written");
-        crop(&image::open(shot(name)).unwrap().to_rgba8(), *rect)
-    };
+    let output = scripted(&common::asset("scenes/seed-simple.toml"), &[], &steps, &dir);
+    let view = |name: &str| view_in(&output, &shot(name)).0;
     let mean = flip(&view("settled"), &view("at-once"), "full-scale", &dir);
     assert!(mean < MAX_FLIP_MEAN, "the screenshot after the move was taken below full scale (mean FLIP {mean})");
     let _ = std::fs::remove_dir_all(&dir);
@@ -756,14 +756,8 @@ fn scene_values_set_in_the_viewer_are_drawn_as_render_draws_them() {
         "wait 2".to_string(),
         format!("screenshot {}", shot.display()),
     ];
-    let mut args = vec![scene.to_str().unwrap(), "--set", "camera.fovy=30", "--size", "640x400", "--frames", "2"];
-    for step in &steps {
-        args.extend(["--step", step.as_str()]);
-    }
-    let output = viewer(&args, &dir);
-    succeeded(&output);
-    let (_, rect) = views(&output).into_iter().find(|(p, _)| p == &shot).expect("the screenshot");
-    let window = crop(&image::open(&shot).unwrap().to_rgba8(), rect);
+    let output = scripted(&scene, &["--set", "camera.fovy=30"], &steps, &dir);
+    let (window, rect) = view_in(&output, &shot);
     let headless = |overrides: &[&str]| {
         let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
         let mut scene = mirador::scene::file::overrides::load(&scene, &overrides).expect("the overrides apply");
