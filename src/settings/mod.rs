@@ -142,17 +142,25 @@ impl RenderSettings {
         let mut slot = &mut table;
         let parts: Vec<&str> = key.split('.').collect();
         let (last, path) = parts.split_last().expect("split always yields one part");
-        // An unknown name is answered with the names the section has.
-        let known = |table: &toml::Table| table.keys().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ");
-        for part in path {
-            let names = known(slot);
-            slot = match slot.get_mut(*part) {
-                Some(toml::Value::Table(inner)) => inner,
-                _ => return Err(rejected(format!("no such settings section; the sections are {names}"))),
+        // An unknown name is answered with the name it most likely misspells, and the names the
+        // section has.
+        let unknown = |what: &str, has: &str, table: &toml::Table, name: &str| {
+            let names = table.keys().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ");
+            let nearest = table.keys().map(|k| (strsim::damerau_levenshtein(k, name), k)).min();
+            let guess = match nearest {
+                Some((distance, k)) if distance <= 2 => format!(" (did you mean `{k}`?)"),
+                _ => String::new(),
             };
+            rejected(format!("no such {what}{guess}; {has} {names}"))
+        };
+        for part in path {
+            if !matches!(slot.get(*part), Some(toml::Value::Table(_))) {
+                return Err(unknown("settings section", "the sections are", slot, part));
+            }
+            slot = slot.get_mut(*part).and_then(toml::Value::as_table_mut).expect("a section, checked just above");
         }
         if !slot.contains_key(*last) {
-            return Err(rejected(format!("no such setting; this section has {}", known(slot))));
+            return Err(unknown("setting", "this section has", slot, last));
         }
         slot.insert(last.to_string(), value);
         let updated: RenderSettings = table.try_into().map_err(|e: toml::de::Error| rejected(e.message().into()))?;
@@ -191,6 +199,11 @@ mod tests {
         assert!(unknown.contains("`specular`"), "an unknown setting is answered with its section's: {unknown}");
         let section = s.set("shadow.enabled=true").unwrap_err().to_string();
         assert!(section.contains("`shadows`"), "an unknown section is answered with the sections: {section}");
+        // A misspelling gets the name it most likely means; a name far from every one gets none.
+        assert!(section.contains("did you mean `shadows`?"), "{section}");
+        let setting = s.set("shadows.enable=true").unwrap_err().to_string();
+        assert!(setting.contains("did you mean `enabled`?"), "{setting}");
+        assert!(!s.set("lighting.x=1").unwrap_err().to_string().contains("did you mean"));
         assert!(s.set("exposure=bright").is_err());
         assert!(s.set("exposure=-1").is_err());
         assert!(s.set("exposure").is_err());
