@@ -478,3 +478,37 @@ fn where_the_renderers_agree_explain_names_the_nearest_pixel_that_differs() {
     let flat = explained(&scene, &scene.settings, (100, 100));
     assert_eq!((flat.diagnosis, flat.nearest), (None, None), "nothing near a flat pixel differs");
 }
+
+/// On a planar mirror `explain` follows the mirrored camera: what it saw at the pixel (its own
+/// surface, terms and lights) beside what the tracer's reflected ray hits. Where the two see
+/// different surfaces (along the red sphere's outline in the left mirror of `mirrors.toml`) the
+/// diagnosis names both; where they see the same (the floor in the mirror) it does not; a pixel
+/// off the mirrors has no mirrored side.
+#[test]
+fn on_a_planar_mirror_explain_follows_the_mirrored_camera() {
+    let scene = Scene::load(&common::asset("scenes/mirrors.toml")).expect("the mirrors scene");
+    let object = |s: Option<&mirador::explain::RasterSurface>| s.and_then(|s| s.object.clone());
+    let reflected_hit = |e: &Explanation| {
+        let reflected = e.trace.rays.children.iter().find(|c| c.kind == RayKind::Reflected)?;
+        reflected.hit.as_ref().and_then(|h| h.object.clone())
+    };
+    // Along the outline (a row of pixels across it, so that a pixel's worth of rounding on
+    // another CPU cannot move it out), at least one pixel sees two surfaces, and every pixel's
+    // diagnosis says so exactly when it does.
+    let mut outline = 0;
+    for x in 144..=156 {
+        let e = explained(&scene, &scene.settings, (x, 187));
+        let seen = e.through_mirror.as_ref().expect("a pixel of the left mirror has its camera's pixel");
+        assert!(close_half(sum(&seen.terms), seen.radiance), "({x}, 187): the mirrored side's terms add up");
+        let (camera, ray) = (object(seen.surface.as_ref()), reflected_hit(&e));
+        let named = e.diagnosis.as_deref().is_some_and(|d| d.starts_with("In the mirror `left mirror`"));
+        assert_eq!(named, camera != ray, "({x}, 187): camera saw {camera:?}, the ray hits {ray:?}: {:?}", e.diagnosis);
+        outline += usize::from(camera != ray);
+    }
+    assert!(outline > 0, "the row crosses the sphere's outline in the mirror");
+    let inside = explained(&scene, &scene.settings, (120, 200));
+    let seen = inside.through_mirror.as_ref().expect("the mirror's camera");
+    assert_eq!(object(seen.surface.as_ref()).as_deref(), Some("floor"));
+    assert_eq!(reflected_hit(&inside).as_deref(), Some("floor"));
+    assert!(explained(&scene, &scene.settings, (100, 220)).through_mirror.is_none(), "the floor is no mirror");
+}

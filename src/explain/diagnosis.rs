@@ -22,7 +22,14 @@ pub fn same(a: Vec3, b: Vec3) -> bool {
 const SELF_SHADOW_DEPTH: f32 = 0.005;
 
 /// One sentence naming the technique behind the difference, or `None` where the radiances agree.
-pub fn diagnose(scene: &Scene, settings: &RenderSettings, raster: &RasterSide, trace: &TraceSide) -> Option<String> {
+/// `raster` is the rasterizer's pixel and, on a planar mirror, what its mirrored camera saw
+/// there.
+pub fn diagnose(
+    scene: &Scene,
+    settings: &RenderSettings,
+    (raster, through_mirror): (&RasterSide, Option<&RasterSide>),
+    trace: &TraceSide,
+) -> Option<String> {
     if same(raster.radiance, trace.radiance) {
         return None;
     }
@@ -45,11 +52,34 @@ pub fn diagnose(scene: &Scene, settings: &RenderSettings, raster: &RasterSide, t
         ));
     }
     shadows(scene, settings, raster, rays)
+        .or_else(|| planar_mirror(raster, through_mirror, rays))
         .or_else(|| refraction(scene, raster, rays))
         .or_else(|| transparency(settings, raster))
         .or_else(|| environment(raster, rays))
         .or_else(|| mip_level(raster, rays))
         .or_else(|| Some(largest(raster, trace)))
+}
+
+/// A planar mirror whose mirrored camera saw another surface at the pixel than the reflected
+/// ray hits: the outline of what the mirror shows (the tessellated shape against the exact one),
+/// or the mirror's own edge.
+fn planar_mirror(raster: &RasterSide, through_mirror: Option<&RasterSide>, rays: &RayNode) -> Option<String> {
+    let mirror = raster.surface.as_ref()?.object.clone()?;
+    let seen = through_mirror?.surface.as_ref();
+    let reflected = rays.children.iter().find(|c| c.kind == RayKind::Reflected)?;
+    let camera_saw = seen.filter(|s| s.kind != "background").and_then(|s| s.object.clone());
+    let ray_hit = reflected.hit.as_ref().and_then(|h| h.object.clone());
+    if camera_saw == ray_hit {
+        return None;
+    }
+    let name = |object: Option<String>| object.map_or("nothing (the background)".to_string(), |o| format!("`{o}`"));
+    Some(format!(
+        "In the mirror `{mirror}` the two see different surfaces: the mirrored camera saw {} at this pixel, the \
+         reflected ray hits {}: an outline seen in the mirror (the tessellated shape against the exact one), or the \
+         mirror's edge.",
+        name(camera_saw),
+        name(ray_hit),
+    ))
 }
 
 /// Projected shadows (object precision) seen differently from the shadow ray, from what is

@@ -49,6 +49,9 @@ pub struct Explanation {
     /// Where they agree: the nearest pixel whose displayed colours differ, within
     /// [`NEAREST_RADIUS`] pixels ([`Nearest`]).
     pub nearest: Option<Nearest>,
+    /// On a planar mirror: what its mirrored camera saw at this pixel (the surface, its terms
+    /// and lights), the rasterizer's counterpart of the tracer's reflected ray.
+    pub through_mirror: Option<Box<RasterSide>>,
 }
 
 /// A pixel near an agreeing one where the two renderers' displayed colours differ. FLIP's error
@@ -241,12 +244,37 @@ impl<'s> Explainer<'s> {
         let rays = trace_pixel(&self.tracer, (x, y));
         let trace = TraceSide { radiance: rays.radiance, terms: rays.terms.clone(), lights: rays.lights.clone(), rays };
         let raster = raster_side(scene, settings, (&pixel, self.renderer.facts()));
-        let diagnosis = diagnosis::diagnose(scene, settings, &raster, &trace);
+        let through_mirror = self.through_mirror(gpu, &raster)?;
+        let diagnosis = diagnosis::diagnose(scene, &self.settings, (&raster, through_mirror.as_deref()), &trace);
         let nearest = match diagnosis {
             Some(_) => None,
             None => self.nearest_difference(gpu, (x, y))?,
         };
-        Ok(Explanation { pixel: [x, y], raster, trace, diagnosis, nearest })
+        Ok(Explanation { pixel: [x, y], raster, trace, diagnosis, nearest, through_mirror })
+    }
+
+    /// Where the inspected pixel shows a planar mirror: one more inspected frame, recorded by
+    /// that mirror's camera instead of the main one, read at the same pixel (the mirrored
+    /// camera's image is pixel-aligned with the view's). `None` elsewhere, or where the mirror
+    /// drew no camera (too deep, or seen edge-on).
+    fn through_mirror(&mut self, gpu: &Gpu, raster: &RasterSide) -> Result<Option<Box<RasterSide>>, ExplainError> {
+        let (scene, settings) = (self.scene, &self.settings);
+        let Some(surface) = raster.surface.as_ref().filter(|s| s.mirror.is_some()) else { return Ok(None) };
+        let Some(object) = surface.object.as_ref().and_then(|name| scene.objects.iter().position(|o| &o.name == name))
+        else {
+            return Ok(None);
+        };
+        self.renderer.inspect_through(Some((object, surface.point)));
+        self.renderer.render(gpu, scene, settings, &mut self.targets, &self.output.view);
+        let pixel = self.renderer.inspected_through().then(|| self.renderer.inspection(gpu, &self.targets));
+        self.renderer.inspect_through(None);
+        match pixel {
+            None => Ok(None),
+            Some(pixel) => {
+                let pixel = pixel.ok_or(ExplainError::Readback)?;
+                Ok(Some(Box::new(raster_side(scene, settings, (&pixel, self.renderer.facts())))))
+            }
+        }
     }
 
     /// The nearest pixel to `(x, y)`, within [`NEAREST_RADIUS`], whose displayed colours differ

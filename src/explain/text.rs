@@ -298,6 +298,24 @@ pub fn render(explanation: &Explanation) -> String {
     section(&mut out, "lights and shadows", raster_lights(raster), traced_lights(&trace.rays));
     section(&mut out, "textures and bumps", raster_textures(raster), traced_textures(&trace.rays));
     section(&mut out, "reflections and transmission", raster_reflections(raster), traced_secondary(&trace.rays));
+    if let Some(seen) = &explanation.through_mirror {
+        // The mirrored camera's pixel beside the reflected ray: the same question one level down.
+        let reflected = trace.rays.children.iter().find(|c| c.kind == RayKind::Reflected);
+        let traced = |lines: fn(&RayNode) -> Vec<String>| reflected.map_or_else(Vec::new, lines);
+        let radiance = |node: &RayNode| vec![v3(node.radiance)];
+        section(
+            &mut out,
+            "in the mirror: what its camera saw here, and what the reflected ray hits",
+            [vec![format!("radiance {}", v3(seen.radiance))], raster_surface(seen)].concat(),
+            [traced(radiance).into_iter().map(|r| format!("radiance {r}")).collect(), traced(traced_surface)].concat(),
+        );
+        section(
+            &mut out,
+            "in the mirror: terms",
+            terms(&seen.terms),
+            reflected.map_or_else(Vec::new, |r| terms(&r.terms)),
+        );
+    }
     section(
         &mut out,
         "transparent layers and volumes, in blend order",

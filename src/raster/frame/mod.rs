@@ -24,7 +24,7 @@ use super::context::{Figure, FrameContext, FrameEncoder, FrameReport};
 use super::environment::pass::EnvironmentPass;
 use super::inspect::{Inspector, RasterPixel, RecordKind};
 use super::mirror::MirrorPlane;
-use super::mirror::pass::{MirrorPass, volumes as mirror_volumes};
+use super::mirror::pass::{MirrorNode, MirrorPass, volumes as mirror_volumes};
 use super::overlays::{FRUSTUM_COLOUR, Overlays, WIREFRAME_COLOUR, box_edges};
 use super::present::PresentPass;
 use super::refraction::{PreparedRefraction, RefractionPass};
@@ -84,6 +84,12 @@ pub struct Renderer {
     view_groups: ViewGroups,
     /// Where an inspecting renderer records what its shaders computed at one pixel.
     inspector: Option<Inspector>,
+    /// Inspect the pixel as the mirrored camera of a planar mirror saw it rather than as the
+    /// main camera does: the mirror's object and a point of the mirror at the pixel (which face,
+    /// for a box of mirrors). See [`Self::inspect_through`].
+    through: Option<(usize, Vec3)>,
+    /// The mirrored camera the last inspected frame was inspected through (its node), if any.
+    inspected_through: Option<usize>,
     /// What the last inspected frame decided before it drew.
     facts: FrameFacts,
     /// Submit and time each pass on its own (`render --stats`): slower, but it says where the
@@ -153,6 +159,8 @@ impl Renderer {
             layouts,
             view_groups: ViewGroups::default(),
             inspector: inspect.then(|| Inspector::new(device)),
+            through: None,
+            inspected_through: None,
             facts: FrameFacts::default(),
             profile: false,
         }
@@ -166,10 +174,28 @@ impl Renderer {
         }
     }
 
+    /// Inspects the next frames' pixel through a planar mirror: the mirrored camera of the mirror
+    /// of `object` whose plane holds `point` (one level deep) records what it saw at that pixel
+    /// (its image is pixel-aligned with the view's), and the main view records nothing. `None`:
+    /// the main view, as usual.
+    pub fn inspect_through(&mut self, mirror: Option<(usize, Vec3)>) {
+        self.through = mirror;
+    }
+
+    /// Whether the last inspected frame was inspected through a mirror: `false` also when
+    /// [`Self::inspect_through`] named a mirror that drew no camera (then nothing was recorded).
+    pub fn inspected_through(&self) -> bool {
+        self.inspected_through.is_some()
+    }
+
     /// What the last frame computed at the inspected pixel, read back from the GPU; `targets` are
-    /// the frame's.
+    /// the frame's. Through a mirror, the pixel of its mirrored camera's image.
     pub fn inspection(&self, gpu: &Gpu, targets: &FrameTargets) -> Option<RasterPixel> {
-        self.inspector.as_ref()?.read(gpu, &targets.hdr.texture)
+        let image = match self.inspected_through {
+            Some(node) => &self.mirrors.targets(node).hdr.texture,
+            None => &targets.hdr.texture,
+        };
+        self.inspector.as_ref()?.read(gpu, image)
     }
 
     /// What the last inspected frame decided before it drew: what the explainer reads instead of
@@ -223,7 +249,20 @@ impl Renderer {
             && let Some(pixel) = inspector.pixel
         {
             inspector.begin(&gpu.queue, pixel);
-            plan.main.key.inspect = true;
+            self.inspected_through = self.through.and_then(|(object, point)| {
+                let mirrors = &self.mirrors.mirrors;
+                let distance = |node: &MirrorNode| mirrors[node.mirror].plane.distance(point).abs();
+                (0..plan.mirror_nodes.len())
+                    .filter(|&k| {
+                        plan.mirror_nodes[k].level == 1 && mirrors[plan.mirror_nodes[k].mirror].object == object
+                    })
+                    .min_by(|&a, &b| distance(&plan.mirror_nodes[a]).total_cmp(&distance(&plan.mirror_nodes[b])))
+            });
+            match self.inspected_through {
+                Some(node) => plan.mirror_views[node].key.inspect = true,
+                None if self.through.is_some() => {}
+                None => plan.main.key.inspect = true,
+            }
             self.facts = facts(&plan, &self.mirrors, &self.environment, self.scene_gpu.geometry.bounds);
         }
         let layers = (&plan.maps, plan.first_shadow_slot);
