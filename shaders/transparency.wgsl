@@ -22,11 +22,12 @@ fn transparent_fragment(in: VertexOut) -> vec4f {
 
 // The transparency lab's route (assets/labs/transparency): the blend made by `transparent_blend`
 // (shaders/common/types.wgsl) instead of the GPU's blend state. False in Mirador; the lab's
-// routes set it, and src/raster/transparency.rs then draws every transparent surface twice. A
-// fragment cannot read the pixel behind it, but any blend of the notes' form is affine in it,
-// I' = a + b·I, so two draws make it exactly: the first multiplies what the pixel holds by
-// b = blend(Im, t, 1) − blend(Im, t, 0) (the blend computes dst·src), the second adds
-// a = blend(Im, t, 0) (src + dst).
+// routes set it, and src/raster/transparency.rs then draws every transparent triangle twice, both
+// draws before the next triangle. A fragment cannot read the pixel behind it, but any blend of
+// the notes' form is affine in it, channel by channel, I' = a + b·I, so two draws make it
+// exactly: the first multiplies what the pixel holds by b = blend(Im, t, 1) − blend(Im, t, 0)
+// (the blend computes dst·src), the second adds a = blend(Im, t, 0) (src + dst). Triangle by
+// triangle, because a draw that covered a pixel twice would multiply twice, then add twice.
 const BLEND_BY_HAND = false;
 
 // Im and kt·Mt at a fragment, as the GPU's blend state takes them: kt·Mt is the material's

@@ -397,6 +397,16 @@ fn copy_writes_a_scene_and_its_files_into_a_folder_that_reads_nothing_outside() 
         let again = mirador(&["copy", scene, folder.to_str().unwrap()]);
         assert!(!again.status.success() && stderr(&again).contains("already exists"), "{}", stderr(&again));
     }
+    // A texture named by an absolute path has no place in the folder: refused, nothing written.
+    let absolute = dir.join("absolute.toml");
+    let checker = asset("textures/checker.png");
+    let text =
+        format!("[materials.floor]\ntexture = \"{checker}\"\n[[objects]]\ntype = \"plane\"\nmaterial = \"floor\"\n");
+    std::fs::write(&absolute, text).unwrap();
+    let into = dir.join("absolute-copy");
+    let refused = mirador(&["copy", absolute.to_str().unwrap(), into.to_str().unwrap()]);
+    assert!(!refused.status.success() && stderr(&refused).contains("absolute path"), "{}", stderr(&refused));
+    assert!(!into.join("absolute.toml").exists(), "a refused copy writes nothing");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -456,16 +456,22 @@ fn both_sides_list_the_same_lights() {
 }
 
 /// FLIP's error map spreads a pixel's error over its neighbours, so its brightest spot may agree
-/// (`mirrors.toml`, pixel (283, 212), beside the red sphere's outline): there `explain` says the
-/// renderers agree and names the nearest pixel that differs, which has a diagnosis of its own.
+/// (`mirrors.toml`, around pixel (283, 212), beside the red sphere's outline): there `explain`
+/// says the renderers agree and names the nearest pixel that differs, which has a diagnosis of its
+/// own.
 /// In a flat area nothing nearby differs and no pixel is named.
 #[test]
 fn where_the_renderers_agree_explain_names_the_nearest_pixel_that_differs() {
     let scene = Scene::load(&common::asset("scenes/mirrors.toml")).expect("the mirrors scene");
-    let agreeing = explained(&scene, &scene.settings, (283, 212));
-    assert_eq!(agreeing.diagnosis, None, "the pixel asked about agrees");
-    let nearest = agreeing.nearest.clone().expect("a pixel beside it differs");
-    assert!(nearest.distance <= 2.0, "{nearest:?}");
+    // The pixel nearest (283, 212) along its row that agrees and has one that differs beside it
+    // (a row, so that an outline a pixel away on another CPU cannot move it out).
+    let agreeing = [283, 282, 284, 281, 285, 280, 286]
+        .into_iter()
+        .map(|x| explained(&scene, &scene.settings, (x, 212)))
+        .find(|e| e.diagnosis.is_none() && e.nearest.is_some())
+        .expect("a pixel beside the sphere's outline that agrees");
+    let nearest = agreeing.nearest.clone().expect("found with one");
+    assert!(nearest.distance <= mirador::explain::NEAREST_RADIUS as f32, "{nearest:?}");
     assert!(nearest.levels >= mirador::explain::DIFFERS_BY);
     let [x, y] = nearest.pixel;
     let differing = explained(&scene, &scene.settings, (x, y));

@@ -267,21 +267,29 @@ fn a_student_file_is_never_overwritten() {
 fn what_a_lab_routes_by_hand_draws_what_the_fixed_function_draws() {
     use mirador::lab::images;
     let gpu = common::gpu();
-    for (name, set, bound) in [
-        ("mipmaps", vec![], 0.02),
-        ("shadow-map", vec!["shadows.filter=\"none\"".to_owned()], 0.01),
-        ("planar-mirrors", vec!["mirrors.depth=1".to_owned()], 0.01),
-        ("transparency", vec![], 0.01),
+    let sorted = |sort: &str| vec![format!("transparency.sort=\"{sort}\"")];
+    for (name, scene, set, bound) in [
+        ("mipmaps", None, vec![], 0.02),
+        ("shadow-map", None, vec!["shadows.filter=\"none\"".to_owned()], 0.01),
+        ("planar-mirrors", None, vec!["mirrors.depth=1".to_owned()], 0.01),
+        ("transparency", None, vec![], 0.00005),
+        // Glass spheres whose near and far walls are drawn in one run of triangles, and in one
+        // draw of an object's both faces: the blend by hand must still be applied fragment by
+        // fragment. Applied draw by draw it is off by a mean of 0.00009 and 0.0012 (worst region
+        // 0.0027 and 0.037); fragment by fragment it is the fixed function's image exactly.
+        ("transparency", Some("transparency.toml"), sorted("triangle"), 0.00005),
+        ("transparency", Some("transparency.toml"), sorted("unsorted"), 0.00005),
     ] {
         let lab = lab::find(name).unwrap();
-        let test = lab::ImageTest { set, ..lab.images[0].clone() };
+        let scene = scene.map_or_else(|| lab.images[0].scene.clone(), str::to_owned);
+        let test = lab::ImageTest { scene, set, ..lab.images[0].clone() };
         let scene = images::scene(&test, None).unwrap();
         let by_hand = images::raster(gpu, &scene, &lab::source::reference(&lab)).unwrap();
         let fixed = images::raster(gpu, &scene, &mirador::shaders::Wgsl::builtin()).unwrap();
         let (figures, _) = images::figures(&fixed, &by_hand);
         eprintln!(
-            "{name}: by hand against the fixed function: mean {:.5}, worst region {:.5}",
-            figures.mean, figures.worst_region
+            "{name} ({}): by hand against the fixed function: mean {:.5}, worst region {:.5}",
+            test.scene, figures.mean, figures.worst_region
         );
         assert!(figures.mean <= bound && figures.worst_region <= 4.0 * bound, "{name}: {figures:?}");
         // And the route is taken: the stub's image differs.

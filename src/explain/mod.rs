@@ -95,6 +95,9 @@ pub struct RasterSurface {
     /// `background`.
     pub kind: &'static str,
     pub object: Option<String>,
+    /// The object's index in the scene (names need not be unique).
+    #[serde(skip)]
+    pub object_index: Option<usize>,
     pub material: Option<String>,
     pub point: Vec3,
     /// The depth buffer's value.
@@ -260,10 +263,7 @@ impl<'s> Explainer<'s> {
     fn through_mirror(&mut self, gpu: &Gpu, raster: &RasterSide) -> Result<Option<Box<RasterSide>>, ExplainError> {
         let (scene, settings) = (self.scene, &self.settings);
         let Some(surface) = raster.surface.as_ref().filter(|s| s.mirror.is_some()) else { return Ok(None) };
-        let Some(object) = surface.object.as_ref().and_then(|name| scene.objects.iter().position(|o| &o.name == name))
-        else {
-            return Ok(None);
-        };
+        let Some(object) = surface.object_index else { return Ok(None) };
         self.renderer.inspect_through(Some((object, surface.point)));
         self.renderer.render(gpu, scene, settings, &mut self.targets, &self.output.view);
         let pixel = self.renderer.inspected_through().then(|| self.renderer.inspection(gpu, &self.targets));
@@ -505,6 +505,7 @@ fn raster_surface(
     RasterSurface {
         kind,
         object: if background { None } else { object_name(scene, record.object) },
+        object_index: (!background && record.object != UNKNOWN_OBJECT).then_some(record.object as usize),
         material: if background { None } else { material_name(scene, record.material) },
         point: record.world,
         depth: record.depth,

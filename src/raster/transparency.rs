@@ -436,19 +436,37 @@ impl PreparedTransparency<'_> {
         let t = scene_gpu.transmittance[material].as_dvec3();
         pass.set_blend_constant(wgpu::Color { r: t.x, g: t.y, b: t.z, a: 1.0 });
         pass.set_bind_group(1, &scene_gpu.materials()[material], &[]);
-        for key in pipeline_keys(ctx, view.key, draw, depth) {
-            pass.set_pipeline(&self.pass.pipelines[&key]);
-            match draw {
-                Draw::Object { object, .. } => {
-                    let object: &TransparentObject = &scene_gpu.geometry.transparent[*object];
-                    scene_gpu.geometry.draw_instances(pass, object.mesh, object.instance..object.instance + 1);
-                }
-                Draw::Triangles { indices, .. } => {
-                    let list = self.pass.triangles.as_ref().expect("sorted in prepare");
-                    pass.set_vertex_buffer(0, list.vertices.slice(..));
-                    pass.set_vertex_buffer(1, list.identity.slice(..));
-                    pass.set_index_buffer(list.orders[&view.slot].indices.slice(..), wgpu::IndexFormat::Uint32);
-                    pass.draw_indexed(indices.clone(), 0, 0..1);
+        let keys = pipeline_keys(ctx, view.key, draw, depth);
+        let indices = match draw {
+            Draw::Object { object, .. } => {
+                let object: &TransparentObject = &scene_gpu.geometry.transparent[*object];
+                0..scene_gpu.geometry.index_count(object.mesh)
+            }
+            Draw::Triangles { indices, .. } => {
+                let list = self.pass.triangles.as_ref().expect("sorted in prepare");
+                pass.set_vertex_buffer(0, list.vertices.slice(..));
+                pass.set_vertex_buffer(1, list.identity.slice(..));
+                pass.set_index_buffer(list.orders[&view.slot].indices.slice(..), wgpu::IndexFormat::Uint32);
+                indices.clone()
+            }
+        };
+        // The transparency lab's blend by hand is two draws per surface, multiply then add; a draw
+        // that covers a pixel twice (a sphere's near and far walls in one run of triangles) would
+        // multiply twice, then add twice. So there each triangle takes both draws before the next
+        // (a triangle covers a pixel once): I' = a + b·I holds fragment by fragment, in any order.
+        let by_hand = keys.first().is_some_and(|(blend, ..)| *blend == Blend::ByHandFactor);
+        let parts: Vec<Range<u32>> =
+            if by_hand { indices.clone().step_by(3).map(|first| first..first + 3).collect() } else { vec![indices] };
+        for part in parts {
+            for key in &keys {
+                pass.set_pipeline(&self.pass.pipelines[key]);
+                match draw {
+                    Draw::Object { object, .. } => {
+                        let object: &TransparentObject = &scene_gpu.geometry.transparent[*object];
+                        let instances = object.instance..object.instance + 1;
+                        scene_gpu.geometry.draw_part(pass, object.mesh, part.clone(), instances);
+                    }
+                    Draw::Triangles { .. } => pass.draw_indexed(part.clone(), 0, 0..1),
                 }
             }
         }

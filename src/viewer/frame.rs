@@ -404,7 +404,7 @@ impl Viewer {
         let drawn = self.raster.render(screen, scene, &self.settings, (self.view.overlay_open, filter));
         (self.scene.scene.camera.width, self.scene.scene.camera.height) = (width, height);
         if scale == 1.0
-            && let Some(lab) = &mut self.lab
+            && let Some(lab) = self.lab.as_mut().filter(|lab| lab.panel().shown == super::lab::LabShown::Difference)
         {
             let mut scene = self.scene.scene.clone();
             scene.settings = self.settings.clone();

@@ -93,7 +93,9 @@ mod native {
         pub lab: Lab,
         /// The student's file.
         pub file: PathBuf,
-        modified: Option<SystemTime>,
+        /// The file's modification time and length when last read: an editor that truncates and
+        /// writes within one tick of the clock still changes the length.
+        modified: Option<(SystemTime, u64)>,
         checked: Instant,
         /// The student's functions as last compiled (the stub's neutral bodies until a version
         /// does), and how many versions compiled so far.
@@ -288,8 +290,9 @@ mod native {
         }
     }
 
-    fn modified(path: &Path) -> Option<SystemTime> {
-        std::fs::metadata(path).and_then(|m| m.modified()).ok()
+    fn modified(path: &Path) -> Option<(SystemTime, u64)> {
+        let metadata = std::fs::metadata(path).ok()?;
+        Some((metadata.modified().ok()?, metadata.len()))
     }
 }
 

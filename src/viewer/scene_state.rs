@@ -37,12 +37,15 @@ pub struct SceneState {
 
 struct Watch {
     path: PathBuf,
-    modified: Option<SystemTime>,
+    /// The file's modification time and length when last read: a save within one tick of a
+    /// coarse clock still changes the length, mostly.
+    modified: Option<(SystemTime, u64)>,
     checked: Instant,
 }
 
-fn modified(path: &Path) -> Option<SystemTime> {
-    std::fs::metadata(path).and_then(|m| m.modified()).ok()
+fn modified(path: &Path) -> Option<(SystemTime, u64)> {
+    let metadata = std::fs::metadata(path).ok()?;
+    Some((metadata.modified().ok()?, metadata.len()))
 }
 
 /// Loads `path`, or the built-in showcase, with `overrides` of its own values applied.

@@ -6,7 +6,9 @@
 //! libraries and their texture maps, a glTF's buffers and images). Each lands under the folder
 //! at the path the scene gave it with its leading `..` steps dropped
 //! (`../../textures/checker.png` → `textures/checker.png`), and the copy of the scene names it
-//! so: the folder reads nothing outside itself. Nothing already in the folder is overwritten.
+//! so: the folder reads nothing outside itself, which is checked by loading the copy (a copy that
+//! would still read a file from outside, named by an absolute path or with `..` further in, is
+//! refused and taken back). Nothing already in the folder is overwritten.
 
 use std::path::{Component, Path, PathBuf};
 
@@ -25,17 +27,33 @@ pub fn copy(scene: &Path, dir: &Path) -> Result<Copied, String> {
     let mut plan: Vec<(PathBuf, PathBuf)> = Vec::new();
     let mut rewritten = text.clone();
     for (relative, source) in &found {
-        let target = inside(relative);
-        if target.as_os_str().is_empty() {
-            return Err(format!("{}: `{relative}` names no file inside a folder", scene.display()));
-        }
+        let target = inside(relative).ok_or_else(|| {
+            format!(
+                "{}: `{relative}` is named by an absolute path or with `..` inside it, so it has no place in the \
+                 folder: copy it by hand",
+                scene.display()
+            )
+        })?;
         let written = target.to_string_lossy().replace('\\', "/");
         if written != *relative {
-            rewritten = rewritten.replace(&format!("\"{relative}\""), &format!("\"{written}\""));
+            for quote in ['"', '\''] {
+                rewritten =
+                    rewritten.replace(&format!("{quote}{relative}{quote}"), &format!("{quote}{written}{quote}"));
+            }
         }
         for (from, to) in with_dependencies(source, &target)? {
-            if !plan.iter().any(|(_, t)| *t == to) {
-                plan.push((from, to));
+            match plan.iter().find(|(_, t)| *t == to) {
+                Some((other, _)) if *other != from => {
+                    return Err(format!(
+                        "{}: {} and {} would both be copied to {}: copy them by hand",
+                        scene.display(),
+                        other.display(),
+                        from.display(),
+                        to.display()
+                    ));
+                }
+                Some(_) => {}
+                None => plan.push((from, to)),
             }
         }
     }
@@ -47,16 +65,48 @@ pub fn copy(scene: &Path, dir: &Path) -> Result<Copied, String> {
             dir.join(taken).display()
         ));
     }
-    for (from, to) in &plan {
+    let written = write(&plan, dir, name, &rewritten);
+    // The copy must read nothing outside the folder; otherwise it is taken back.
+    let outside = written.and_then(|()| {
+        let read = files_read(&dir.join(name))?;
+        let dir = std::fs::canonicalize(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        Ok(read.into_iter().find(|(_, found)| std::fs::canonicalize(found).map_or(true, |f| !f.starts_with(&dir))))
+    });
+    match outside {
+        Ok(None) => Ok(Copied { files }),
+        Ok(Some((relative, found))) => {
+            remove(&files, dir);
+            Err(format!(
+                "{}: the copy would still read `{relative}` from {}; nothing was copied",
+                scene.display(),
+                found.display()
+            ))
+        }
+        Err(e) => {
+            remove(&files, dir);
+            Err(e)
+        }
+    }
+}
+
+/// Writes the files of `plan` and the rewritten scene into `dir`.
+fn write(plan: &[(PathBuf, PathBuf)], dir: &Path, name: &std::ffi::OsStr, scene: &str) -> Result<(), String> {
+    for (from, to) in plan {
         let to = dir.join(to);
         if let Some(parent) = to.parent() {
             std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
         }
         std::fs::copy(from, &to).map_err(|e| format!("copying {} to {}: {e}", from.display(), to.display()))?;
     }
-    crate::output::write_atomically(rewritten.as_bytes(), &dir.join(name))
-        .map_err(|e| format!("{}: {e}", dir.join(name).display()))?;
-    Ok(Copied { files })
+    crate::output::write_atomically(scene.as_bytes(), &dir.join(name))
+        .map_err(|e| format!("{}: {e}", dir.join(name).display()))
+}
+
+/// Removes what a failed copy wrote (`files`, relative to `dir`); the folders stay.
+fn remove(files: &[PathBuf], dir: &Path) {
+    for file in files {
+        let _ = std::fs::remove_file(dir.join(file));
+    }
 }
 
 /// The files loading the scene at `scene` reads, as the scene names each and where it was
@@ -67,9 +117,15 @@ pub fn files_read(scene: &Path) -> Result<Vec<(String, PathBuf)>, String> {
     Ok(found)
 }
 
-/// `relative` with its leading `..` and `.` steps dropped: where the copy keeps the file.
-fn inside(relative: &str) -> PathBuf {
-    Path::new(relative).components().skip_while(|c| matches!(c, Component::ParentDir | Component::CurDir)).collect()
+/// `relative` with its leading `..` and `.` steps dropped: where the copy keeps the file. `None`
+/// for a path that would not stay in the folder: absolute, or with `..` further in.
+fn inside(relative: &str) -> Option<PathBuf> {
+    let rest: Vec<Component> = Path::new(relative)
+        .components()
+        .skip_while(|c| matches!(c, Component::ParentDir | Component::CurDir))
+        .collect();
+    let plain = !rest.is_empty() && rest.iter().all(|c| matches!(c, Component::Normal(_)));
+    plain.then(|| rest.iter().collect())
 }
 
 /// The file at `source`, to be kept at `target`, and the files it names itself, each kept at the
@@ -96,10 +152,12 @@ fn with_dependencies(source: &Path, target: &Path) -> Result<Vec<(PathBuf, PathB
         Some("gltf") => gltf_uris(source)?,
         _ => Vec::new(),
     };
+    // A file the model names beside or below itself keeps its place relative to the model; one
+    // named elsewhere (`../maps/wood.png`, an absolute path) is left where it is.
     for relative in named {
         let from = from_dir.join(&relative);
-        let kept = inside(&relative);
-        if from.is_file() && kept.as_os_str().len() == Path::new(&relative).as_os_str().len() {
+        let kept = inside(&relative).filter(|kept| kept.as_os_str().len() == Path::new(&relative).as_os_str().len());
+        if let Some(kept) = kept.filter(|_| from.is_file()) {
             out.push((from, to_dir.join(kept)));
         }
     }
