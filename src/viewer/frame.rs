@@ -552,6 +552,13 @@ impl Viewer {
         }
     }
 
+    /// Applies render settings given on the command line (checked already).
+    pub fn apply_settings(&mut self, assignments: &[String]) {
+        for assignment in assignments {
+            self.set(assignment);
+        }
+    }
+
     fn set(&mut self, assignment: &str) {
         if crate::scene::file::overrides::is_scene_override(assignment) {
             // The camera keeps the view's size, which the file does not know.

@@ -116,7 +116,7 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
     // `--set` takes the scene's own values (`camera.fovy=30`) and render settings alike.
     let (values, settings): (Vec<String>, Vec<String>) =
         options.set.iter().cloned().partition(|a| crate::scene::file::overrides::is_scene_override(a));
-    let (lab, mut scene) = match &options.lab {
+    let (lab, scene) = match &options.lab {
         Some(dir) if values.is_empty() => {
             let (lab, scene) = open_lab(dir)?;
             (Some(lab), scene)
@@ -124,8 +124,12 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
         Some(_) => anyhow::bail!("--set {}: in lab mode the scene is the lab's; --set takes settings only", values[0]),
         None => (None, scene_state::load(options.scene.as_deref(), &values)?),
     };
+    // Checked now, so that a bad one is an error before the window opens; applied once the
+    // viewer has put back what it remembered of this scene, so the command line wins, and the
+    // panel counts them as changes from the scene file's own.
+    let mut checked = scene.settings.clone();
     for assignment in &settings {
-        scene.settings.set(assignment).context("--set")?;
+        checked.set(assignment).context("--set")?;
     }
     let event_loop = EventLoop::<Wake>::with_user_event().build().map_err(|e| {
         log::info!("no event loop: {e}");
@@ -134,6 +138,7 @@ pub fn run(options: ViewerOptions) -> anyhow::Result<()> {
     let proxy = event_loop.create_proxy();
     let mut app = App {
         options,
+        settings,
         scene: Some(scene),
         overrides: values,
         lab,
@@ -161,6 +166,8 @@ struct App {
     lab: Option<lab::LabMode>,
     /// `--set`'s overrides of the scene's own values, kept by the scene for its reloads.
     overrides: Vec<String>,
+    /// `--set`'s render settings, applied over what the viewer remembered.
+    settings: Vec<String>,
     proxy: EventLoopProxy<Wake>,
     running: Option<(Screen, Viewer)>,
     outcome: anyhow::Result<()>,
@@ -199,6 +206,7 @@ impl App {
         let mut viewer = Viewer::new(&mut screen, scene, &config, self.options.steps.clone(), wake, self.lab.take());
         viewer.notices.extend(notices);
         viewer.scene.overrides = std::mem::take(&mut self.overrides);
+        viewer.apply_settings(&self.settings);
         viewer.scripted = self.options.scripted();
         if self.options.stats {
             println!("adapter: {}", screen.gpu.describe());
