@@ -311,7 +311,9 @@ fn stop_quietly_when_the_reader_stops() {
     std::panic::set_hook(Box::new(move |info| {
         let payload = info.payload();
         let message = payload.downcast_ref::<String>().map(String::as_str).or(payload.downcast_ref::<&str>().copied());
-        if message.is_some_and(|m| m.starts_with("failed printing to stdout") && m.contains("Broken pipe")) {
+        // "Broken pipe" on Unix; Windows says the pipe "is being closed" (os error 232).
+        let closed = |m: &str| m.contains("Broken pipe") || m.contains("os error 232");
+        if message.is_some_and(|m| m.starts_with("failed printing to stdout") && closed(m)) {
             std::process::exit(141);
         }
         default(info);
