@@ -139,6 +139,9 @@ fn fs_transparent_inspect(in: VertexOut) -> @location(0) vec4f {
 @fragment
 fn fs_blend_term_inspect(in: VertexOut) -> @location(0) vec4f {
     probe.object = in.object;
+    let b = blend_inputs(in);
+    probe.blend_factor =
+        transparent_blend(b.im, b.transmittance, vec3f(1.0)) - transparent_blend(b.im, b.transmittance, vec3f(0.0));
     let out = blend_term(in);
     probe.alpha = transparent_fragment(in).a;
     inspect_record(INSPECT_TRANSPARENT, in.clip, out.rgb);

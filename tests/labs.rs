@@ -452,3 +452,30 @@ fn every_mutant_of_every_answer_key_fails_its_checks() {
         .collect();
     assert!(stale.is_empty(), "listed as equivalent but no longer made, or now caught:\n{}", stale.join("\n"));
 }
+
+/// Inspecting the student's pixels in the transparency lab reads the student's blend: where the
+/// three panes overlap, drawn with a mistaken blend (`Im + I`: nothing filtered), the pixel's
+/// terms add up to the radiance the student's blend drew, not to what Mirador's would have.
+#[test]
+fn explain_reads_the_students_blend() {
+    use mirador::lab::images;
+    let gpu = common::gpu();
+    let lab = lab::find("transparency").unwrap();
+    let mistake = lab.mistakes.iter().find(|m| m.name == "what is behind not filtered").expect("the mistake");
+    let wgsl = lab::source::student(&lab, &lab.mistaken(mistake));
+    let scene = images::scene(&lab.images[0], None).unwrap();
+    // Each pane glows 0.5 in its colour: unfiltered, the overlap of all three is linear 0.5 grey.
+    let image = images::raster(gpu, &scene, &wgsl).unwrap();
+    let (x, y, _) = image
+        .enumerate_pixels()
+        .find(|(_, _, p)| p.0[..3].iter().all(|&c| c.abs_diff(188) <= 1))
+        .expect("the three panes' overlap");
+    let explanation = mirador::explain::Explainer::with_wgsl(gpu, &scene, &scene.settings, wgsl)
+        .expect("an inspecting renderer")
+        .explain(gpu, (x, y))
+        .expect("the pixel explained");
+    let raster = &explanation.raster;
+    let sum: glam::Vec3 = raster.terms.iter().map(|t| t.radiance).sum();
+    assert!(raster.radiance.min_element() > 0.45, "the student's blend drew {}", raster.radiance);
+    assert!((sum - raster.radiance).abs().max_element() <= 2e-3, "terms {sum} against {}", raster.radiance);
+}

@@ -88,6 +88,10 @@ struct InspectFragment {
     fresnel_exit: f32,
     refracted: vec3f,
     refraction_source: f32,
+    // The transparency lab's blend by hand (BLEND_BY_HAND): b, what the pixel behind the fragment
+    // is multiplied by, from the student's blend.
+    blend_factor: vec3f,
+    _pad5: f32,
     lights: array<InspectLight, MAX_LIGHTS>,
 }
 

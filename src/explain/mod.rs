@@ -343,7 +343,7 @@ fn kind_of(record: &GpuInspectFragment) -> Option<&'static RecordKind> {
     record_kinds().find(|kind| kind.code == record.kind)
 }
 
-fn kept<'r>(scene: &Scene, settings: &RenderSettings, pixel: &'r RasterPixel) -> Kept<'r> {
+fn kept<'r>(scene: &Scene, settings: &RenderSettings, pixel: &'r RasterPixel, by_hand: bool) -> Kept<'r> {
     let records = &pixel.fragments;
     let part = |r: &GpuInspectFragment| kind_of(r).map(|k| k.part);
     let surface = records
@@ -358,6 +358,10 @@ fn kept<'r>(scene: &Scene, settings: &RenderSettings, pixel: &'r RasterPixel) ->
     let lets_through = |r: &GpuInspectFragment| -> Vec3 {
         if part(r) == Some(Part::Composited) {
             return Vec3::splat(1.0 - r.alpha);
+        }
+        // A lab's blend by hand: the student's b, as the record holds it.
+        if by_hand && part(r) == Some(Part::Transparent) {
+            return r.blend_factor;
         }
         let material = &scene.materials[r.material as usize];
         if settings.terms.fresnel && material.bends_light() {
@@ -411,7 +415,7 @@ fn kept<'r>(scene: &Scene, settings: &RenderSettings, pixel: &'r RasterPixel) ->
 
 /// The rasterizer's side from its records.
 fn raster_side(scene: &Scene, settings: &RenderSettings, (pixel, facts): (&RasterPixel, &FrameFacts)) -> RasterSide {
-    let kept = kept(scene, settings, pixel);
+    let kept = kept(scene, settings, pixel, facts.blend_by_hand);
     // What the layers in front of each element let through, nearest last.
     let mut front = vec![Vec3::ONE; kept.layers.len() + 1];
     for k in (0..kept.layers.len()).rev() {

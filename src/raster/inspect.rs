@@ -121,6 +121,9 @@ pub struct GpuInspectFragment {
     pub fresnel_exit: f32,
     pub refracted: Vec3,
     pub refraction_source: f32,
+    /// The transparency lab's blend by hand: `b`, what the pixel behind is multiplied by.
+    pub blend_factor: Vec3,
+    pub _pad5: f32,
     pub lights: [GpuInspectLight; MAX_LIGHTS],
 }
 

@@ -61,6 +61,9 @@ pub struct FrameFacts {
     pub cubes: Vec<(usize, Vec3)>,
     /// The box around the drawn geometry (the shadow fit's and the parallax proxies' bounds).
     pub bounds: Option<(Vec3, Vec3)>,
+    /// Transparent surfaces were blended by a lab's blend by hand (`BLEND_BY_HAND`): what each
+    /// lets through is its record's `blend_factor`, not the material's.
+    pub blend_by_hand: bool,
 }
 
 /// The passes, built once per device and output format, and the scene they draw.
@@ -264,6 +267,7 @@ impl Renderer {
                 None => plan.main.key.inspect = true,
             }
             self.facts = facts(&plan, &self.mirrors, &self.environment, self.scene_gpu.geometry.bounds);
+            self.facts.blend_by_hand = self.surface.wgsl.routes("BLEND_BY_HAND");
         }
         let layers = (&plan.maps, plan.first_shadow_slot);
         self.shadow.record(gpu, &mut frame, &self.scene_gpu, layers, &settings.shadows);
@@ -394,6 +398,7 @@ fn facts(
         mirrors: seen.map(|node| (mirrors.mirrors[node.mirror].object, mirrors.mirrors[node.mirror].plane)).collect(),
         cubes: environment.centres().to_vec(),
         bounds,
+        blend_by_hand: false,
     }
 }
 
