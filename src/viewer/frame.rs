@@ -89,6 +89,9 @@ pub struct Viewer {
     pub lab: Option<LabMode>,
     /// The settings changed in each scene opened before (`super::config`), by scene key.
     remembered: BTreeMap<String, toml::Table>,
+    /// The settings and the scene's own the panel's list of changed settings was made from, and
+    /// the list.
+    changed: (RenderSettings, RenderSettings, Vec<String>),
 }
 
 /// Scripted steps still to run and the wait in progress.
@@ -164,6 +167,7 @@ impl Viewer {
             inspect_next: None,
             lab,
             remembered,
+            changed: Default::default(),
         }
     }
 
@@ -351,8 +355,11 @@ impl Viewer {
     fn lay_out(&mut self, screen: &mut Screen) -> (UiOutput, egui::FullOutput) {
         let raw = screen.take_input();
         let raster_id = (screen.composition == Composition::Textured).then(|| self.raster.texture_id());
-        let changed: Vec<String> =
-            self.changed_settings().iter().map(|(key, value)| format!("{key} = {value}")).collect();
+        // Listed again only when the settings or the scene's own change, not every frame.
+        if (&self.changed.0, &self.changed.1) != (&self.settings, &self.scene.seed_settings) {
+            let list = self.changed_settings().iter().map(|(key, value)| format!("{key} = {value}")).collect();
+            self.changed = (self.settings.clone(), self.scene.seed_settings.clone(), list);
+        }
         let mut output = UiOutput::default();
         let mut model = UiModel {
             settings: &self.settings,
@@ -370,7 +377,7 @@ impl Viewer {
             probe: self.probe.shown(),
             seen: self.seen.shown(),
             lab: self.lab.as_ref().map(LabMode::panel),
-            changed_settings: &changed,
+            changed_settings: &self.changed.2,
         };
         let full = screen.egui.run_ui(raw, |ui| output = ui::draw(ui, &mut model));
         (output, full)

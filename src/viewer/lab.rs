@@ -73,7 +73,7 @@ pub use native::LabMode;
 #[cfg(not(target_arch = "wasm32"))]
 mod native {
     use std::path::{Path, PathBuf};
-    use std::time::{Duration, SystemTime};
+    use std::time::SystemTime;
 
     use web_time::Instant;
 
@@ -84,10 +84,8 @@ mod native {
     use crate::raster::Headless;
     use crate::scene::{Camera, Light};
     use crate::shaders::Wgsl;
+    use crate::viewer::scene_state::{WATCH_PERIOD, modified};
     use crate::{RenderSettings, Scene};
-
-    /// How often the student's file's modification time is checked.
-    const WATCH_PERIOD: Duration = Duration::from_millis(500);
 
     pub struct LabMode {
         pub lab: Lab,
@@ -107,8 +105,19 @@ mod native {
         pub shown: LabShown,
         /// The difference view's image and mean, and what it was made from.
         pub difference: Option<ShownDifference>,
+        /// The renderers that draw it, kept from one view to the next.
+        renderers: Option<DifferenceRenderers>,
         /// The shader the view draws with changed: the frame rebuilds its renderer.
         changed: bool,
+    }
+
+    /// The two renderers the difference view draws with, kept while the student's functions, the
+    /// scene and the view's size stay the same: making one compiles every pass.
+    struct DifferenceRenderers {
+        /// The student's version, the scene's revision and the image size they were made for.
+        made_for: (u64, u64, (u32, u32)),
+        reference: Headless,
+        student: Headless,
     }
 
     pub struct ShownDifference {
@@ -154,6 +163,7 @@ mod native {
                 problems: Vec::new(),
                 shown: LabShown::Student,
                 difference: None,
+                renderers: None,
                 changed: true,
             };
             mode.read();
@@ -260,11 +270,25 @@ mod native {
             if self.difference.as_ref().is_some_and(|d| d.inputs == inputs) {
                 return;
             }
-            let draw =
-                |wgsl: Wgsl| gpu.checked(|| Headless::with_wgsl(gpu, scene, wgsl).render(gpu, scene, &scene.settings));
-            let (reference, student) = match (draw(source::reference(&self.lab)), draw(self.student.clone())) {
-                (Ok(reference), Ok(student)) => (reference, student),
-                (Err(e), _) | (_, Err(e)) => {
+            let made_for = (self.generation, revision, (scene.camera.width, scene.camera.height));
+            let (lab, student, kept) = (&self.lab, &self.student, &mut self.renderers);
+            let drawn = gpu.checked(|| {
+                let renderers = match kept.take() {
+                    Some(renderers) if renderers.made_for == made_for => renderers,
+                    _ => DifferenceRenderers {
+                        made_for,
+                        reference: Headless::with_wgsl(gpu, scene, source::reference(lab)),
+                        student: Headless::with_wgsl(gpu, scene, student.clone()),
+                    },
+                };
+                let renderers = kept.insert(renderers);
+                let reference = renderers.reference.render(gpu, scene, &scene.settings);
+                (reference, renderers.student.render(gpu, scene, &scene.settings))
+            });
+            let (reference, student) = match drawn {
+                Ok(images) => images,
+                Err(e) => {
+                    self.renderers = None;
                     log::warn!("lab difference: {e}");
                     return;
                 }
@@ -288,11 +312,6 @@ mod native {
             );
             self.difference = Some(ShownDifference { texture, flip_mean: difference.flip_mean, inputs });
         }
-    }
-
-    fn modified(path: &Path) -> Option<(SystemTime, u64)> {
-        let metadata = std::fs::metadata(path).ok()?;
-        Some((metadata.modified().ok()?, metadata.len()))
     }
 }
 

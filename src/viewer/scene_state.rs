@@ -13,7 +13,7 @@ use crate::scene::Camera;
 use crate::{RenderSettings, Scene};
 
 /// How often the scene file's modification time is checked.
-const WATCH_PERIOD: Duration = Duration::from_millis(500);
+pub(super) const WATCH_PERIOD: Duration = Duration::from_millis(500);
 
 pub struct SceneState {
     pub scene: Scene,
@@ -43,7 +43,8 @@ struct Watch {
     checked: Instant,
 }
 
-fn modified(path: &Path) -> Option<(SystemTime, u64)> {
+/// A watched file's modification time and length (the scene file, a lab's file).
+pub(super) fn modified(path: &Path) -> Option<(SystemTime, u64)> {
     let metadata = std::fs::metadata(path).ok()?;
     Some((metadata.modified().ok()?, metadata.len()))
 }

@@ -395,34 +395,32 @@ fn view(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
 fn error_boxes(ui: &mut egui::Ui, model: &UiModel, rect: Rect, output: &mut UiOutput) {
     if let Some(lab) = model.lab.as_ref().filter(|lab| !lab.problems.is_empty()) {
         let file = lab.file.file_name().map_or(lab.file.display().to_string(), |f| f.to_string_lossy().into_owned());
-        egui::Area::new(egui::Id::unique("mirador::lab_error")).fixed_pos(rect.min + egui::vec2(12.0, 12.0)).show(
-            ui.ctx(),
-            |ui| {
-                egui::Frame::popup(ui.style()).fill(LAB_ERROR_FILL).show(ui, |ui| {
-                    ui.set_max_width(rect.width() - 40.0);
-                    let text = format!("{file} does not compile; {} drawn.\n{}", lab.fallback, lab.problems.join("\n"));
-                    ui.label(egui::RichText::new(text).monospace().color(Color32::WHITE));
-                });
-            },
-        );
+        error_box(ui, rect, ("mirador::lab_error", LAB_ERROR_FILL), |ui| {
+            let text = format!("{file} does not compile; {} drawn.\n{}", lab.fallback, lab.problems.join("\n"));
+            ui.label(egui::RichText::new(text).monospace().color(Color32::WHITE));
+        });
     }
     if let Some(error) = model.scene.error.clone() {
-        egui::Area::new(egui::Id::unique("mirador::scene_error")).fixed_pos(rect.min + egui::vec2(12.0, 12.0)).show(
-            ui.ctx(),
-            |ui| {
-                egui::Frame::popup(ui.style()).fill(Color32::from_rgb(90, 20, 20)).show(ui, |ui| {
-                    ui.set_max_width(rect.width() - 40.0);
-                    ui.colored_label(
-                        Color32::WHITE,
-                        format!("The scene could not be loaded; the previous one is kept.\n{error}"),
-                    );
-                    if ui.button("dismiss").clicked() {
-                        output.actions.push(Action::DismissError);
-                    }
-                });
-            },
-        );
+        error_box(ui, rect, ("mirador::scene_error", Color32::from_rgb(90, 20, 20)), |ui| {
+            ui.colored_label(
+                Color32::WHITE,
+                format!("The scene could not be loaded; the previous one is kept.\n{error}"),
+            );
+            if ui.button("dismiss").clicked() {
+                output.actions.push(Action::DismissError);
+            }
+        });
     }
+}
+
+/// A box of `fill` over the 3D view `rect`, at its top left, with `content`.
+fn error_box(ui: &egui::Ui, rect: Rect, (id, fill): (&str, Color32), content: impl FnOnce(&mut egui::Ui)) {
+    egui::Area::new(egui::Id::unique(id)).fixed_pos(rect.min + egui::vec2(12.0, 12.0)).show(ui.ctx(), |ui| {
+        egui::Frame::popup(ui.style()).fill(fill).show(ui, |ui| {
+            ui.set_max_width(rect.width() - 40.0);
+            content(ui);
+        });
+    });
 }
 
 /// The fill behind a lab file's compile error over the view (tests/viewer.rs looks for it).
