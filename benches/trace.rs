@@ -1,4 +1,6 @@
-//! BVH benchmark: Mirador's BVH against the `bvh` (0.13) and `obvhs` (0.4) crates.
+//! BVH benchmark: Mirador's two BVHs, the wide one (the tracer's default, with and without its
+//! AVX box test) and the binary one the course builds, against the `bvh` (0.13) and `obvhs` (0.4)
+//! crates. Ratios are given against the binary BVH, which was the default until the wide one.
 //!
 //! Scene: a displaced UV sphere of 1024 × 512 quads (1 046 528 triangles after the pole fans).
 //! Rays: 512 × 512 primary rays from a pinhole camera that sees the whole sphere, and one shadow
@@ -24,6 +26,7 @@ use glam::{Vec2, Vec3, Vec3A};
 use mirador::base::{MaterialId, Ray};
 use mirador::trace::accel::Accelerator;
 use mirador::trace::accel::bvh::Bvh;
+use mirador::trace::accel::wide::Wide;
 use mirador::trace::geometry::{Primitive, Triangle};
 use rayon::prelude::*;
 
@@ -177,7 +180,14 @@ impl bvh::bounding_hierarchy::BHShape<f32, 3> for BvhShape {
     }
 }
 
-fn mirador_row(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Row {
+/// Mirador's BVH as `build` makes it, binary or wide.
+fn mirador_row<A: Accelerator>(
+    name: &'static str,
+    build: impl Fn(&[Primitive]) -> A,
+    tris: &[[Vec3; 3]],
+    primary: &[Query],
+    shadow: &[Query],
+) -> Row {
     let prims: Vec<Primitive> = tris
         .iter()
         .map(|&positions| {
@@ -191,12 +201,12 @@ fn mirador_row(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Row {
             })
         })
         .collect();
-    let (build, accel) = timed(true, || Bvh::build(&prims));
+    let (build_time, accel) = timed(true, || build(&prims));
     println!("{}", accel.stats());
     let ray = |q: &Query| Ray { origin: q.origin, direction: q.direction };
     Row {
-        name: "mirador bvh",
-        build,
+        name,
+        build: build_time,
         primary: throughput(primary, |q| accel.closest(&prims, &ray(q), q.t_min, q.t_max).is_some()),
         shadow: throughput(shadow, |q| accel.occluded(&prims, &ray(q), q.t_min, q.t_max)),
     }
@@ -315,7 +325,11 @@ fn main() {
     // `cargo bench --bench trace -- obvhs` runs Mirador and the peers whose names contain "obvhs".
     let filters: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with("--")).collect();
     let wanted = |name: &str| filters.is_empty() || filters.iter().any(|f| name.contains(f.as_str()));
-    let mut rows = vec![mirador_row(&tris, &primary, &shadow)];
+    let mut rows = vec![
+        mirador_row("mirador wide", Wide::build, &tris, &primary, &shadow),
+        mirador_row("wide without AVX", Wide::build_without_avx, &tris, &primary, &shadow),
+        mirador_row("mirador bvh", Bvh::build, &tris, &primary, &shadow),
+    ];
     if wanted("obvhs") {
         rows.extend(obvhs_rows(&tris, &primary, &shadow));
     }
@@ -349,7 +363,9 @@ fn main() {
         );
     }
     println!();
-    println!("ratios: ours/peer throughput (> 1: Mirador faster), peer/ours build time (> 1: Mirador builds faster)");
+    println!(
+        "ratios: the wide BVH's throughput over each other's (> 1: wide faster), their build time over its (> 1: wide builds faster)"
+    );
     let ours = &rows[0];
     for peer in &rows[1..] {
         println!(

@@ -1,6 +1,9 @@
 //! The ray tracer's geometry and accelerators.
 //!
-//! - Every accelerator (BVH, grid, octree) returns the nearest hit brute force returns, on
+//! - The wide BVH returns the binary BVH's hits (the same `t` to the bit, and the same primitive
+//!   or one tied with it), through its AVX box test and its four-wide one, including rays
+//!   parallel to a box's planes from on them and rays through triangle edges and vertices.
+//! - Every accelerator (BVHs, grid, octree) returns the nearest hit brute force returns, on
 //!   thousands of seeded random rays through a triangle soup, a tessellated height field, a
 //!   sphere mesh, a scene of every analytic shape under rotations and non-uniform scales, and the
 //!   built-in scene files; `occluded` agrees with `closest`.
@@ -17,7 +20,9 @@ use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
 use mirador::Scene;
 use mirador::base::{MaterialId, Ray};
 use mirador::scene::{Mesh, Object, Shape};
-use mirador::trace::accel::{AccelKind, Accelerator, build};
+use mirador::trace::accel::bvh::Bvh;
+use mirador::trace::accel::wide::Wide;
+use mirador::trace::accel::{AccelKind, Accelerator, Hit, build};
 use mirador::trace::geometry::{Aabb, Primitive, Triangle, scene_primitives};
 
 /// PCG32 (O'Neill): a few lines of seeded randomness, the same on every machine.
@@ -62,7 +67,7 @@ fn ray(origin: Vec3, direction: Vec3) -> Ray {
     Ray { origin, direction: direction.normalize() }
 }
 
-const KINDS: [AccelKind; 3] = [AccelKind::Bvh, AccelKind::Grid, AccelKind::Octree];
+const KINDS: [AccelKind; 4] = [AccelKind::Wide, AccelKind::Bvh, AccelKind::Grid, AccelKind::Octree];
 
 fn bounds_of(prims: &[Primitive]) -> Aabb {
     prims.iter().fold(Aabb::EMPTY, |b, p| b.union(&p.bounds()))
@@ -316,6 +321,89 @@ fn accelerators_agree_with_brute_force_on_the_built_in_scenes() {
     }
 }
 
+/// The wide BVH, both ways of testing its boxes, against the binary BVH: identical hits.
+fn assert_wide_matches_binary(name: &str, prims: &[Primitive], queries: &[(Ray, f32, f32)]) {
+    let binary = Bvh::build(prims);
+    for (way, wide) in [("AVX where present", Wide::build(prims)), ("four lanes", Wide::build_without_avx(prims))] {
+        for (r, t0, t1) in queries {
+            let (got, want) = (wide.closest(prims, r, *t0, *t1), binary.closest(prims, r, *t0, *t1));
+            let same_t = got.map(|h| h.t.to_bits()) == want.map(|h| h.t.to_bits());
+            // Two primitives hit at the same distance (a shared vertex or edge) may be found in
+            // either order: both BVHs skip a box whose entry rounds past the nearest hit so far,
+            // even where a primitive in it ties with that hit. The tie is real: the other
+            // primitive is hit at that very distance.
+            let tie =
+                |h: Hit| prims[h.primitive as usize].intersect(r, *t0, *t1).map(f32::to_bits) == Some(h.t.to_bits());
+            assert!(
+                same_t && (got == want || got.is_some_and(tie) && want.is_some_and(tie)),
+                "{name}, wide ({way}): {r:?} in ({t0}, {t1}) hits {got:?}, the binary BVH {want:?}"
+            );
+            assert_eq!(
+                wide.occluded(prims, r, *t0, *t1),
+                binary.occluded(prims, r, *t0, *t1),
+                "{name}, wide ({way}): occluded differs for {r:?} in ({t0}, {t1})"
+            );
+        }
+    }
+}
+
+/// Rays along the axes (direction components exactly zero) from the primitives' own vertex
+/// coordinates, so that origins lie on box planes: the box test's 0·∞ case.
+fn axis_rays(prims: &[Primitive], rng: &mut Pcg, count: usize) -> Vec<(Ray, f32, f32)> {
+    let corners: Vec<Vec3> = prims.iter().flat_map(|p| [p.bounds().min, p.bounds().max]).collect();
+    let axes = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z];
+    (0..count)
+        .map(|_| {
+            let (a, b) =
+                (corners[rng.next_u32() as usize % corners.len()], corners[rng.next_u32() as usize % corners.len()]);
+            // Two coordinates from one corner, one from another: on two planes at once, often.
+            let origin = Vec3::new(a.x, a.y, b.z) - 0.5 * Vec3::Z;
+            (ray(origin, axes[rng.next_u32() as usize % 6]), 0.0, f32::INFINITY)
+        })
+        .collect()
+}
+
+#[test]
+fn the_wide_bvh_finds_exactly_the_binary_bvhs_hits() {
+    let mut rng = Pcg::new(8);
+    let cube = Aabb::new(Vec3::splat(-1.0), Vec3::ONE);
+    let soup: Vec<Primitive> = (0..2000)
+        .map(|_| {
+            let a = rng.in_box(&cube);
+            triangle([a, a + 0.1 * rng.unit_vector(), a + 0.1 * rng.unit_vector()])
+        })
+        .collect();
+    let field = mesh_primitives(height_field(40), Mat4::IDENTITY);
+    let sphere = mesh_primitives(welded_sphere(48, 24), Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0)));
+    let analytic = scene_primitives(&analytic_scene());
+    let showcase = scene_primitives(&Scene::load(&mirador::scene::builtin_path("showcase.toml")).unwrap());
+    for (name, prims) in [
+        ("soup", soup),
+        ("height field", field),
+        ("sphere mesh", sphere),
+        ("analytic", analytic),
+        ("showcase", showcase),
+    ] {
+        let focus = bounds_of(&prims);
+        let focus =
+            if focus.extent().max_element() > 50.0 { Aabb::new(Vec3::splat(-5.0), Vec3::splat(5.0)) } else { focus };
+        let mut queries = random_queries(&mut rng, &focus, 3000);
+        queries.extend(axis_rays(&prims, &mut rng, 1000));
+        assert_wide_matches_binary(name, &prims, &queries);
+    }
+    // The height field's vertices and edges, straight down: edge functions that round to zero.
+    let n = 16;
+    let field = height_field(n);
+    let prims = mesh_primitives(field.clone(), Mat4::IDENTITY);
+    let queries: Vec<_> = field
+        .positions
+        .iter()
+        .flat_map(|&p| [p, p + Vec3::new(1.0 / n as f32, 0.0, 0.0)])
+        .map(|p| (ray(p + Vec3::Y, Vec3::NEG_Y), 0.0, f32::INFINITY))
+        .collect();
+    assert_wide_matches_binary("height field's vertices", &prims, &queries);
+}
+
 #[test]
 fn meshes_are_watertight_at_shared_edges_and_vertices() {
     let mut rng = Pcg::new(5);
@@ -325,7 +413,9 @@ fn meshes_are_watertight_at_shared_edges_and_vertices() {
                  targets: Vec<Vec3>,
                  origin: &mut dyn FnMut(Vec3) -> Vec3| {
         let accels: Vec<(AccelKind, Box<dyn Accelerator>)> =
-            [AccelKind::None, AccelKind::Bvh, AccelKind::Grid, AccelKind::Octree].map(|k| (k, build(k, prims))).into();
+            [AccelKind::None, AccelKind::Wide, AccelKind::Bvh, AccelKind::Grid, AccelKind::Octree]
+                .map(|k| (k, build(k, prims)))
+                .into();
         for target in targets {
             let o = origin(target);
             let r = ray(o, target - o);
@@ -516,7 +606,7 @@ fn degenerate_input_neither_panics_nor_hits() {
     let nan = Ray { origin: Vec3::ZERO, direction: Vec3::new(f32::NAN, 0.0, 1.0) };
     let zero = Ray { origin: Vec3::ZERO, direction: Vec3::ZERO };
     let infinite = Ray { origin: Vec3::new(f32::INFINITY, 0.0, 0.0), direction: Vec3::NEG_X };
-    for kind in [AccelKind::None, AccelKind::Bvh, AccelKind::Grid, AccelKind::Octree] {
+    for kind in [AccelKind::None, AccelKind::Wide, AccelKind::Bvh, AccelKind::Grid, AccelKind::Octree] {
         let accel = build(kind, &prims);
         for r in [nan, zero, infinite] {
             assert_eq!(accel.closest(&prims, &r, 0.0, f32::INFINITY), None, "{kind:?}: {r:?}");

@@ -260,15 +260,45 @@ fn jittered_sampling_is_deterministic_across_runs_and_threads() {
 fn every_accelerator_draws_the_same_image() {
     let scene = small_showcase();
     let reference = mirador::trace::render_image(&scene, &scene.settings);
-    for accelerator in [AccelKind::Grid, AccelKind::Octree, AccelKind::None] {
+    for accelerator in [AccelKind::Bvh, AccelKind::Grid, AccelKind::Octree, AccelKind::None] {
         let mut settings = scene.settings.clone();
         settings.trace.accelerator = accelerator;
         assert_same_image(
             &mirador::trace::render_image(&scene, &settings),
             &reference,
-            &format!("{accelerator:?} vs BVH"),
+            &format!("{accelerator:?} vs the wide BVH"),
         );
     }
+}
+
+/// The wide BVH (the default) and the binary one the course builds draw the same image of
+/// every scene under `assets/scenes/`, at a fifth of its size.
+#[test]
+fn the_wide_and_the_binary_bvh_draw_the_same_image_of_every_scene() {
+    let mut folders = vec![common::asset("scenes")];
+    let mut scenes = 0;
+    while let Some(folder) = folders.pop() {
+        let mut entries: Vec<_> = std::fs::read_dir(&folder).unwrap().map(|e| e.unwrap().path()).collect();
+        entries.sort();
+        for path in entries {
+            if path.is_dir() {
+                folders.push(path);
+                continue;
+            }
+            if path.extension().is_none_or(|e| e != "toml") {
+                continue;
+            }
+            let mut scene = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+            (scene.camera.width, scene.camera.height) = (scene.camera.width / 5, scene.camera.height / 5);
+            let wide = mirador::trace::render_image(&scene, &scene.settings);
+            let mut settings = scene.settings.clone();
+            assert_eq!(settings.trace.accelerator, AccelKind::Wide, "{}: the default", path.display());
+            settings.trace.accelerator = AccelKind::Bvh;
+            assert_same_image(&mirador::trace::render_image(&scene, &settings), &wide, &path.display().to_string());
+            scenes += 1;
+        }
+    }
+    assert!(scenes >= 26, "only {scenes} scenes found");
 }
 
 #[test]
@@ -393,8 +423,8 @@ fn the_traced_shadow_falls_away_from_the_light() {
 }
 
 #[test]
-fn default_settings_trace_with_the_bvh() {
-    assert_eq!(RenderSettings::default().trace.accelerator, AccelKind::Bvh);
+fn default_settings_trace_with_the_wide_bvh() {
+    assert_eq!(RenderSettings::default().trace.accelerator, AccelKind::Wide);
 }
 
 /// The seed's simple level rule against ray cones on the showcase floor: the cone's footprint is

@@ -195,6 +195,11 @@ pub struct PreparedRay {
     /// Maps `v − origin` to the ray's frame: `x, y` across the ray (sheared so that the ray is
     /// the z axis), `z` the distance along it divided by the largest direction component.
     shear: Mat3A,
+    /// The same shear for tests that work axis by axis (the wide BVH's triangle packets):
+    /// `kx, ky, kz`, and `Sx, Sy, Sz` with `x = A[kx] − Sx·A[kz]`, `y = A[ky] − Sy·A[kz]`,
+    /// `z = Sz·A[kz]`.
+    pub(crate) axes: [usize; 3],
+    pub(crate) shear_factors: Vec3A,
 }
 
 impl PreparedRay {
@@ -225,7 +230,14 @@ impl PreparedRay {
         // for bit, since multiplying by 0 or 1 and adding 0 are exact.
         let rows = [unit(kx) - sx * unit(kz), unit(ky) - sy * unit(kz), sz * unit(kz)];
         let shear = Mat3A::from_cols(rows[0], rows[1], rows[2]).transpose();
-        Some(PreparedRay { origin, direction, inv_direction: direction.recip(), shear })
+        Some(PreparedRay {
+            origin,
+            direction,
+            inv_direction: direction.recip(),
+            shear,
+            axes: [kx, ky, kz],
+            shear_factors: Vec3A::new(sx, sy, sz),
+        })
     }
 }
 

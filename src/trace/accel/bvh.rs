@@ -57,15 +57,15 @@ pub const MAX_DEPTH: usize = 64;
 /// `C_trav / C_isect` of the SAH: a box test against a triangle test.
 const TRAVERSAL_COST: f32 = 1.0;
 /// Ize's `1 + 2γ₃`, `γ_n = nε/(1 − nε)` with ε = 2⁻²⁴.
-const ROBUST_EXIT: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON / 2.0) / (1.0 - 3.0 * f32::EPSILON / 2.0);
+pub(super) const ROBUST_EXIT: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON / 2.0) / (1.0 - 3.0 * f32::EPSILON / 2.0);
 /// Marks an analytic primitive in `Bvh::order`.
-const ANALYTIC: u32 = 1 << 31;
+pub(super) const ANALYTIC: u32 = 1 << 31;
 
 /// 32 bytes: `lo = (min, first)`, `hi = (max, count)`, with the two integers stored as f32 bits
 /// so that each half loads as one 16-byte vector.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
-struct Node {
+pub(super) struct Node {
     lo: [f32; 4],
     hi: [f32; 4],
 }
@@ -76,15 +76,20 @@ impl Node {
         Node { lo: [min.x, min.y, min.z, f32::from_bits(first)], hi: [max.x, max.y, max.z, f32::from_bits(count)] }
     }
 
+    /// The node's box, as `(min, max)`.
+    pub(super) fn bounds(&self) -> (Vec3A, Vec3A) {
+        (Vec3A::from_slice(&self.lo[..3]), Vec3A::from_slice(&self.hi[..3]))
+    }
+
     /// Left child (inner node) or first primitive (leaf).
     #[inline(always)]
-    fn first(&self) -> u32 {
+    pub(super) fn first(&self) -> u32 {
         self.lo[3].to_bits()
     }
 
     /// 0 for an inner node.
     #[inline(always)]
-    fn count(&self) -> u32 {
+    pub(super) fn count(&self) -> u32 {
         self.hi[3].to_bits()
     }
 }
@@ -137,11 +142,12 @@ impl NodeRay {
 
 /// A bounding volume hierarchy built with the binned SAH.
 pub struct Bvh {
-    nodes: Vec<Node>,
+    /// A node's children come after it, and the two children of a node are adjacent.
+    pub(super) nodes: Vec<Node>,
     /// Primitive indices in leaf order; [`ANALYTIC`] marks the non-triangles.
-    order: Vec<u32>,
+    pub(super) order: Vec<u32>,
     /// The triangles' vertices in leaf order (zeros in the slots of analytic primitives).
-    triangles: Vec<[Vec3A; 3]>,
+    pub(super) triangles: Vec<[Vec3A; 3]>,
     stats: AccelStats,
 }
 
