@@ -264,17 +264,22 @@ fn analytic_scene() -> Scene {
     scene
 }
 
-#[test]
-fn accelerators_agree_with_brute_force_on_a_triangle_soup() {
-    let mut rng = Pcg::new(1);
+/// `n` triangles of random sizes (mostly small) and orientations in the cube `[-1, 1]³`.
+fn triangle_soup(rng: &mut Pcg, n: usize) -> Vec<Primitive> {
     let cube = Aabb::new(Vec3::splat(-1.0), Vec3::ONE);
-    let prims: Vec<Primitive> = (0..3000)
+    (0..n)
         .map(|_| {
             let a = rng.in_box(&cube);
             let size = 0.02 + 0.2 * rng.f32().powi(3);
             triangle([a, a + size * rng.unit_vector(), a + size * rng.unit_vector()])
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn accelerators_agree_with_brute_force_on_a_triangle_soup() {
+    let mut rng = Pcg::new(1);
+    let prims = triangle_soup(&mut rng, 3000);
     let queries = random_queries(&mut rng, &bounds_of(&prims), 6000);
     let hits = assert_accelerators_agree("triangle soup", &prims, &queries);
     assert!(hits > 1000, "the rays should hit the soup often, got {hits} hits");
@@ -366,13 +371,7 @@ fn axis_rays(prims: &[Primitive], rng: &mut Pcg, count: usize) -> Vec<(Ray, f32,
 #[test]
 fn the_wide_bvh_finds_exactly_the_binary_bvhs_hits() {
     let mut rng = Pcg::new(8);
-    let cube = Aabb::new(Vec3::splat(-1.0), Vec3::ONE);
-    let soup: Vec<Primitive> = (0..2000)
-        .map(|_| {
-            let a = rng.in_box(&cube);
-            triangle([a, a + 0.1 * rng.unit_vector(), a + 0.1 * rng.unit_vector()])
-        })
-        .collect();
+    let soup = triangle_soup(&mut rng, 2000);
     let field = mesh_primitives(height_field(40), Mat4::IDENTITY);
     let sphere = mesh_primitives(welded_sphere(48, 24), Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0)));
     let analytic = scene_primitives(&analytic_scene());

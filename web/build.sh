@@ -24,7 +24,9 @@ target_dir=$(cargo metadata --format-version 1 --no-deps | sed 's/.*"target_dire
 # Built beside the output and moved in at the end: a failed build leaves no half-written page.
 staging=$(mktemp -d "${out%/}.partial.XXXXXX")
 trap 'rm -rf "$staging"' EXIT
+# Without the function names (1 MB; a panic's stack then shows numbers) and the producers section.
 wasm-bindgen --target web --no-typescript --out-name mirador --out-dir "$staging" \
+    --remove-name-section --remove-producers-section \
     "$target_dir/wasm32-unknown-unknown/release/mirador.wasm"
 cp web/index.html web/test.js "$staging/"
 rm -rf "$out"

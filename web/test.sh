@@ -23,15 +23,19 @@ work=$(mktemp -d)
 capture="$work/capture"
 mkdir -p "$capture"
 port=${MIRADOR_WEB_PORT:-8765}
-python3 web/serve.py --root web/dist --port "$port" --capture "$capture" &
+# Served under a sub-path, as a course site would host it (web/README.md, "Publishing the page").
+site="$work/site"
+mkdir -p "$site/course"
+cp -r web/dist "$site/course/mirador"
+python3 web/serve.py --root "$site" --port "$port" --capture "$capture" &
 server=$!
-trap 'kill $server $browser 2>/dev/null || true; rm -rf "$work/profile"' EXIT
+trap 'kill $server $browser 2>/dev/null || true; rm -rf "$work/profile" "$site"' EXIT
 sleep 1
 browser=
 xvfb-run -a -s "-screen 0 1280x900x24" chromium --no-sandbox --no-first-run --window-size=1280,800 \
     --user-data-dir="$work/profile" --enable-unsafe-webgpu --enable-features=Vulkan --use-angle=vulkan \
     --use-vulkan=swiftshader --disable-vulkan-surface --enable-logging=stderr --v=0 \
-    "http://127.0.0.1:$port/index.html?test" 2>"$work/browser.log" &
+    "http://127.0.0.1:$port/course/mirador/index.html?test" 2>"$work/browser.log" &
 browser=$!
 
 # The page posts `done` after its last screenshot, or `failed` with the reason.
@@ -47,5 +51,8 @@ if [ ! -e "$capture/done" ]; then
     [ -e "$capture/failed" ] && echo "the page said: $(cat "$capture/failed")" >&2
     exit 1
 fi
+# What the page logged of its times: the first frame (a cold load: a new browser profile, nothing
+# cached) and the traced image.
+grep -ao "first frame [0-9]* ms after the page started loading\|traced [0-9]*×[0-9]* in [0-9.]* s" "$work/browser.log" || true
 MIRADOR_WEB_CAPTURE="$capture" cargo test --locked --test web_page -- --ignored --nocapture
 echo "the page's screenshots: $capture"

@@ -71,6 +71,7 @@ pub fn start() {
         device: Rc::default(),
         running: None,
         next_frame: None,
+        first_frame_shown: false,
     });
 }
 
@@ -82,6 +83,7 @@ struct App {
     running: Option<(Screen, Viewer)>,
     /// When the last frame asked for the next one.
     next_frame: Option<Instant>,
+    first_frame_shown: bool,
 }
 
 impl App {
@@ -114,7 +116,15 @@ impl App {
         }
         viewer.push_steps(page::take_steps());
         match viewer.frame(screen) {
-            Ok(end) => self.next_frame = end.next,
+            Ok(end) => {
+                self.next_frame = end.next;
+                if !self.first_frame_shown {
+                    self.first_frame_shown = true;
+                    // From the start of the page's load: what a cold visit waits (web/README.md).
+                    let since_start = web_sys::window().and_then(|w| w.performance()).map_or(0.0, |p| p.now());
+                    log::info!("first frame {since_start:.0} ms after the page started loading");
+                }
+            }
             Err(e) => {
                 page::show_error(&format!("{e:#}"));
                 self.next_frame = None;

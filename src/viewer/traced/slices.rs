@@ -133,6 +133,8 @@ impl TracedWorker {
         if next == height {
             let radiance = RadianceImage { width, height, pixels: std::mem::take(rows) };
             let image = radiance.to_rgba8(transform);
+            // In the page's console, where web/test.sh reads it.
+            log::info!("traced {width}×{height} in {:.2} s", job.started.elapsed().as_secs_f64());
             self.updates.push(Update::Traced(frame(job.key, image.clone(), 1, job.started)));
             self.finished = Some((job.key, image));
             self.job = None;
