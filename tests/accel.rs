@@ -376,8 +376,22 @@ fn the_wide_bvh_finds_exactly_the_binary_bvhs_hits() {
     let sphere = mesh_primitives(welded_sphere(48, 24), Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0)));
     let analytic = scene_primitives(&analytic_scene());
     let showcase = scene_primitives(&Scene::load(&mirador::scene::builtin_path("showcase.toml")).unwrap());
+    // Packets with awkward lanes: triangles of zero area (a point, a segment), exact duplicates
+    // (ties in every lane), slivers, and analytic shapes mixed in among them.
+    let mut awkward = triangle_soup(&mut rng, 300);
+    for _ in 0..100 {
+        let a = rng.in_box(&Aabb::new(Vec3::splat(-1.0), Vec3::ONE));
+        let d = 0.1 * rng.unit_vector();
+        awkward.push(triangle([a, a, a]));
+        awkward.push(triangle([a, a + d, a + 2.0 * d]));
+        awkward.push(triangle([a, a + d, a + d + 1e-6 * rng.unit_vector()]));
+        let copy = awkward[rng.next_u32() as usize % awkward.len()].clone();
+        awkward.push(copy);
+    }
+    awkward.extend(scene_primitives(&analytic_scene()));
     for (name, prims) in [
         ("soup", soup),
+        ("awkward triangles", awkward),
         ("height field", field),
         ("sphere mesh", sphere),
         ("analytic", analytic),
