@@ -127,13 +127,17 @@ impl NodeRay {
         let (near, far) = if CAREFUL {
             let near = (Vec3A::select(self.negative, hi, lo) - self.origin) * self.inv_direction;
             let far = (Vec3A::select(self.negative, lo, hi) - self.origin) * self.inv_direction;
-            (near, far)
+            // 0·∞ = NaN where the origin lies on the plane of a slab the ray runs along: that
+            // slab does not bound the ray. Said outright: how `max` and `min` treat a NaN differs
+            // between SSE2 (the second operand wins), simd128 (the first) and plain floats.
+            (
+                Vec3A::select(near.is_nan_mask(), Vec3A::NEG_INFINITY, near),
+                Vec3A::select(far.is_nan_mask(), Vec3A::INFINITY, far),
+            )
         } else {
             let (a, b) = ((lo - self.origin) * self.inv_direction, (hi - self.origin) * self.inv_direction);
             (a.min(b), a.max(b))
         };
-        // `max(x, t_min)` with x first: where x is NaN (0·∞, the origin on a slab plane of a
-        // ray parallel to it) the lane takes t_min, i.e. that slab does not constrain the ray.
         let enter = near.max(Vec3A::splat(t_min)).max_element();
         let exit = (far * ROBUST_EXIT).min(Vec3A::splat(t_max)).min_element();
         if enter <= exit { enter } else { f32::INFINITY }

@@ -1,6 +1,7 @@
 //! Wide BVH: the teaching BVH collapsed into nodes of eight children, each tested with SIMD.
 //!
-//! The binary BVH ([`super::bvh`]) is the one the course describes; this one finds the same hits
+//! Seed 003 builds the BVH of the notes, and [`super::bvh`] is that one, binary, as the course
+//! describes it (chapter 9). This one finds the same hits
 //! faster, the way production tracers (Embree, tinybvh) do, and is the tracer's default. A CPU's
 //! vector registers hold 4 numbers (SSE, WebAssembly's `simd128`) or 8 (AVX), and one
 //! instruction works on all of them: testing eight boxes costs about what testing one does, if
@@ -15,7 +16,8 @@
 //!   eight `min.x`, then the eight `min.y`, and so on, so that one load reads one plane of every
 //!   box. A ray enters a box through the planes its direction faces, chosen once per ray, so the
 //!   slab test needs no `min`/`max` per plane.
-//! - **Leaves as packets.** A subtree of at most eight primitives becomes one leaf, and a leaf's
+//! - **Leaves as packets.** A subtree of at most eight triangles becomes one leaf (a binary leaf
+//!   made at the depth limit may hold more; an analytic primitive keeps a leaf of its own), and a leaf's
 //!   triangles are stored in packets of four, coordinates lane by lane, tested together by the
 //!   watertight test (Woop et al.) that the binary BVH runs on one. Every lane does the same
 //!   operations in the same order, so each hit distance is the same to the last bit.
@@ -24,13 +26,17 @@
 //!   ray's far bound early. Shadow rays (`occluded`) stop at any hit and skip the sort.
 //! - **Dispatch at run time.** The eight-box test runs as one AVX operation per step on a CPU
 //!   that has AVX (checked once, when the tree is built), else as two four-wide halves (SSE2 on
-//!   every x86-64, `simd128` in the page, plain floats elsewhere).
+//!   every x86-64, `simd128` in the page, NEON on ARM).
 //!
-//! Both BVHs return the exact nearest hit, and their box tests are conservative (Ize's bound), so
-//! they draw the same image; `tests/accel.rs` checks their hits on random rays and
-//! `tests/trace.rs` their images of every scene. One freedom remains: two primitives hit at the
-//! same distance (a vertex shared by two triangles) may be found in either order, since both
-//! trees skip a box whose entry distance rounds past the nearest hit so far.
+//! Both BVHs return the nearest hit, and their box tests are conservative (Ize's bound), so they
+//! draw the same image; `tests/accel.rs` checks their hits on random rays and `tests/trace.rs`
+//! their images of every scene. One freedom remains: two primitives hit at the same distance (a
+//! vertex shared by two triangles), or within a few units in the last place, may be found in
+//! either order, since both trees skip a box whose entry distance rounds past the nearest hit so
+//! far, and they meet the boxes in different orders.
+//!
+//! Limits: analytic primitives (spheres, tori, SDFs) are never grouped into packets; a leaf the
+//! binary tree made at its depth limit becomes a leaf of as many packets as it needs.
 //!
 //! **What it buys** (`cargo bench --bench trace`, a million triangles, one thread): primary rays
 //! 1.65× and shadow rays 2.6× as fast as the binary BVH. The walk from the root to a leaf
@@ -59,11 +65,12 @@ pub const PACKET: usize = 4;
 pub const LEAF_SIZE: usize = 2 * PACKET;
 /// Marks a child that is a leaf: the rest of the `u32` is its first packet.
 const LEAF: u32 = 1 << 31;
-/// Traversal stacks: the small one serves every tree whose deepest path pushes at most this many
-/// entries (the million-triangle benchmark mesh needs 58); deeper trees use [`LARGE_STACK`].
+/// Traversal stacks: the small one serves every tree whose traversal can hold at most this many
+/// entries ([`stack_bound`]; the million-triangle benchmark mesh needs 68); deeper trees use
+/// [`LARGE_STACK`].
 const SMALL_STACK: usize = 96;
-/// Enough for any tree: the binary tree is at most 64 deep, so a path visits at most 64 nodes,
-/// each pushing at most seven.
+/// Enough for any tree: the binary tree is at most 64 deep, so a path visits at most 63 inner
+/// nodes, each leaving at most seven entries pushed.
 const LARGE_STACK: usize = 64 * (WIDTH - 1);
 
 /// Eight children's boxes, plane by plane, and what each child is. 224 bytes.
@@ -120,7 +127,10 @@ impl BoxRay {
 /// Which of a node's eight boxes a ray enters within `(t_min, t_max)`, and where.
 trait BoxTest {
     /// Bit `i` set where the ray enters child `i`'s box, and the entry distances.
-    fn enter<const CAREFUL: bool>(node: &Node, ray: &BoxRay, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]);
+    ///
+    /// # Safety
+    /// The CPU must have the instructions the implementation uses ([`Avx`]: AVX).
+    unsafe fn enter<const CAREFUL: bool>(node: &Node, ray: &BoxRay, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]);
 }
 
 /// The eight boxes as two halves of four: SSE2 on x86-64, `simd128` in the page.
@@ -128,7 +138,7 @@ struct Halves;
 
 impl BoxTest for Halves {
     #[inline(always)]
-    fn enter<const CAREFUL: bool>(node: &Node, ray: &BoxRay, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
+    unsafe fn enter<const CAREFUL: bool>(node: &Node, ray: &BoxRay, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
         let mut entries = [0.0; WIDTH];
         let mut mask = 0;
         for half in 0..2 {
@@ -159,9 +169,9 @@ struct Avx;
 #[cfg(target_arch = "x86_64")]
 impl BoxTest for Avx {
     #[inline(always)]
-    fn enter<const CAREFUL: bool>(node: &Node, ray: &BoxRay, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
+    unsafe fn enter<const CAREFUL: bool>(node: &Node, ray: &BoxRay, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
         use std::arch::x86_64::*;
-        // SAFETY: only reached through `Wide::run_avx`, which runs only where the CPU has AVX.
+        // SAFETY: the caller's promise, that the CPU has AVX.
         unsafe {
             let lanes = |v: [Vec4; 2]| bytemuck::cast::<[Vec4; 2], __m256>(v);
             let splat = |v: Vec4| _mm256_set1_ps(v.x);
@@ -235,7 +245,9 @@ impl Packet {
     ///
     /// Each line is [`crate::trace::geometry`]'s `watertight` with a lane per triangle: the
     /// shear's rows `A[kx] − Sx·A[kz]` (its matrix adds only exact zeros and products by one),
-    /// the three edge functions, their signs, `det` and `T` summed in the same order.
+    /// the three edge functions, their signs, `det` and `T` summed in the same order. (One
+    /// exception, beyond any scene: where `v − origin` overflows to ∞, the matrix's `0·∞` makes
+    /// the scalar test's lane NaN, a miss, while this one skips the term.)
     #[inline(always)]
     fn hits(&self, ray: &PacketRay, t_min: f32, t_max: f32) -> (u32, Vec4, u32) {
         let [kx, ky, kz] = ray.axes;
@@ -273,7 +285,7 @@ pub struct Wide {
     stats: AccelStats,
 }
 
-/// The binary tree's node `index` as a child: its box, and whether it is opened further.
+/// What collapsing the binary tree reads of it: its nodes, and each node's primitives.
 struct Collapse<'a> {
     bvh: &'a Bvh,
     /// Each binary node's primitives in leaf order: a subtree's are contiguous.
@@ -357,8 +369,11 @@ impl Wide {
         // (wide node, binary node it is made of, level); the root wide node holds the binary root
         // as its only child when that is already a leaf.
         let mut work = Vec::new();
+        // How many children each node has.
+        let mut used: Vec<usize> = Vec::new();
         if !binary.is_empty() {
             nodes.push(Node::EMPTY);
+            used.push(0);
             work.push((0usize, 0usize, 0usize));
         }
         while let Some((wide, index, level)) = work.pop() {
@@ -376,12 +391,17 @@ impl Wide {
                 } else {
                     node.child[slot] = nodes.len() as u32;
                     nodes.push(Node::EMPTY);
+                    used.push(0);
                     work.push((nodes.len() - 1, child, level + 1));
                 }
             }
             nodes[wide] = node;
+            used[wide] = children.len();
         }
-        let stack_bound = stack_bound(&nodes);
+        let stack_bound = stack_bound(&nodes, &used);
+        // A path visits at most 63 inner nodes (the binary tree is at most 64 deep), each leaving
+        // at most seven pushed: 442 entries and the one popped.
+        assert!(stack_bound <= LARGE_STACK, "a wide BVH whose traversal needs {stack_bound} stack entries");
         let avx = avx && avx_available();
         let stats = AccelStats {
             name: if avx { "wide bvh (8-wide, AVX)" } else { "wide bvh (8-wide, 2 × 4 lanes)" },
@@ -412,11 +432,14 @@ impl Wide {
             // SAFETY: `avx` is set only where the CPU reports AVX.
             return unsafe { self.run_avx::<ANY>(&query, careful, small) };
         }
-        match (careful, small) {
-            (false, true) => self.traverse::<Halves, ANY, false, SMALL_STACK>(&query),
-            (true, true) => self.traverse::<Halves, ANY, true, SMALL_STACK>(&query),
-            (false, false) => self.traverse::<Halves, ANY, false, LARGE_STACK>(&query),
-            (true, false) => self.traverse::<Halves, ANY, true, LARGE_STACK>(&query),
+        // SAFETY: `Halves` uses what every target has (SSE2 on x86-64).
+        unsafe {
+            match (careful, small) {
+                (false, true) => self.traverse::<Halves, ANY, false, SMALL_STACK>(&query),
+                (true, true) => self.traverse::<Halves, ANY, true, SMALL_STACK>(&query),
+                (false, false) => self.traverse::<Halves, ANY, false, LARGE_STACK>(&query),
+                (true, false) => self.traverse::<Halves, ANY, true, LARGE_STACK>(&query),
+            }
         }
     }
 
@@ -424,17 +447,23 @@ impl Wide {
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     fn run_avx<const ANY: bool>(&self, query: &Query, careful: bool, small: bool) -> Option<Hit> {
-        match (careful, small) {
-            (false, true) => self.traverse::<Avx, ANY, false, SMALL_STACK>(query),
-            (true, true) => self.traverse::<Avx, ANY, true, SMALL_STACK>(query),
-            (false, false) => self.traverse::<Avx, ANY, false, LARGE_STACK>(query),
-            (true, false) => self.traverse::<Avx, ANY, true, LARGE_STACK>(query),
+        // SAFETY: this function runs only where the CPU has AVX (its callers check).
+        unsafe {
+            match (careful, small) {
+                (false, true) => self.traverse::<Avx, ANY, false, SMALL_STACK>(query),
+                (true, true) => self.traverse::<Avx, ANY, true, SMALL_STACK>(query),
+                (false, false) => self.traverse::<Avx, ANY, false, LARGE_STACK>(query),
+                (true, false) => self.traverse::<Avx, ANY, true, LARGE_STACK>(query),
+            }
         }
     }
 
     /// Nearest-first traversal with an explicit stack of (child, entry distance).
+    ///
+    /// # Safety
+    /// The CPU must have what `B`'s box test uses.
     #[inline(always)]
-    fn traverse<B: BoxTest, const ANY: bool, const CAREFUL: bool, const STACK: usize>(
+    unsafe fn traverse<B: BoxTest, const ANY: bool, const CAREFUL: bool, const STACK: usize>(
         &self,
         query: &Query,
     ) -> Option<Hit> {
@@ -447,7 +476,8 @@ impl Wide {
         loop {
             if current & LEAF == 0 {
                 let node = &self.nodes[current as usize];
-                let (mut mask, entries) = B::enter::<CAREFUL>(node, &box_ray, t_min, t_max);
+                // SAFETY: the caller's promise about `B`.
+                let (mut mask, entries) = unsafe { B::enter::<CAREFUL>(node, &box_ray, t_min, t_max) };
                 let child = |i: usize| (node.child[i], entries[i]);
                 if mask != 0 {
                     let first = mask.trailing_zeros() as usize;
@@ -475,7 +505,7 @@ impl Wide {
                         mask &= mask - 1;
                         stack.push_sorted::<ANY>(base, child(i));
                     }
-                    current = stack.pop().map_or(0, |(child, _)| child);
+                    current = stack.pop().expect("three children were just pushed").0;
                     continue;
                 }
             } else if let Some(hit) = self.leaf::<ANY>(current & !LEAF, query, &packet_ray, &mut best, &mut t_max) {
@@ -537,8 +567,8 @@ impl Wide {
     }
 }
 
-/// The traversal's stack of `(child, entry distance)`, left uninitialized: zeroing its 96
-/// entries for every ray cost 7 % of a primary ray's time.
+/// The traversal's stack of `(child, entry distance)`, left uninitialized: zeroing its
+/// [`SMALL_STACK`] entries for every ray cost 7 % of a primary ray's time.
 struct Stack<const N: usize> {
     items: [MaybeUninit<(u32, f32)>; N],
     /// `items[..len]` are written.
@@ -621,9 +651,9 @@ impl Node {
 /// Appends the packets of the leaf holding the binary tree's primitives `range` (leaf order).
 fn push_packets(packets: &mut Vec<Packet>, bvh: &Bvh, range: std::ops::Range<usize>) {
     let first = packets.len();
-    for chunk in range.collect::<Vec<_>>().chunks(PACKET) {
+    for start in range.clone().step_by(PACKET) {
         let mut packet = Packet { more: true, ..Packet::EMPTY };
-        for (lane, &k) in chunk.iter().enumerate() {
+        for (lane, k) in (start..(start + PACKET).min(range.end)).enumerate() {
             let entry = bvh.order[k];
             packet.primitives[lane] = entry & !ANALYTIC;
             if entry & ANALYTIC != 0 {
@@ -644,18 +674,20 @@ fn push_packets(packets: &mut Vec<Packet>, bvh: &Bvh, range: std::ops::Range<usi
     }
 }
 
-/// The most stack entries a traversal can hold: along any path, each node pushes at most one
-/// fewer than its children. Children come after their parent, so a backward sweep sees them
-/// first.
-fn stack_bound(nodes: &[Node]) -> usize {
-    let mut bound = vec![0usize; nodes.len()];
+/// The most entries a traversal's stack can hold, from each node's number of children (`used`).
+/// A node that enters `k` children pushes all of them and pops the nearest: `k` at once, and
+/// `k − 1` left while the walk is below it. So a node needs `max(k, k − 1 + its deepest child's
+/// need)`, at worst with every child entered. (The traversal pushes one fewer for one or two
+/// children entered; the bound does not count that saving.) Children come after their parent, so
+/// a backward sweep sees them first.
+fn stack_bound(nodes: &[Node], used: &[usize]) -> usize {
+    let mut need = vec![0usize; nodes.len()];
     for i in (0..nodes.len()).rev() {
         let node = &nodes[i];
-        let used = (0..WIDTH).filter(|&s| node.planes[0][s / 4][s % 4] != f32::INFINITY).count();
-        let deepest = (0..used).filter(|&s| node.child[s] & LEAF == 0).map(|s| bound[node.child[s] as usize]).max();
-        bound[i] = used.saturating_sub(1) + deepest.unwrap_or(0);
+        let deepest = (0..used[i]).filter(|&s| node.child[s] & LEAF == 0).map(|s| need[node.child[s] as usize]).max();
+        need[i] = used[i].saturating_sub(1) + deepest.unwrap_or(0).max(1);
     }
-    bound.first().copied().unwrap_or(0)
+    need.first().copied().unwrap_or(0)
 }
 
 fn avx_available() -> bool {
@@ -680,5 +712,81 @@ impl Accelerator for Wide {
 
     fn stats(&self) -> AccelStats {
         self.stats.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Vec2, Vec3};
+
+    use super::*;
+    use crate::base::MaterialId;
+    use crate::trace::geometry::Triangle;
+
+    fn triangles(corners: impl Iterator<Item = [Vec3; 3]>) -> Vec<Primitive> {
+        corners
+            .map(|positions| {
+                Primitive::Triangle(Triangle {
+                    positions,
+                    normals: [Vec3::Z; 3],
+                    uvs: [Vec2::ZERO; 3],
+                    object: 0,
+                    material: MaterialId(0),
+                })
+            })
+            .collect()
+    }
+
+    /// The stack's highest over walks that enter every child of every node, pushing and popping
+    /// as [`Wide::traverse`] does, each walk visiting the children in a random order (which is
+    /// nearest depends on the ray).
+    fn every_child_entered(wide: &Wide, walks: u32) -> usize {
+        let used = |node: &Node| (0..WIDTH).filter(|&s| node.planes[0][s / 4][s % 4] != f32::INFINITY).count();
+        let mut seed = 1u64;
+        let mut random = move |n: usize| {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 33) as usize % n
+        };
+        let mut peak = 0;
+        for _ in 0..walks {
+            let (mut stack, mut current) = (Vec::new(), Some(0u32));
+            while let Some(child) = current {
+                current = stack.pop();
+                if child & LEAF != 0 {
+                    continue;
+                }
+                if let Some(popped) = current {
+                    stack.push(popped);
+                }
+                let node = &wide.nodes[child as usize];
+                let mut children = node.child[..used(node)].to_vec();
+                for i in (1..children.len()).rev() {
+                    children.swap(i, random(i + 1));
+                }
+                stack.extend_from_slice(&children);
+                peak = peak.max(stack.len());
+                current = stack.pop();
+            }
+        }
+        peak
+    }
+
+    #[test]
+    fn the_stack_bound_covers_a_walk_that_enters_every_child() {
+        let grid = triangles((0..40 * 40).map(|i| {
+            let p = Vec3::new((i % 40) as f32, (i / 40) as f32, ((i * 7) % 5) as f32);
+            [p, p + Vec3::X, p + Vec3::Y]
+        }));
+        // Each triangle half the size of the last, nested toward the origin: a deep, lopsided tree.
+        let nested = triangles((0..60).map(|i| {
+            let s = 0.5f32.powi(i);
+            [Vec3::new(s, 0.0, 0.0), Vec3::new(0.0, s, 0.0), Vec3::new(s, s, s)]
+        }));
+        for (name, prims) in [("grid", grid), ("nested", nested)] {
+            let wide = Wide::build(&prims);
+            let peak = every_child_entered(&wide, 20_000);
+            // Never above the bound, and the bound is reached: it is exact.
+            assert_eq!(peak, wide.stack_bound, "{name}: the walks' peak against the bound");
+        }
     }
 }
