@@ -269,6 +269,7 @@ fn what_a_lab_routes_by_hand_draws_what_the_fixed_function_draws() {
     let gpu = common::gpu();
     let sorted = |sort: &str| vec![format!("transparency.sort=\"{sort}\"")];
     for (name, scene, set, bound) in [
+        // Measured 0.0054: lavapipe's texel fetch, not the route (docs/architecture.md, "The lab's seam").
         ("mipmaps", None, vec![], 0.02),
         ("shadow-map", None, vec!["shadows.filter=\"none\"".to_owned()], 0.01),
         ("planar-mirrors", None, vec!["mirrors.depth=1".to_owned()], 0.01),
