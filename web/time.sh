@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# Times the page: `bash web/time.sh [DIST] [RUNS]` loads DIST/index.html?test (default web/dist,
+# built by web/build.sh) RUNS times (default 3) in Chromium with WebGPU on SwiftShader under Xvfb,
+# each time with a new browser profile (a cold visit: nothing cached), served from localhost
+# under a sub-path. It prints, per run, what the page logs to its console: the first frame's time
+# from the start of the page's load, and the traced showcase's time. Compare two builds by
+# running it on each in turn (web/README.md, "What a visit downloads, and how soon it draws").
+set -euo pipefail
+cd "$(dirname "$0")/.."
+dist=${1:-web/dist}
+runs=${2:-3}
+port=${MIRADOR_WEB_PORT:-8766}
+if [ ! -f "$dist/index.html" ]; then
+    echo "$dist/ is not a built page: run bash web/build.sh first" >&2
+    exit 1
+fi
+command -v chromium >/dev/null && command -v xvfb-run >/dev/null || {
+    echo "needs chromium and xvfb (bash web/test.sh installs them)" >&2
+    exit 1
+}
+for run in $(seq "$runs"); do
+    work=$(mktemp -d)
+    mkdir -p "$work/site/course" "$work/capture"
+    cp -r "$dist" "$work/site/course/mirador"
+    python3 web/serve.py --root "$work/site" --port "$port" --capture "$work/capture" >/dev/null &
+    server=$!
+    sleep 1
+    xvfb-run -a -s "-screen 0 1280x900x24" chromium --no-sandbox --no-first-run --window-size=1280,800 \
+        --user-data-dir="$work/profile" --enable-unsafe-webgpu --enable-features=Vulkan --use-angle=vulkan \
+        --use-vulkan=swiftshader --disable-vulkan-surface --enable-logging=stderr --v=0 \
+        "http://127.0.0.1:$port/course/mirador/index.html?test" 2>"$work/browser.log" &
+    browser=$!
+    for _ in $(seq 180); do
+        [ -e "$work/capture/done" ] || [ -e "$work/capture/failed" ] && break
+        sleep 1
+    done
+    pkill -P $browser 2>/dev/null || true
+    kill $browser $server 2>/dev/null || true
+    wait $server 2>/dev/null || true
+    first=$(grep -ao "first frame [0-9]* ms" "$work/browser.log" | head -1 || true)
+    traced=$(grep -ao "traced [0-9]*×[0-9]* in [0-9.]* s" "$work/browser.log" | head -1 || true)
+    echo "run $run: ${first:-no first frame logged}; ${traced:-no traced image logged}"
+    rm -rf "$work"
+done
