@@ -26,5 +26,5 @@ impl Ray {
 pub struct MaterialId(pub usize);
 
 /// Index into [`crate::scene::Scene::textures`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct TextureId(pub usize);

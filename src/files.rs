@@ -71,7 +71,7 @@ pub fn check_regular(path: &Path) -> io::Result<()> {
 }
 
 #[cfg(target_arch = "wasm32")]
-pub use in_memory::{add, check_regular, open};
+pub use in_memory::{add, check_regular, open, opened};
 
 /// Whether `path` is not there at all: what a model's importer may warn about and draw without
 /// (a file that is there but is no regular file, or cannot be read, is an error of its reader).
@@ -166,6 +166,21 @@ mod in_memory {
             }
         }
         out
+    }
+
+    /// The files the person opened, by their names under `opened/`: what the page's tracer
+    /// workers need besides the built-in assets.
+    pub fn opened() -> Vec<(String, Vec<u8>)> {
+        FILES.with(|files| {
+            files
+                .borrow()
+                .iter()
+                .filter_map(|(path, bytes)| {
+                    let name = path.strip_prefix("opened").ok()?;
+                    Some((name.to_string_lossy().into_owned(), bytes.to_vec()))
+                })
+                .collect()
+        })
     }
 
     /// Adds (or replaces) a file.

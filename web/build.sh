@@ -28,7 +28,7 @@ trap 'rm -rf "$staging"' EXIT
 wasm-bindgen --target web --no-typescript --out-name mirador --out-dir "$staging" \
     --remove-name-section --remove-producers-section \
     "$target_dir/wasm32-unknown-unknown/release/mirador.wasm"
-cp web/index.html web/test.js "$staging/"
+cp web/index.html web/test.js web/tracer.js "$staging/"
 rm -rf "$out"
 mv "$staging" "$out"
 trap - EXIT

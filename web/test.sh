@@ -53,6 +53,6 @@ if [ ! -e "$capture/done" ]; then
 fi
 # What the page logged of its times: the first frame (a cold load: a new browser profile, nothing
 # cached) and the traced image.
-grep -ao "first frame [0-9]* ms after the page started loading\|traced [0-9]*×[0-9]* in [0-9.]* s" "$work/browser.log" || true
+grep -ao "first frame [0-9]* ms after the page started loading\|traced [0-9]*×[0-9]* in [0-9.]* s ([a-z ]*)" "$work/browser.log" || true
 MIRADOR_WEB_CAPTURE="$capture" cargo test --locked --test web_page -- --ignored --nocapture
 echo "the page's screenshots: $capture"

@@ -38,7 +38,7 @@ for run in $(seq "$runs"); do
     kill $browser $server 2>/dev/null || true
     wait $server 2>/dev/null || true
     first=$(grep -ao "first frame [0-9]* ms" "$work/browser.log" | head -1 || true)
-    traced=$(grep -ao "traced [0-9]*×[0-9]* in [0-9.]* s" "$work/browser.log" | head -1 || true)
+    traced=$(grep -ao "traced [0-9]*×[0-9]* in [0-9.]* s[^\"]*" "$work/browser.log" | head -1 || true)
     echo "run $run: ${first:-no first frame logged}; ${traced:-no traced image logged}"
     rm -rf "$work"
 done

@@ -39,7 +39,7 @@ pub enum Projection {
 }
 
 /// A pinhole (or orthographic) camera in the course's terms.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Camera {
     pub eye: Vec3,
     pub center: Vec3,

@@ -47,7 +47,7 @@ impl Attenuation {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum LightKind {
     /// Radiates equally in all directions from `position`.
     Point { position: Vec3 },
@@ -58,7 +58,9 @@ pub enum LightKind {
     Spot { position: Vec3, direction: Vec3, inner: f32, outer: f32 },
 }
 
-#[derive(Clone, Debug, PartialEq)]
+/// Serializable for the page's tracer workers, which receive the lights as the viewer has edited
+/// them.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Light {
     pub name: String,
     pub kind: LightKind,

@@ -28,7 +28,7 @@ pub struct Texture {
 
 /// How texture coordinates outside [0, 1] are brought back into the image, per axis (glTF's
 /// `wrapS` / `wrapT`; the GPU sampler's address modes).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Wrap {
     #[default]
     Repeat,
@@ -54,7 +54,7 @@ impl Wrap {
 
 /// A height field given by a formula rather than an image (docs/course/04-bump-mapping.md), with closed-form
 /// derivatives so finite differences can be compared with them.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum ProceduralHeight {
     /// `a·sin(2π·f_u·u)·sin(2π·f_v·v)`.
     Sine { frequency: Vec2, amplitude: f32 },
@@ -65,7 +65,7 @@ pub enum ProceduralHeight {
 
 /// How a material's coverage `α` is read (glTF's `alphaMode`). `α` is [`Material::alpha`] times
 /// the colour texture's alpha where there is a texture.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum AlphaMode {
     /// `α` is ignored: the surface covers all of its area.
     #[default]
@@ -85,7 +85,9 @@ impl AlphaMode {
 
 /// One material of the model
 /// `ME + AG + Σ V·S·(ka·C + kd·C·max(0, n·l) + ks·S·max(0, r·v)^e) + kps·MPS·L(r) + kt·MT·L(t)`.
-#[derive(Clone, Debug, PartialEq)]
+/// Serializable whole for the page's tracer workers (`src/web/tracer.rs`), which receive the
+/// materials as the viewer has edited them.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Material {
     pub name: String,
     /// `C`: linear RGB surface colour, multiplied by `texture` where there is one.

@@ -646,7 +646,7 @@ impl Viewer {
         let (camera, settings, _, _) = self.request.as_ref().expect("set just above");
         let mut scene = self.scene.scene.clone();
         scene.camera = camera.clone();
-        self.traced.worker.trace(self.key, &scene, settings);
+        self.traced.worker.trace(self.key, &scene, &self.scene.overrides, settings);
         if self.view.mode == ViewMode::Difference
             && full_resolution
             && !self.traced.worker.compared(self.key)

@@ -14,6 +14,7 @@
 //! - No configuration file is remembered, and the scene is not watched for changes.
 
 mod page;
+pub mod tracer;
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -55,6 +56,10 @@ pub fn start() {
     let _ = log::set_logger(&page::CONSOLE).map(|()| log::set_max_level(log::LevelFilter::Info));
     for (path, bytes) in crate::files::builtin_bytes() {
         crate::files::add(std::path::Path::new(path), bytes.to_vec());
+    }
+    // A tracer worker (web/tracer.js) has no window: it traces, and draws nothing.
+    if web_sys::window().is_none() {
+        return;
     }
     let event_loop = match EventLoop::<Wake>::with_user_event().build() {
         Ok(event_loop) => event_loop,

@@ -13,9 +13,12 @@
 //!
 //! - [`thread`] (native): one worker thread with a rayon pool of all cores but one (the other
 //!   keeps the rasterizer and the UI responsive), cancelled within a tile.
-//! - [`slices`] (the browser, which has one thread): the same work in slices of a few
-//!   milliseconds between frames; the page asks for frames while work is left.
+//! - [`slices`] (the browser, which gives a page one thread): the progressive levels in slices of
+//!   a few milliseconds between frames; the full image in rows handed to [`pool`]'s Web Workers,
+//!   one a core, or in slices where there are none. The page asks for frames while work is left.
 
+#[cfg(target_arch = "wasm32")]
+mod pool;
 #[cfg(target_arch = "wasm32")]
 mod slices;
 #[cfg(not(target_arch = "wasm32"))]
@@ -25,6 +28,10 @@ use std::time::Duration;
 
 use image::RgbaImage;
 
+#[cfg(target_arch = "wasm32")]
+pub(crate) use pool::SceneRecipe;
+#[cfg(target_arch = "wasm32")]
+pub(crate) use slices::OwnedTracer;
 #[cfg(target_arch = "wasm32")]
 pub use slices::TracedWorker;
 #[cfg(not(target_arch = "wasm32"))]

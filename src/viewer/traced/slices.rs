@@ -1,8 +1,9 @@
-//! The traced image in the browser, which gives a page one thread: the worker's work done in
-//! slices of [`SLICE`] between frames, on the page's thread. The progressive levels come first,
-//! one level a slice; then the full image a few rows at a time ([`Tracer::render_rows`], the rows
-//! `Tracer::render` would trace), shown as it goes over the last progressive level. The window asks
-//! for the next frame while [`TracedWorker::busy`].
+//! The traced image in the browser, which gives a page one thread: the progressive levels come
+//! first, one level a slice of [`SLICE`] between frames on the page's thread. Then the full image
+//! ([`Tracer::render_rows`], the rows `Tracer::render` would trace), shown as it goes over the
+//! last progressive level: in bands handed to Web Workers, one a core ([`super::pool`]), or where
+//! the browser gives none, a few rows a slice on the page's thread. The window asks for the next
+//! frame while [`TracedWorker::busy`].
 
 use std::time::Duration;
 
@@ -10,6 +11,7 @@ use glam::Vec3;
 use image::RgbaImage;
 use web_time::Instant;
 
+use super::pool::{BAND, Pool, SceneRecipe};
 use super::{DifferenceFrame, LAST_BLOCK, START_BLOCK, TracedFrame, Update, compare_ready};
 use crate::output::OutputTransform;
 use crate::trace::{Progressive, RadianceImage, Tracer};
@@ -22,8 +24,9 @@ const SLICE: Duration = Duration::from_millis(30);
 const SHOW_EVERY: Duration = Duration::from_millis(300);
 
 self_cell::self_cell!(
-    /// A tracer and the scene and settings it reads, kept together between slices.
-    struct OwnedTracer {
+    /// A tracer and the scene and settings it reads, kept together between slices (and in the
+    /// page's tracer workers, `src/web/tracer.rs`).
+    pub(crate) struct OwnedTracer {
         owner: Box<(Scene, RenderSettings)>,
         #[covariant]
         dependent: Tracer,
@@ -34,16 +37,36 @@ self_cell::self_cell!(
 struct Job {
     key: u64,
     tracer: OwnedTracer,
+    /// The request for the workers (JSON of [`SceneRecipe`]).
+    recipe: String,
     progressive: Progressive,
-    /// The full image's rows traced so far (`None` while progressive levels remain).
-    rows: Option<Vec<Vec3>>,
+    /// The full image in progress (`None` while progressive levels remain).
+    full: Option<Full>,
     started: Instant,
     shown: Instant,
+}
+
+/// The full image in progress.
+struct Full {
+    /// The rows received so far over the last progressive level.
+    pixels: Vec<Vec3>,
+    /// That level's block size.
+    below: u32,
+    /// How many rows were received.
+    received: u32,
+    /// The first row not yet handed out (or traced).
+    next: u32,
+    /// Whether the workers were given the job.
+    given: bool,
 }
 
 /// The window's handle on the tracer: the same calls as the native worker thread's.
 pub struct TracedWorker {
     job: Option<Job>,
+    /// The workers, from the first request on; `None` after they fail, or where the browser gives
+    /// none.
+    pool: Option<Pool>,
+    pool_tried: bool,
     updates: Vec<Update>,
     compared: Option<u64>,
     raster: Option<(u64, RgbaImage)>,
@@ -54,11 +77,20 @@ impl TracedWorker {
     /// Nothing runs beside the page: `wake` is not needed, frames are asked for while
     /// [`TracedWorker::busy`].
     pub fn start(_wake: impl Fn() + Send + 'static) -> TracedWorker {
-        TracedWorker { job: None, updates: Vec::new(), compared: None, raster: None, finished: None }
+        TracedWorker {
+            job: None,
+            pool: None,
+            pool_tried: false,
+            updates: Vec::new(),
+            compared: None,
+            raster: None,
+            finished: None,
+        }
     }
 
-    /// Makes sure request `key` is being traced: a new key drops the previous request.
-    pub fn trace(&mut self, key: u64, scene: &Scene, settings: &RenderSettings) {
+    /// Makes sure request `key` is being traced: a new key drops the previous request. `overrides`
+    /// are the values set over the scene file's, which the workers apply again.
+    pub fn trace(&mut self, key: u64, scene: &Scene, overrides: &[String], settings: &RenderSettings) {
         if self.job.as_ref().is_some_and(|job| job.key == key) || self.finished.as_ref().is_some_and(|(k, _)| *k == key)
         {
             return;
@@ -66,8 +98,14 @@ impl TracedWorker {
         let tracer =
             OwnedTracer::new(Box::new((scene.clone(), settings.clone())), |owned| Tracer::new(&owned.0, &owned.1));
         let progressive = tracer.with_dependent(|_, tracer| Progressive::new(tracer, START_BLOCK));
+        // The workers start with the first request, and load while the progressive levels run.
+        if !self.pool_tried {
+            self.pool_tried = true;
+            self.pool = Pool::start();
+        }
+        let recipe = serde_json::to_string(&SceneRecipe::of(scene, overrides, settings)).unwrap_or_default();
         let now = Instant::now();
-        self.job = Some(Job { key, tracer, progressive, rows: None, started: now, shown: now });
+        self.job = Some(Job { key, tracer, recipe, progressive, full: None, started: now, shown: now });
     }
 
     /// Stops the current request (the view no longer shows traced images).
@@ -96,9 +134,8 @@ impl TracedWorker {
     /// last call.
     pub fn poll(&mut self) -> (Option<TracedFrame>, Option<DifferenceFrame>) {
         let deadline = Instant::now() + SLICE;
-        while Instant::now() < deadline && self.job.is_some() {
-            self.work();
-        }
+        // The workers' bands arrive between frames: with them at work, one step a frame.
+        while Instant::now() < deadline && self.job.is_some() && !self.work() {}
         if let Some(frame) = compare_ready(&mut self.raster, &self.finished) {
             self.updates.push(Update::Difference(frame));
         }
@@ -112,40 +149,76 @@ impl TracedWorker {
         (traced, difference)
     }
 
-    /// One step of the current job: a progressive level, or a few rows of the full image.
-    fn work(&mut self) {
-        let Some(job) = &mut self.job else { return };
+    /// One step of the current job: a progressive level, or the full image's next rows from the
+    /// workers or from this thread. Returns whether the workers have it, so the frame should not
+    /// wait for them.
+    fn work(&mut self) -> bool {
+        let Some(job) = &mut self.job else { return false };
         let transform = OutputTransform::of(&job.tracer.borrow_owner().1);
         let (width, height) = (job.progressive.image().width, job.progressive.image().height);
-        let Some(rows) = &mut job.rows else {
+        let Some(full) = &mut job.full else {
             let progressive = &mut job.progressive;
             let block = job.tracer.with_dependent(|_, tracer| progressive.refine(tracer)).unwrap_or(1);
             let image = progressive.image().to_rgba8(transform);
             self.updates.push(Update::Traced(frame(job.key, image, block, job.started)));
-            if block <= LAST_BLOCK {
-                job.rows = Some(Vec::with_capacity((width * height) as usize));
+            // With workers the full image comes soon: one coarse level to show meanwhile.
+            if block <= LAST_BLOCK || self.pool.is_some() {
+                let pixels = progressive.image().pixels.clone();
+                job.full = Some(Full { pixels, below: block, received: 0, next: 0, given: false });
             }
-            return;
+            return false;
         };
-        let done = rows.len() as u32 / width.max(1);
-        let next = (done + 4).min(height);
-        rows.extend(job.tracer.with_dependent(|_, tracer| tracer.render_rows(done..next).0));
-        if next == height {
-            let radiance = RadianceImage { width, height, pixels: std::mem::take(rows) };
+        let row = |y: u32| (y * width) as usize;
+        let by_workers = match &self.pool {
+            Some(pool) => {
+                if !full.given {
+                    pool.job(job.key, &job.recipe, &crate::files::opened());
+                    full.given = true;
+                }
+                for band in pool.bands().into_iter().filter(|band| band.key == job.key) {
+                    let start = row(band.first);
+                    full.pixels[start..start + band.pixels.len()].copy_from_slice(&band.pixels);
+                    full.received += band.pixels.len() as u32 / width.max(1);
+                }
+                while full.next < height && pool.ask(job.key, full.next, (full.next + BAND).min(height)) {
+                    full.next = (full.next + BAND).min(height);
+                }
+                if let Some(error) = pool.failed() {
+                    // Traced on this thread instead, from the top.
+                    log::warn!("the tracer workers failed ({error}); tracing on the page's thread");
+                    self.pool = None;
+                    (full.received, full.next) = (0, 0);
+                }
+                self.pool.is_some()
+            }
+            None => {
+                let next = (full.next + 4).min(height);
+                let rows = job.tracer.with_dependent(|_, tracer| tracer.render_rows(full.next..next).0);
+                full.pixels[row(full.next)..row(next)].copy_from_slice(&rows);
+                full.received += next - full.next;
+                full.next = next;
+                false
+            }
+        };
+        if full.received >= height {
+            let radiance = RadianceImage { width, height, pixels: std::mem::take(&mut full.pixels) };
             let image = radiance.to_rgba8(transform);
             // In the page's console, where web/test.sh reads it.
-            log::info!("traced {width}×{height} in {:.2} s", job.started.elapsed().as_secs_f64());
+            log::info!(
+                "traced {width}×{height} in {:.2} s ({})",
+                job.started.elapsed().as_secs_f64(),
+                if by_workers { "workers" } else { "the page's thread" }
+            );
             self.updates.push(Update::Traced(frame(job.key, image.clone(), 1, job.started)));
             self.finished = Some((job.key, image));
             self.job = None;
         } else if job.shown.elapsed() >= SHOW_EVERY {
             // The rows traced so far over the last progressive level.
-            let mut pixels = job.progressive.image().pixels.clone();
-            pixels[..rows.len()].copy_from_slice(rows);
-            let image = RadianceImage { width, height, pixels }.to_rgba8(transform);
-            self.updates.push(Update::Traced(frame(job.key, image, LAST_BLOCK, job.started)));
+            let image = RadianceImage { width, height, pixels: full.pixels.clone() }.to_rgba8(transform);
+            self.updates.push(Update::Traced(frame(job.key, image, full.below, job.started)));
             job.shown = Instant::now();
         }
+        by_workers
     }
 }
 

@@ -50,7 +50,7 @@ impl TracedWorker {
     }
 
     /// Makes sure request `key` is being traced: a new key cancels the previous request.
-    pub fn trace(&mut self, key: u64, scene: &Scene, settings: &RenderSettings) {
+    pub fn trace(&mut self, key: u64, scene: &Scene, _overrides: &[String], settings: &RenderSettings) {
         if self.current.as_ref().is_some_and(|(k, _)| *k == key) {
             return;
         }

@@ -1,0 +1,41 @@
+//! The page's tracer workers: the same module as the page, run in Web Workers (web/tracer.js), one
+//! a core, each tracing the rows of the full image it is asked for
+//! (`crate::viewer::traced::pool` hands them out). A worker has no window and no share of the
+//! page's memory, so it rebuilds the scene: it reads the same scene file (the built-in assets are
+//! in the module; the files the person opened come with the job) with the same overrides, then
+//! takes what the viewer changes in place: the camera, the lights, the materials and the
+//! settings. The rows it returns are the ones `Tracer::render_rows` returns on the page's thread,
+//! to the bit (web/test.sh checks the finished image against `mirador trace`).
+
+use std::cell::RefCell;
+
+use wasm_bindgen::prelude::*;
+
+use crate::trace::Tracer;
+use crate::viewer::traced::{OwnedTracer, SceneRecipe};
+
+thread_local! {
+    static TRACER: RefCell<Option<OwnedTracer>> = const { RefCell::new(None) };
+}
+
+/// Rebuilds the scene of `job` (JSON of [`SceneRecipe`]) and a tracer of it, for the rows asked
+/// next.
+#[wasm_bindgen]
+pub fn tracer_job(job: &str) -> Result<(), JsError> {
+    let job: SceneRecipe = serde_json::from_str(job).map_err(|e| JsError::new(&format!("a tracer job: {e}")))?;
+    let owned = job.scene().map_err(|e| JsError::new(&e))?;
+    let tracer = OwnedTracer::new(Box::new(owned), |owned| Tracer::new(&owned.0, &owned.1));
+    TRACER.with(|t| *t.borrow_mut() = Some(tracer));
+    Ok(())
+}
+
+/// Rows `first..end` of the full image, radiance as `r, g, b` a pixel, row by row.
+#[wasm_bindgen]
+pub fn trace_rows(first: u32, end: u32) -> Result<Vec<f32>, JsError> {
+    TRACER.with(|t| {
+        let tracer = t.borrow();
+        let tracer = tracer.as_ref().ok_or_else(|| JsError::new("rows asked before a tracer job"))?;
+        let (rows, _) = tracer.with_dependent(|_, tracer| tracer.render_rows(first..end));
+        Ok(rows.iter().flat_map(|p| p.to_array()).collect())
+    })
+}

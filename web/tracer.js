@@ -1,0 +1,23 @@
+// The page's tracer worker (src/web/tracer.rs, src/viewer/traced/pool.rs): the same module as the
+// page, without a window. It is given a job (the scene as the page has it, and the files the
+// person opened), then rows of the full image, and posts back their radiance.
+import init, * as mirador from "./mirador.js";
+
+const ready = init();
+self.onmessage = async (event) => {
+  await ready;
+  const message = event.data;
+  try {
+    if (message.files) {
+      for (const [name, bytes] of message.files) mirador.add_file(name, bytes);
+    }
+    if (message.job) mirador.tracer_job(message.job);
+    if (message.rows) {
+      const [first, end] = message.rows;
+      const pixels = mirador.trace_rows(first, end);
+      self.postMessage({ key: message.key, first, pixels }, [pixels.buffer]);
+    }
+  } catch (error) {
+    self.postMessage({ key: message.key, error: String(error) });
+  }
+};
