@@ -21,30 +21,13 @@ bash web/build.sh
 
 work=$(mktemp -d)
 capture="$work/capture"
-mkdir -p "$capture"
 port=${MIRADOR_WEB_PORT:-8765}
-# Served under a sub-path, as a course site would host it (web/README.md, "Publishing the page").
-site="$work/site"
-mkdir -p "$site/course"
-cp -r web/dist "$site/course/mirador"
-python3 web/serve.py --root "$site" --port "$port" --capture "$capture" &
-server=$!
-trap 'kill $server $browser 2>/dev/null || true; rm -rf "$work/profile" "$site"' EXIT
-sleep 1
+. web/browser.sh
+serve_page web/dist "$work" "$port"
 browser=
-xvfb-run -a -s "-screen 0 1280x900x24" chromium --no-sandbox --no-first-run --window-size=1280,800 \
-    --user-data-dir="$work/profile" --enable-unsafe-webgpu --enable-features=Vulkan --use-angle=vulkan \
-    --use-vulkan=swiftshader --disable-vulkan-surface --enable-logging=stderr --v=0 \
-    "http://127.0.0.1:$port/course/mirador/index.html?test" 2>"$work/browser.log" &
-browser=$!
-
+trap 'kill $server $browser 2>/dev/null || true; rm -rf "$work/profile" "$work/site"' EXIT
 # The page posts `done` after its last screenshot, or `failed` with the reason.
-for _ in $(seq 600); do
-    [ -e "$capture/done" ] || [ -e "$capture/failed" ] && break
-    sleep 1
-done
-pkill -P $browser 2>/dev/null || true
-kill $browser 2>/dev/null || true
+open_page "$work" "$port"
 if [ ! -e "$capture/done" ]; then
     echo "the page did not finish its test; its console:" >&2
     grep -a "CONSOLE" "$work/browser.log" | tail -40 >&2

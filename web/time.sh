@@ -18,27 +18,16 @@ command -v chromium >/dev/null && command -v xvfb-run >/dev/null || {
     echo "needs chromium and xvfb (bash web/test.sh installs them)" >&2
     exit 1
 }
+. web/browser.sh
 for run in $(seq "$runs"); do
     work=$(mktemp -d)
-    mkdir -p "$work/site/course" "$work/capture"
-    cp -r "$dist" "$work/site/course/mirador"
-    python3 web/serve.py --root "$work/site" --port "$port" --capture "$work/capture" >/dev/null &
-    server=$!
-    sleep 1
-    xvfb-run -a -s "-screen 0 1280x900x24" chromium --no-sandbox --no-first-run --window-size=1280,800 \
-        --user-data-dir="$work/profile" --enable-unsafe-webgpu --enable-features=Vulkan --use-angle=vulkan \
-        --use-vulkan=swiftshader --disable-vulkan-surface --enable-logging=stderr --v=0 \
-        "http://127.0.0.1:$port/course/mirador/index.html?test" 2>"$work/browser.log" &
-    browser=$!
-    for _ in $(seq 180); do
-        [ -e "$work/capture/done" ] || [ -e "$work/capture/failed" ] && break
-        sleep 1
-    done
-    pkill -P $browser 2>/dev/null || true
-    kill $browser $server 2>/dev/null || true
-    wait $server 2>/dev/null || true
+    serve_page "$dist" "$work" "$port"
+    open_page "$work" "$port"
+    kill "$server" 2>/dev/null || true
+    wait "$server" 2>/dev/null || true
     first=$(grep -ao "first frame [0-9]* ms" "$work/browser.log" | head -1 || true)
     traced=$(grep -ao "traced [0-9]*×[0-9]* in [0-9.]* s[^\"]*" "$work/browser.log" | head -1 || true)
     echo "run $run: ${first:-no first frame logged}; ${traced:-no traced image logged}"
-    rm -rf "$work"
+    sleep 1
+    rm -rf "$work" 2>/dev/null || true
 done
