@@ -19,6 +19,8 @@
 
 #[cfg(target_arch = "wasm32")]
 mod pool;
+#[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+mod recipe;
 #[cfg(target_arch = "wasm32")]
 mod slices;
 #[cfg(not(target_arch = "wasm32"))]
@@ -29,7 +31,7 @@ use std::time::Duration;
 use image::RgbaImage;
 
 #[cfg(target_arch = "wasm32")]
-pub(crate) use pool::SceneRecipe;
+pub(crate) use recipe::SceneRecipe;
 #[cfg(target_arch = "wasm32")]
 pub(crate) use slices::OwnedTracer;
 #[cfg(target_arch = "wasm32")]

@@ -4,16 +4,11 @@
 //! between frames; no memory is shared, so the page needs no special headers from its server.
 
 use std::cell::RefCell;
-use std::path::PathBuf;
 use std::rc::Rc;
 
 use glam::Vec3;
-use serde::{Deserialize, Serialize};
 use wasm_bindgen::JsCast;
 use wasm_bindgen::prelude::*;
-
-use crate::scene::{Camera, Light, Material};
-use crate::{RenderSettings, Scene};
 
 /// The rows a worker traces at a time: small enough to share the image evenly, large enough that
 /// messages cost little beside the tracing.
@@ -37,48 +32,6 @@ struct Inbox {
     idle: Vec<usize>,
     /// A worker's error: the pool is then given up and the page's thread traces.
     failed: Option<String>,
-}
-
-/// What a worker needs to rebuild the page's scene and trace it as the page would.
-#[derive(Serialize, Deserialize)]
-pub(crate) struct SceneRecipe {
-    source: Option<PathBuf>,
-    overrides: Vec<String>,
-    camera: Camera,
-    ambient: Vec3,
-    background: Vec3,
-    lights: Vec<Light>,
-    materials: Vec<Material>,
-    settings: RenderSettings,
-}
-
-impl SceneRecipe {
-    pub(crate) fn of(scene: &Scene, overrides: &[String], settings: &RenderSettings) -> SceneRecipe {
-        SceneRecipe {
-            source: scene.source.clone(),
-            overrides: overrides.to_vec(),
-            camera: scene.camera.clone(),
-            ambient: scene.ambient,
-            background: scene.background,
-            lights: scene.lights.clone(),
-            materials: scene.materials.clone(),
-            settings: settings.clone(),
-        }
-    }
-
-    pub(crate) fn scene(self) -> Result<(Scene, RenderSettings), String> {
-        let mut scene =
-            crate::viewer::scene_state::load(self.source.as_deref(), &self.overrides).map_err(|e| e.to_string())?;
-        if scene.materials.len() != self.materials.len() || scene.lights.len() != self.lights.len() {
-            return Err("the scene file changed since the page read it".into());
-        }
-        scene.camera = self.camera;
-        scene.ambient = self.ambient;
-        scene.background = self.background;
-        scene.lights = self.lights;
-        scene.materials = self.materials;
-        Ok((scene, self.settings))
-    }
 }
 
 pub(super) struct Pool {
@@ -117,7 +70,7 @@ impl Pool {
         Some(Pool { workers, inbox, _listeners: listeners })
     }
 
-    /// Gives every worker the job `key` (JSON of [`SceneRecipe`]) and the files the
+    /// Gives every worker the job `key` (JSON of [`super::SceneRecipe`]) and the files the
     /// person opened; the bands asked for next are of this job.
     pub fn job(&self, key: u64, job: &str, files: &[(String, Vec<u8>)]) {
         let list = js_sys::Array::new();

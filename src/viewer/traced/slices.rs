@@ -11,7 +11,8 @@ use glam::Vec3;
 use image::RgbaImage;
 use web_time::Instant;
 
-use super::pool::{BAND, Pool, SceneRecipe};
+use super::SceneRecipe;
+use super::pool::{BAND, Pool};
 use super::{DifferenceFrame, LAST_BLOCK, START_BLOCK, TracedFrame, Update, compare_ready};
 use crate::output::OutputTransform;
 use crate::trace::{Progressive, RadianceImage, Tracer};
