@@ -38,6 +38,7 @@ pub(super) struct Pool {
     workers: Vec<web_sys::Worker>,
     inbox: Rc<RefCell<Inbox>>,
     _listeners: Vec<Closure<dyn FnMut(web_sys::MessageEvent)>>,
+    _on_error: Closure<dyn FnMut(JsValue)>,
 }
 
 impl Pool {
@@ -50,6 +51,12 @@ impl Pool {
         let inbox = Rc::new(RefCell::new(Inbox::default()));
         let options = web_sys::WorkerOptions::new();
         options.set_type(web_sys::WorkerType::Module);
+        // A worker that cannot start (web/tracer.js missing from the host, a module error) never
+        // answers: the page's thread then traces, rather than wait for ever.
+        let shared = inbox.clone();
+        let on_error = Closure::<dyn FnMut(JsValue)>::new(move |_| {
+            shared.borrow_mut().failed = Some("a tracer worker did not start (web/tracer.js)".into());
+        });
         let (mut workers, mut listeners) = (Vec::new(), Vec::new());
         for index in 0..cores.min(16) {
             let worker = web_sys::Worker::new_with_options("./tracer.js", &options).ok()?;
@@ -63,11 +70,12 @@ impl Pool {
                 inbox.idle.push(index);
             });
             worker.set_onmessage(Some(listener.as_ref().unchecked_ref()));
+            worker.set_onerror(Some(on_error.as_ref().unchecked_ref()));
             inbox.borrow_mut().idle.extend([index; AHEAD]);
             workers.push(worker);
             listeners.push(listener);
         }
-        Some(Pool { workers, inbox, _listeners: listeners })
+        Some(Pool { workers, inbox, _listeners: listeners, _on_error: on_error })
     }
 
     /// Gives every worker the job `key` (JSON of [`super::SceneRecipe`]) and the files the
