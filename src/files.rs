@@ -170,14 +170,14 @@ mod in_memory {
 
     /// The files the person opened, by their names under `opened/`: what the page's tracer
     /// workers need besides the built-in assets.
-    pub fn opened() -> Vec<(String, Vec<u8>)> {
+    pub fn opened() -> Vec<(String, Rc<[u8]>)> {
         FILES.with(|files| {
             files
                 .borrow()
                 .iter()
                 .filter_map(|(path, bytes)| {
                     let name = path.strip_prefix("opened").ok()?;
-                    Some((name.to_string_lossy().into_owned(), bytes.to_vec()))
+                    Some((name.to_string_lossy().into_owned(), bytes.clone()))
                 })
                 .collect()
         })

@@ -43,7 +43,7 @@
 
 use std::f32::consts::{FRAC_PI_2, PI, TAU};
 
-use glam::{Affine3A, Mat3, Mat3A, Vec2, Vec3, Vec3A};
+use glam::{Affine3A, Mat3, Vec2, Vec3, Vec3A};
 
 use crate::base::{MaterialId, Ray};
 use crate::scene::{Object, Scene, Shape};
@@ -192,14 +192,12 @@ pub struct PreparedRay {
     pub origin: Vec3A,
     pub direction: Vec3A,
     pub inv_direction: Vec3A,
-    /// Maps `v − origin` to the ray's frame: `x, y` across the ray (sheared so that the ray is
-    /// the z axis), `z` the distance along it divided by the largest direction component.
-    shear: Mat3A,
-    /// The same shear for tests that work axis by axis (the wide BVH's triangle packets):
-    /// `kx, ky, kz`, and `Sx, Sy, Sz` with `x = A[kx] − Sx·A[kz]`, `y = A[ky] − Sy·A[kz]`,
-    /// `z = Sz·A[kz]`.
+    /// The watertight test's frame: `kx, ky, kz`, with `kz` the direction's largest axis.
     pub(crate) axes: [usize; 3],
-    pub(crate) shear_factors: Vec3A,
+    /// Its shear `Sx, Sy, Sz`, which maps `A = v − origin` to the ray's frame: `x = A[kx] − Sx·A[kz]`,
+    /// `y = A[ky] − Sy·A[kz]` across the ray (sheared so that the ray is the z axis), `z = Sz·A[kz]`
+    /// the distance along it divided by the largest direction component.
+    pub(crate) shear: Vec3A,
 }
 
 impl PreparedRay {
@@ -224,20 +222,16 @@ impl PreparedRay {
         if direction[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        let (sx, sy, sz) = (direction[kx] / direction[kz], direction[ky] / direction[kz], 1.0 / direction[kz]);
-        let unit = |k: usize| Vec3A::AXES[k];
-        // Entries are exactly 0, 1, −S: each row reproduces the paper's `A[kx] − Sx·A[kz]` bit
-        // for bit, since multiplying by 0 or 1 and adding 0 are exact.
-        let rows = [unit(kx) - sx * unit(kz), unit(ky) - sy * unit(kz), sz * unit(kz)];
-        let shear = Mat3A::from_cols(rows[0], rows[1], rows[2]).transpose();
-        Some(PreparedRay {
-            origin,
-            direction,
-            inv_direction: direction.recip(),
-            shear,
-            axes: [kx, ky, kz],
-            shear_factors: Vec3A::new(sx, sy, sz),
-        })
+        let shear = Vec3A::new(direction[kx] / direction[kz], direction[ky] / direction[kz], 1.0 / direction[kz]);
+        Some(PreparedRay { origin, direction, inv_direction: direction.recip(), axes: [kx, ky, kz], shear })
+    }
+
+    /// `v` in the ray's sheared frame.
+    #[inline(always)]
+    fn local(&self, v: Vec3A) -> Vec3A {
+        let a = v - self.origin;
+        let [kx, ky, kz] = self.axes;
+        Vec3A::new(a[kx] - self.shear.x * a[kz], a[ky] - self.shear.y * a[kz], self.shear.z * a[kz])
     }
 }
 
@@ -245,9 +239,7 @@ impl PreparedRay {
 /// `U/det, V/det, W/det` of `v0, v1, v2`; `None` if the ray's line misses the triangle.
 #[inline(always)]
 fn watertight(ray: &PreparedRay, v0: Vec3A, v1: Vec3A, v2: Vec3A) -> Option<(f32, f32, f32, f32, f32)> {
-    let a = ray.shear * (v0 - ray.origin);
-    let b = ray.shear * (v1 - ray.origin);
-    let c = ray.shear * (v2 - ray.origin);
+    let (a, b, c) = (ray.local(v0), ray.local(v1), ray.local(v2));
     let mut u = c.x * b.y - c.y * b.x;
     let mut v = a.x * c.y - a.y * c.x;
     let mut w = b.x * a.y - b.y * a.x;

@@ -22,6 +22,8 @@ thread_local! {
 /// next.
 #[wasm_bindgen]
 pub fn tracer_job(job: &str) -> Result<(), JsError> {
+    // A job that fails leaves no tracer of the last one to trace its rows.
+    TRACER.with(|t| *t.borrow_mut() = None);
     let job: SceneRecipe = serde_json::from_str(job).map_err(|e| JsError::new(&format!("a tracer job: {e}")))?;
     let owned = job.scene().map_err(|e| JsError::new(&e))?;
     let tracer = OwnedTracer::new(Box::new(owned), |owned| Tracer::new(&owned.0, &owned.1));

@@ -206,7 +206,7 @@ impl PacketRay {
         PacketRay {
             origin: [0, 1, 2].map(|k| Vec4::splat(ray.origin[k])),
             axes: ray.axes,
-            shear: [0, 1, 2].map(|k| Vec4::splat(ray.shear_factors[k])),
+            shear: [0, 1, 2].map(|k| Vec4::splat(ray.shear[k])),
         }
     }
 }
@@ -244,10 +244,8 @@ impl Packet {
     /// settles in double precision.
     ///
     /// Each line is [`crate::trace::geometry`]'s `watertight` with a lane per triangle: the
-    /// shear's rows `A[kx] − Sx·A[kz]` (its matrix adds only exact zeros and products by one),
-    /// the three edge functions, their signs, `det` and `T` summed in the same order. (One
-    /// exception, beyond any scene: where `v − origin` overflows to ∞, the matrix's `0·∞` makes
-    /// the scalar test's lane NaN, a miss, while this one skips the term.)
+    /// sheared frame `A[kx] − Sx·A[kz]`, the three edge functions, their signs, `det` and `T`,
+    /// each computed in the same order.
     #[inline(always)]
     fn hits(&self, ray: &PacketRay, t_min: f32, t_max: f32) -> (u32, Vec4, u32) {
         let [kx, ky, kz] = ray.axes;

@@ -4,6 +4,7 @@
 //! between frames; no memory is shared, so the page needs no special headers from its server.
 
 use std::cell::RefCell;
+use std::collections::HashMap;
 use std::rc::Rc;
 
 use glam::Vec3;
@@ -37,6 +38,8 @@ struct Inbox {
 pub(super) struct Pool {
     workers: Vec<web_sys::Worker>,
     inbox: Rc<RefCell<Inbox>>,
+    /// The opened files every worker has, as they were sent.
+    sent: RefCell<HashMap<String, Rc<[u8]>>>,
     _listeners: Vec<Closure<dyn FnMut(web_sys::MessageEvent)>>,
     _on_error: Closure<dyn FnMut(JsValue)>,
 }
@@ -75,15 +78,21 @@ impl Pool {
             workers.push(worker);
             listeners.push(listener);
         }
-        Some(Pool { workers, inbox, _listeners: listeners, _on_error: on_error })
+        Some(Pool { workers, inbox, sent: RefCell::default(), _listeners: listeners, _on_error: on_error })
     }
 
     /// Gives every worker the job `key` (JSON of [`super::SceneRecipe`]) and the files the
-    /// person opened; the bands asked for next are of this job.
-    pub fn job(&self, key: u64, job: &str, files: &[(String, Vec<u8>)]) {
+    /// person opened that it has not been given yet (the same bytes are sent once, not with every
+    /// request); the bands asked for next are of this job.
+    pub fn job(&self, key: u64, job: &str, files: &[(String, Rc<[u8]>)]) {
         let list = js_sys::Array::new();
+        let mut sent = self.sent.borrow_mut();
         for (name, bytes) in files {
-            list.push(&js_sys::Array::of2(&name.into(), &js_sys::Uint8Array::from(bytes.as_slice())));
+            if sent.get(name).is_some_and(|s| Rc::ptr_eq(s, bytes)) {
+                continue;
+            }
+            list.push(&js_sys::Array::of2(&name.into(), &js_sys::Uint8Array::from(&bytes[..])));
+            sent.insert(name.clone(), bytes.clone());
         }
         for worker in &self.workers {
             let message = message(key);

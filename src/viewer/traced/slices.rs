@@ -38,8 +38,8 @@ self_cell::self_cell!(
 struct Job {
     key: u64,
     tracer: OwnedTracer,
-    /// The request for the workers (JSON of [`SceneRecipe`]).
-    recipe: String,
+    /// The values set over the scene file's, for the workers' [`SceneRecipe`].
+    overrides: Vec<String>,
     progressive: Progressive,
     /// The full image in progress (`None` while progressive levels remain).
     full: Option<Full>,
@@ -104,9 +104,9 @@ impl TracedWorker {
             self.pool_tried = true;
             self.pool = Pool::start();
         }
-        let recipe = serde_json::to_string(&SceneRecipe::of(scene, overrides, settings)).unwrap_or_default();
+        let overrides = overrides.to_vec();
         let now = Instant::now();
-        self.job = Some(Job { key, tracer, recipe, progressive, full: None, started: now, shown: now });
+        self.job = Some(Job { key, tracer, overrides, progressive, full: None, started: now, shown: now });
     }
 
     /// Stops the current request (the view no longer shows traced images).
@@ -173,7 +173,9 @@ impl TracedWorker {
         let by_workers = match &self.pool {
             Some(pool) => {
                 if !full.given {
-                    pool.job(job.key, &job.recipe, &crate::files::opened());
+                    let (scene, settings) = job.tracer.borrow_owner().as_ref();
+                    let recipe = SceneRecipe::of(scene, &job.overrides, settings);
+                    pool.job(job.key, &serde_json::to_string(&recipe).unwrap_or_default(), &crate::files::opened());
                     full.given = true;
                 }
                 for band in pool.bands().into_iter().filter(|band| band.key == job.key) {
