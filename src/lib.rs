@@ -9,6 +9,8 @@
 //! - [`output`]: the output transform both renderers share.
 //! - [`linear_output`]: the radiance before that transform, as OpenEXR.
 //! - [`lab`]: a student's WGSL in place of a technique's own functions, checked and graded.
+//! - [`budget`]: what each of the rasterizer's approximations costs, each swapped for its traced
+//!   counterpart (the hybrid).
 //! - [`compare`]: image metrics for golden images and raster-vs-trace comparisons.
 //! - [`viewer`]: the interactive window (winit + egui) over both renderers.
 //! - [`volume`]: scalar fields on voxel grids, classified and ray-cast by both renderers.
@@ -20,6 +22,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod base;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod budget;
 pub mod compare;
 pub mod explain;
 pub mod files;

@@ -102,6 +102,23 @@ enum Command {
         #[arg(long, value_name = "FILE.json")]
         json: Option<PathBuf>,
     },
+    /// The error budget: how much of the raster-vs-traced difference each of the rasterizer's
+    /// approximations costs, each swapped for its traced counterpart inside the raster frame
+    /// (docs/course/12-error-budget.md).
+    Budget {
+        #[command(flatten)]
+        scene: SceneArgs,
+        #[command(flatten)]
+        trace: TraceArgs,
+        /// Also write the sheet here: the images, a bar per approximation and its error map.
+        #[arg(long, value_name = "FILE.png")]
+        sheet: Option<PathBuf>,
+        /// Write the budget as JSON to this file (`-`: standard output, instead of the text):
+        /// `whole`, `floor`, `floor_causes`, and each approximation's `name`, `alone` and
+        /// `left_alone`.
+        #[arg(long, value_name = "FILE.json")]
+        json: Option<PathBuf>,
+    },
     /// Labs: write a technique's functions in WGSL and have them checked against Mirador's own and
     /// the ray tracer (docs/course/labs.md).
     Lab {
@@ -286,6 +303,7 @@ fn main() -> ExitCode {
             compare(scene, trace, &output, [raster_out, trace_out, error_out], (exr.as_deref(), json.as_deref()))
         }
         Some(Command::Explain { scene, trace, pixel, json }) => explain(scene, trace, pixel, json.as_deref()),
+        Some(Command::Budget { scene, trace, sheet, json }) => budget(scene, trace, sheet.as_deref(), json.as_deref()),
         Some(Command::View(args)) => view(args),
         Some(Command::Lab { command }) => return lab(command),
         Some(Command::Diff { reference, test, mask, json }) => {
@@ -749,6 +767,39 @@ fn compare(
     if let (Some(raster_linear), Some(path)) = (raster_linear, exr_path) {
         let both = LinearImage::side_by_side(&raster_linear, &linear_of(traced_radiance)?);
         clock.time("EXR encode + write", || write_exr(&both, path))?;
+    }
+    if args.stats {
+        println!("{}", clock.report());
+    }
+    Ok(())
+}
+
+fn budget(args: SceneArgs, trace_args: TraceArgs, sheet: Option<&Path>, json: Option<&Path>) -> anyhow::Result<()> {
+    if let Some(path) = sheet {
+        check_png(path)?;
+    }
+    let mut clock = Stopwatch::default();
+    let mut scene = prepare(&args, &mut clock)?;
+    apply_trace_args(&mut scene.settings, &trace_args)?;
+    let traced_radiance = ray_trace(&scene, trace_args.threads, &mut clock, args.stats)?;
+    let traced = traced_radiance.to_rgba8(mirador::output::OutputTransform::of(&scene.settings));
+    let gpu = clock.time("device", Gpu::headless)?;
+    gpu.check_image_size((scene.camera.width, scene.camera.height))?;
+    let budget =
+        gpu.checked(|| clock.time("raster frames", || mirador::budget::budget(&gpu, &scene, &scene.settings, traced)))?;
+    let text = serde_json::to_string_pretty(&budget.json()).expect("the budget serialises");
+    match json {
+        Some(path) if path.as_os_str() == "-" => println!("{text}"),
+        _ => {
+            print!("{}", budget.report());
+            if let Some(path) = json {
+                output::write_atomically(text.as_bytes(), path)
+                    .with_context(|| format!("writing {}", path.display()))?;
+            }
+        }
+    }
+    if let Some(path) = sheet {
+        clock.time("encode + write", || write_png(&mirador::budget::sheet::sheet(&budget), path))?;
     }
     if args.stats {
         println!("{}", clock.report());

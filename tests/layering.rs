@@ -36,6 +36,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("trace", 4),
     ("gpu", 4),
     ("raster", 5),
+    ("budget", 6),
     ("explain", 6),
     ("lab", 6),
     ("viewer", 7),

@@ -24,6 +24,8 @@ override BUMP_VIEW: u32 = 0u;
 override TANGENTS_PER_VERTEX: bool = false;
 override BUMP_ANALYTIC: bool = false;
 override FLAT_COLOUR: bool = false;
+// TRACED_* bits: the hybrid's terms read from the view's traced image (src/raster/traced.rs).
+override TRACED: u32 = 0u;
 // The material's inputs (MaterialKey).
 override COLOR_TEXTURE: bool = false;
 override HEIGHT_KIND: u32 = 0u;
@@ -36,6 +38,14 @@ override ENVIRONMENT: u32 = 0u;
 const SHADOWS_OFF: u32 = 0u;
 const SHADOWS_MAP: u32 = 1u;
 const SHADOWS_PROJECTED: u32 = 2u;
+
+const TRACED_VISIBILITY: u32 = 1u;
+const TRACED_REFLECTION: u32 = 2u;
+const TRACED_COLOUR: u32 = 4u;
+// The layers of the view's traced image.
+const TRACED_SURFACE_LAYER: i32 = 0;
+const TRACED_REFLECTION_LAYER: i32 = 1;
+const TRACED_VISIBILITY_LAYER: i32 = 2;
 
 const BUMP_VIEW_NORMALS: u32 = 1u;
 const BUMP_VIEW_TANGENTS: u32 = 2u;
@@ -295,7 +305,12 @@ fn shade_surface(in: VertexOut) -> Shaded {
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
     let tangents = surface_tangents(in);
-    let color = surface_color(in.uv, duv_dx, duv_dy);
+    // The hybrid's terms hold at this pixel only if they were traced on this fragment's surface.
+    let here = TRACED != 0u && traced_object(in.clip.xy) == in.object + 1u;
+    var color = surface_color(in.uv, duv_dx, duv_dy);
+    if (TRACED & TRACED_COLOUR) != 0u && here {
+        color = traced_term(in.clip.xy, TRACED_SURFACE_LAYER);
+    }
     if INSPECT {
         probe.world = in.world;
         probe.uv = in.uv;
@@ -340,7 +355,12 @@ fn shade_surface(in: VertexOut) -> Shaded {
                 probe.lights[i].layer = -1;
                 probe.lights[i].lit = 1.0;
             }
-            let visible = visibility(light, in.world, facing, in.clip.xy);
+            var visible: vec3f;
+            if (TRACED & TRACED_VISIBILITY) != 0u && here && light.shadow_slot >= 0 {
+                visible = traced_term(in.clip.xy, TRACED_VISIBILITY_LAYER + light.shadow_slot);
+            } else {
+                visible = visibility(light, in.world, facing, in.clip.xy);
+            }
             if INSPECT {
                 let parts = direct_terms(surface, n, v, incidence, frame.terms);
                 probe.lights[i].ambient = parts[0];
@@ -374,7 +394,26 @@ fn shade_surface(in: VertexOut) -> Shaded {
             probe.env_layer = in.env_layer;
         }
     }
+    if (TRACED & TRACED_REFLECTION) != 0u && here {
+        // kps·MPS·L(r), L(r) traced: in place of the mirrored camera's image and the environment
+        // maps, which the frame leaves out when this is on.
+        let traced_reflection = material.reflectance * traced_term(in.clip.xy, TRACED_REFLECTION_LAYER);
+        radiance += traced_reflection;
+        if INSPECT {
+            probe.mirror = traced_reflection;
+        }
+    }
     return Shaded(radiance, n, v, environment_radiance);
+}
+
+// The object + 1 whose surface the view's traced terms were traced on at this pixel; 0: none.
+fn traced_object(pixel: vec2f) -> u32 {
+    return u32(textureLoad(traced, vec2i(pixel), TRACED_SURFACE_LAYER, 0).a);
+}
+
+// One of the view's traced terms at this pixel.
+fn traced_term(pixel: vec2f, layer: i32) -> vec3f {
+    return textureLoad(traced, vec2i(pixel), layer, 0).rgb;
 }
 
 // L(d), the radiance arriving at p from direction d, looked up in the environment map: for the

@@ -2,7 +2,7 @@
 // group per view (src/raster/view_group.rs, whose VIEW_GROUP table tests/layouts.rs checks
 // against these declarations binding by binding): the frame's shadow and environment maps, the
 // same in every view, and the images earlier phases of this view made for its shading (the
-// projected-shadow mask), so a technique that makes one shows in the main camera, every mirrored
+// projected-shadow mask, the traced terms), so a technique that makes one shows in the main camera, every mirrored
 // camera and every cube face alike. An inspecting renderer adds bindings 11 and 12
 // (shaders/common/inspect.wgsl).
 
@@ -25,3 +25,6 @@
 // Object-precision shadows (src/raster/shadow/projected.rs): per shadowed light, a channel that
 // is 1 where the polygons cover this view's pixel.
 @group(2) @binding(4) var projected_mask: texture_2d<f32>;
+// The hybrid's traced terms (src/raster/traced.rs), at the first opaque surface of this view's
+// pixel: layer 0 its colour C and object + 1, layer 1 L(r), layers 2.. each shadowed light's V_i.
+@group(2) @binding(13) var traced: texture_2d_array<f32>;

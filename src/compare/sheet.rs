@@ -5,8 +5,9 @@
 use ab_glyph::{Font, FontRef, PxScale, ScaleFont};
 use image::{Rgba, RgbaImage};
 
-const BACKGROUND: Rgba<u8> = Rgba([24, 24, 28, 255]);
-const TEXT: Rgba<u8> = Rgba([235, 235, 235, 255]);
+/// The sheets' background and text colours.
+pub const BACKGROUND: Rgba<u8> = Rgba([24, 24, 28, 255]);
+pub const TEXT: Rgba<u8> = Rgba([235, 235, 235, 255]);
 const MARGIN: u32 = 8;
 const LABEL_HEIGHT: u32 = 28;
 

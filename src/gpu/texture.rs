@@ -28,6 +28,32 @@ impl GpuTexture {
         Self::image(device, label, size, format, usage)
     }
 
+    /// A 2D array of `layers` images that receives copies (`COPY_DST`) for shaders to read, viewed
+    /// as an array whatever its number of layers.
+    pub fn layered_copy_target(
+        device: &wgpu::Device,
+        label: &str,
+        size: (u32, u32),
+        layers: u32,
+        format: wgpu::TextureFormat,
+    ) -> GpuTexture {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: layers },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        GpuTexture { texture, view }
+    }
+
     /// One 2D image of one level, with `usage`.
     fn image(
         device: &wgpu::Device,

@@ -11,8 +11,8 @@
 use super::uniforms::alpha_mode_code;
 use crate::scene::{Material, ProceduralHeight};
 use crate::settings::{
-    BumpView, EnvironmentMap, EnvironmentSettings, RenderSettings, ShadowFilter, ShadowMethod, ShadowView,
-    TangentSource, TextureFilter,
+    BumpView, EnvironmentMap, EnvironmentSettings, HybridSettings, RenderSettings, ShadowFilter, ShadowMethod,
+    ShadowView, TangentSource, TextureFilter,
 };
 
 /// A value a pipeline constant takes (WGSL's `override`s are set as `f64`).
@@ -84,6 +84,8 @@ pipeline_constants! {
         flat_colour: bool = "FLAT_COLOUR" <- settings.raster.flat_colour,
         /// `ENV_MAP_*`: where curved mirrors look their reflection up; 0: nowhere.
         environment: u32 = "ENVIRONMENT" <- environment_code(&settings.environment),
+        /// `TRACED_*` bits: the hybrid's terms read from the view's traced image.
+        traced: u32 = "TRACED" <- traced_code(&settings.hybrid),
         /// Record what the shading computes at the inspected pixel (`shaders/common/inspect.wgsl`): the
         /// main view of an inspected frame only.
         inspect: bool = "INSPECT" <- false,
@@ -96,6 +98,18 @@ pub const ENV_MAP_CUBE: u32 = 1;
 pub const ENV_MAP_SPHERE: u32 = 2;
 pub const ENV_MAP_LATLONG: u32 = 3;
 pub const ENV_MAP_DYNAMIC: u32 = 4;
+
+/// `TRACED` bits (shaders/common/surface.wgsl): which of the hybrid's terms the shading reads.
+pub const TRACED_VISIBILITY: u32 = 1;
+pub const TRACED_REFLECTION: u32 = 2;
+pub const TRACED_COLOUR: u32 = 4;
+
+fn traced_code(hybrid: &HybridSettings) -> u32 {
+    let bit = |on: bool, bit: u32| if on { bit } else { 0 };
+    bit(hybrid.shadows, TRACED_VISIBILITY)
+        | bit(hybrid.reflections, TRACED_REFLECTION)
+        | bit(hybrid.textures, TRACED_COLOUR)
+}
 
 /// `SHADOW_METHOD`: no shadows at all (no light casts one, or shadows are off).
 pub const SHADOWS_OFF: u32 = 0;

@@ -37,22 +37,50 @@ pub enum ViewImage {
     /// Object-precision shadows: one channel per shadowed light, 1 where the light is hidden
     /// (`super::shadow::projected`, drawn after the view's depth prepass).
     ProjectedMask,
+    /// The hybrid's traced terms at each pixel's first opaque surface (`super::traced`, copied in
+    /// before the view draws): layer [`TRACED_SURFACE`] holds `C` and the surface's object + 1,
+    /// layer [`TRACED_REFLECTION`] `L(r)`, and the layers from [`TRACED_VISIBILITY`] on each
+    /// shadowed light's `V_i`. Made at the targets' size only when a frame traces a term.
+    Traced,
 }
+
+/// The layers of [`ViewImage::Traced`].
+pub const TRACED_SURFACE: u32 = 0;
+pub const TRACED_REFLECTION: u32 = 1;
+pub const TRACED_VISIBILITY: u32 = 2;
+/// Its layers: a visibility layer for each of the rasterizer's shadowed lights (four).
+pub const TRACED_LAYERS: u32 = TRACED_VISIBILITY + 4;
 
 impl ViewImage {
     /// Every view image, in the order the targets keep them.
-    pub const ALL: [ViewImage; 1] = [ViewImage::ProjectedMask];
+    pub const ALL: [ViewImage; 2] = [ViewImage::ProjectedMask, ViewImage::Traced];
 
     pub fn format(self) -> wgpu::TextureFormat {
         match self {
             ViewImage::ProjectedMask => wgpu::TextureFormat::Rgba8Unorm,
+            ViewImage::Traced => wgpu::TextureFormat::Rgba32Float,
         }
     }
 
     pub fn label(self) -> &'static str {
         match self {
             ViewImage::ProjectedMask => "view_group::projected_mask",
+            ViewImage::Traced => "view_group::traced",
         }
+    }
+
+    /// Its layers: one, or a 2D array.
+    pub fn layers(self) -> Option<u32> {
+        match self {
+            ViewImage::ProjectedMask => None,
+            ViewImage::Traced => Some(TRACED_LAYERS),
+        }
+    }
+
+    /// Made at the targets' size only when a frame asks ([`ViewImages::ensure`]); one pixel
+    /// until then, so views that never read it cost nothing.
+    fn on_demand(self) -> bool {
+        matches!(self, ViewImage::Traced)
     }
 
     fn index(self) -> usize {
@@ -67,12 +95,27 @@ pub struct ViewImages {
 
 impl ViewImages {
     pub fn new(device: &wgpu::Device, size: (u32, u32)) -> ViewImages {
-        let images = ViewImage::ALL.iter().map(|i| GpuTexture::target(device, i.label(), size, i.format())).collect();
-        ViewImages { images }
+        let made = |i: &ViewImage| make(device, *i, if i.on_demand() { (1, 1) } else { size });
+        ViewImages { images: ViewImage::ALL.iter().map(made).collect() }
     }
 
     pub fn get(&self, image: ViewImage) -> &GpuTexture {
         &self.images[image.index()]
+    }
+
+    /// Makes `image` at `size` if it is smaller (an image made on demand).
+    pub fn ensure(&mut self, device: &wgpu::Device, image: ViewImage, size: (u32, u32)) {
+        let made = self.images[image.index()].texture.size();
+        if (made.width, made.height) != size {
+            self.images[image.index()] = make(device, image, size);
+        }
+    }
+}
+
+fn make(device: &wgpu::Device, image: ViewImage, size: (u32, u32)) -> GpuTexture {
+    match image.layers() {
+        None => GpuTexture::target(device, image.label(), size, image.format()),
+        Some(layers) => GpuTexture::layered_copy_target(device, image.label(), size, layers, image.format()),
     }
 }
 

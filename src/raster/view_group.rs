@@ -4,7 +4,7 @@
 //! - the frame's inputs, the same in every view: the shadow maps and how to read them, the
 //!   environment maps;
 //! - the **view images**: images that earlier phases of *that* view made for its shading to
-//!   read ([`ViewImage`]; today the projected-shadow mask). Each view draws its own into its
+//!   read ([`ViewImage`]: the projected-shadow mask, the hybrid's traced terms). Each view draws its own into its
 //!   own targets, so a technique that makes one shows in every view: the main camera, each
 //!   mirrored camera and each cube face (STYLE rule 17; Bevy's mesh view bind group is the model).
 //!
@@ -124,6 +124,12 @@ pub const VIEW_GROUP: &[ViewBinding] = {
             name: "env_latlong",
             ty: texture(FILTERABLE, Dim::D2),
             resource: Resource::LatlongMap,
+        },
+        ViewBinding {
+            binding: 13,
+            name: "traced",
+            ty: texture(UNFILTERABLE, Dim::D2Array),
+            resource: Resource::View(ViewImage::Traced),
         },
         ViewBinding {
             binding: 11,

@@ -18,6 +18,7 @@ pub mod field;
 
 mod bump;
 mod environment;
+mod hybrid;
 mod mirrors;
 mod raster;
 mod shadows;
@@ -29,6 +30,7 @@ mod volume;
 
 pub use bump::{BumpSettings, BumpView, TangentSource};
 pub use environment::{EnvironmentMap, EnvironmentSettings, EnvironmentView, Parallax, SphereView};
+pub use hybrid::HybridSettings;
 pub use mirrors::{MAX_MIRROR_DEPTH, MirrorSettings, MirrorView};
 pub use raster::{Prepass, RasterSettings};
 pub use shadows::{ShadowFilter, ShadowFit, ShadowMethod, ShadowSettings, ShadowView};
@@ -86,6 +88,9 @@ section! {
         /// `C = C_amb + C_luz·k_dif·(n·L)` and composite front to back; or find the isosurface
         /// `f = iso`.
         volume: VolumeSettings = VolumeSettings::default(),
+        /// The hybrid (docs/course/12-error-budget.md): approximations of the rasterizer swapped
+        /// for their traced counterparts inside its frame.
+        hybrid: HybridSettings = HybridSettings::default(),
         /// How the rasterizer spends its time: prepass, tessellation, render scale. None of these
         /// changes what a technique computes; each trades time for a measured difference
         /// (docs/performance.md).

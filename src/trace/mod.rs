@@ -24,6 +24,7 @@ pub mod explain;
 pub mod geometry;
 pub mod render;
 pub mod sampling;
+pub mod terms;
 pub mod texture;
 pub mod volume;
 pub mod whitted;

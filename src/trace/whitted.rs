@@ -428,7 +428,7 @@ impl Whitted<'_> {
 
     /// The shading normal at the hit: bumped on the unturned normal, then turned to the viewer
     /// `v`, exactly as the rasterizer does.
-    fn shading_normal(&self, material: &Material, hit: &SurfaceHit, v: Vec3) -> Vec3 {
+    pub(super) fn shading_normal(&self, material: &Material, hit: &SurfaceHit, v: Vec3) -> Vec3 {
         facing_viewer(self.textures.shading_normal(material, hit, &self.bump), v)
     }
 

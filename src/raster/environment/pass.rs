@@ -13,7 +13,7 @@ use super::{
 use crate::gpu::Gpu;
 use crate::gpu::mipmap::MipmapGenerator;
 use crate::raster::context::{Figure, FrameEncoder};
-use crate::raster::targets::FrameTargets;
+use crate::raster::targets::{FrameTargets, ViewImage};
 use crate::raster::view::View;
 use crate::scene::Scene;
 use crate::settings::{EnvironmentMap, EnvironmentView, Refraction, RenderSettings};
@@ -131,6 +131,14 @@ impl EnvironmentPass {
     }
 
     /// The target a cube face is drawn into (a face is due only after [`Self::prepare`] made it).
+    /// Makes `image` at full size in the capture targets, if there are any (an image made on
+    /// demand).
+    pub fn ensure_images(&mut self, device: &wgpu::Device, image: ViewImage) {
+        if let Some(targets) = &mut self.capture {
+            targets.images.ensure(device, image, targets.size);
+        }
+    }
+
     pub fn capture_targets(&self) -> &FrameTargets {
         self.capture.as_ref().expect("made by prepare with the faces due")
     }

@@ -33,7 +33,8 @@ use super::scene_pass::{MirrorImages, PreparedScene, ScenePass};
 use super::shadow::projected::ProjectedPass;
 use super::shadow::views::ShadowLayout;
 use super::shadow::{ShadowMaps, ShadowPass};
-use super::targets::{FrameTargets, drawn_size};
+use super::targets::{FrameTargets, ViewImage, drawn_size};
+use super::traced::{self, PreparedTraced};
 use super::transparency::{PreparedTransparency, TransparencyPass};
 use super::view::{FrameView, ViewKind};
 use super::view_group::{FrameInputs, ViewGroups};
@@ -109,6 +110,8 @@ struct Phases<'p> {
     refraction: Option<PreparedRefraction<'p>>,
     /// `None`: transparent surfaces are drawn with the opaque ones (or there are none).
     transparency: Option<PreparedTransparency<'p>>,
+    /// The hybrid's traced terms of every view; `None`: none is traced.
+    traced: Option<PreparedTraced>,
 }
 
 impl Renderer {
@@ -240,10 +243,17 @@ impl Renderer {
         targets: &mut FrameTargets,
         output: &wgpu::TextureView,
     ) -> FrameReport {
+        // Where the hybrid traces reflections, the passes draw without what they replace.
+        let raster_settings = traced::raster_settings(settings);
+        let settings = raster_settings.as_ref().unwrap_or(settings);
+        let wanted = traced::wanted(settings);
         let out = output.texture().size();
         let size = drawn_size((out.width, out.height), settings.raster.render_scale);
         if targets.size != size {
             *targets = FrameTargets::new(&gpu.device, size);
+        }
+        if wanted.is_some() {
+            targets.images.ensure(&gpu.device, ViewImage::Traced, size);
         }
         let targets = &*targets;
         let mut frame = FrameEncoder::new(gpu, self.profile);
@@ -269,6 +279,10 @@ impl Renderer {
             self.facts = facts(&plan, &self.mirrors, &self.environment, self.scene_gpu.geometry.bounds);
             self.facts.blend_by_hand = self.surface.wgsl.routes("BLEND_BY_HAND");
         }
+        if wanted.is_some() {
+            self.mirrors.ensure_images(&gpu.device, ViewImage::Traced);
+            self.environment.ensure_images(&gpu.device, ViewImage::Traced);
+        }
         let layers = (&plan.maps, plan.first_shadow_slot);
         self.shadow.record(gpu, &mut frame, &self.scene_gpu, layers, &settings.shadows);
         let maps = self.shadow.maps();
@@ -281,6 +295,8 @@ impl Renderer {
                 ViewKind::CubeFace { .. } => (view, environment.capture_targets()),
             })
             .collect();
+        let traced =
+            wanted.map(|w| traced::prepare((&gpu.device, scene, settings), &mut frame, w, &plan.lights, &views));
         let inspection = self.inspector.as_ref().map(|i| &i.buffer);
         let inputs = frame_inputs(&maps, environment, inspection);
         self.view_groups.prepare(&gpu.device, &self.layouts.view, &inputs, &views);
@@ -298,6 +314,7 @@ impl Renderer {
             volumes: self.volumes.prepare(&ctx, &views),
             refraction: plan.transparency.then(|| self.refraction.prepare(&ctx, &views)).flatten(),
             transparency: plan.transparency.then(|| self.transparency.prepare(&ctx, &mut frame, &views)),
+            traced,
         };
         // Cube faces first (a mirror may reflect a curved mirror), each copied into its cube;
         // then the mirrored cameras deepest first, so every view's mirrors find their images.
@@ -414,6 +431,9 @@ fn record_view(
     mirrors: &MirrorImages,
 ) {
     let transparent_later = phases.transparency.is_some();
+    if let Some(traced) = &phases.traced {
+        traced.record(frame, view, targets);
+    }
     if view.prepass {
         phases.scene.record_prepass(ctx, frame, view, targets, transparent_later);
     }

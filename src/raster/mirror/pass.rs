@@ -23,7 +23,7 @@
 
 use super::{Mirror, Side, camera_side, find_mirrors, mirrored_view};
 use crate::raster::scene_pass::{MirrorImages, ScenePass};
-use crate::raster::targets::FrameTargets;
+use crate::raster::targets::{FrameTargets, ViewImage};
 use crate::raster::view::{View, frustum_corners};
 use crate::scene::Scene;
 
@@ -71,6 +71,13 @@ impl MirrorPass {
             let targets = FrameTargets::new(device, size);
             let image = scene_pass.mirror_image_group(device, &targets.hdr.view);
             self.targets.push((targets, image));
+        }
+    }
+
+    /// Makes `image` at full size in every mirrored camera's targets (an image made on demand).
+    pub fn ensure_images(&mut self, device: &wgpu::Device, image: ViewImage) {
+        for (targets, _) in &mut self.targets {
+            targets.images.ensure(device, image, targets.size);
         }
     }
 

@@ -1,0 +1,211 @@
+//! The error budget (docs/course/12-error-budget.md): how much of the difference between the
+//! rasterizer and the ray tracer each of the rasterizer's approximations costs, measured by
+//! swapping it for its traced counterpart inside the raster frame (`settings.hybrid`,
+//! `crate::raster::traced`) and comparing by FLIP.
+//!
+//! For a scene, with `R` the raster image, `T` the traced one, `R+a` the raster image with
+//! approximation `a` traced and `R−a` the one with every approximation but `a` traced:
+//!
+//! - **whole**: `FLIP(R, T)`;
+//! - **alone** (what `a` costs, added alone to the rest): `FLIP(R, R+a)`, the change swapping
+//!   `a` alone makes; its error map is where `a` errs;
+//! - **left alone** (what `a` costs, left alone): `FLIP(R−a, T)`, the difference left when `a`
+//!   is the only approximation not traced; it includes the floor;
+//! - **floor**: `FLIP(R+all, T)`, what remains with every approximation swapped: the
+//!   rasterization of primary visibility itself (curved shapes tessellated, a pixel's surface
+//!   chosen by coverage rather than by a ray) and every approximation that has no traced
+//!   counterpart yet ([`unswapped`]).
+//!
+//! FLIP does not add: two errors on one pixel cost less than their sum, so the figures are a
+//! ranking and a map of where each approximation errs, not shares that sum to the whole (Arvo,
+//! Torrance and Smits split the error by its sources in the same spirit, with bounds rather
+//! than measurements).
+
+pub mod sheet;
+
+use image::RgbaImage;
+
+use crate::Scene;
+use crate::compare::difference_beyond;
+use crate::gpu::Gpu;
+use crate::raster::Headless;
+use crate::settings::{HybridSettings, RenderSettings};
+
+/// Differences of up to this many levels (of 255, in every channel) are not counted: they are
+/// rounding, not an approximation (the rasterizer's radiance passes through a half-float target:
+/// a flat sky of 0.78 comes out one level below the tracer's, which costs a mean FLIP of 0.02 on
+/// its own; lavapipe and libm round their last bits differently from CPU to CPU). The tests'
+/// comparisons look past the same two levels (tests/README.md).
+pub const ROUNDING_LEVELS: u8 = 2;
+
+/// One of the rasterizer's approximations with a traced counterpart.
+pub struct Approximation {
+    /// Its name in the budget's report and JSON.
+    pub name: &'static str,
+    /// What the rasterizer does, and what replaces it.
+    pub swap: &'static str,
+    /// Whether `scene` (with its settings) makes this approximation anywhere.
+    pub in_use: fn(&Scene, &RenderSettings) -> bool,
+    /// Its switch in `settings.hybrid`.
+    pub traced: fn(&mut HybridSettings) -> &mut bool,
+}
+
+/// Every approximation the budget can swap, in the order it reports them.
+pub const APPROXIMATIONS: [Approximation; 3] = [
+    Approximation {
+        name: "shadows",
+        swap: "shadow maps or projected polygons → shadow rays from the visible surface",
+        in_use: |scene, settings| settings.shadows.enabled && !scene.lights.is_empty(),
+        traced: |hybrid| &mut hybrid.shadows,
+    },
+    Approximation {
+        name: "reflections",
+        swap: "mirrored cameras and environment maps → the traced L(r)",
+        in_use: |scene, _| scene.objects.iter().any(|o| reflects(&scene.materials[o.material.0])),
+        traced: |hybrid| &mut hybrid.reflections,
+    },
+    Approximation {
+        name: "texture filtering",
+        swap: "trilinear from screen derivatives → the tracer's ray-cone filtering",
+        in_use: |scene, _| scene.objects.iter().any(|o| scene.materials[o.material.0].texture.is_some()),
+        traced: |hybrid| &mut hybrid.textures,
+    },
+];
+
+fn reflects(material: &crate::scene::Material) -> bool {
+    material.mirror * material.mirror_color != glam::Vec3::ZERO
+}
+
+/// What keeps the fully swapped frame from the tracer's image in `scene`: the approximations
+/// without a traced counterpart that it uses, and what no swap removes.
+pub fn unswapped(scene: &Scene, settings: &RenderSettings) -> Vec<&'static str> {
+    let mut causes =
+        vec!["primary visibility: triangles rasterized by coverage (curved shapes tessellated) against exact ray hits"];
+    let material = |o: &crate::scene::Object| &scene.materials[o.material.0];
+    if scene.objects.iter().any(|o| material(o).is_transparent()) {
+        causes.push("transmission: sorted blending and the screen-space refraction are not swapped yet");
+    }
+    if !scene.volumes.is_empty() {
+        causes.push("volumes: the rasterizer's marching is not swapped yet");
+    }
+    if settings.trace.anti_aliasing != crate::settings::AntiAliasing::Center {
+        causes.push("anti-aliasing: the tracer samples more than each pixel's centre");
+    }
+    causes
+}
+
+/// One approximation's two figures, and its error map.
+pub struct Item {
+    pub name: &'static str,
+    pub swap: &'static str,
+    /// `FLIP(R, R+a)`.
+    pub alone: f32,
+    /// `FLIP(R−a, T)`.
+    pub left_alone: f32,
+    /// `R` against `R+a`: where the approximation errs.
+    pub error_map: RgbaImage,
+}
+
+/// A scene's error budget.
+pub struct Budget {
+    /// `FLIP(R, T)`.
+    pub whole: f32,
+    /// The approximations the scene uses, in [`APPROXIMATIONS`]' order.
+    pub items: Vec<Item>,
+    /// `FLIP(R+all, T)`.
+    pub floor: f32,
+    /// What the floor is made of ([`unswapped`]).
+    pub floor_causes: Vec<&'static str>,
+    /// The images: raster, traced, every approximation swapped.
+    pub raster: RgbaImage,
+    pub traced: RgbaImage,
+    pub hybrid: RgbaImage,
+}
+
+/// The budget of `scene` with `settings`, drawn on `gpu`, against `traced` (the tracer's image
+/// of the scene with `settings`).
+pub fn budget(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, traced: RgbaImage) -> Budget {
+    let mut headless = Headless::new(gpu, scene);
+    let mut raster = |settings: &RenderSettings| headless.render(gpu, scene, settings);
+    let used: Vec<&Approximation> = APPROXIMATIONS.iter().filter(|a| (a.in_use)(scene, settings)).collect();
+    let with = |traced_ones: &mut dyn Iterator<Item = &&Approximation>| {
+        let mut settings = settings.clone();
+        settings.hybrid = HybridSettings::default();
+        for a in traced_ones {
+            *(a.traced)(&mut settings.hybrid) = true;
+        }
+        settings
+    };
+    let flip = |a: &RgbaImage, b: &RgbaImage| {
+        difference_beyond(a, b, ROUNDING_LEVELS).expect("every image has the camera's size")
+    };
+    let plain = raster(&with(&mut std::iter::empty()));
+    let hybrid = raster(&with(&mut used.iter()));
+    let items = used
+        .iter()
+        .map(|a| {
+            let added = raster(&with(&mut std::iter::once(a)));
+            let others = raster(&with(&mut used.iter().filter(|b| b.name != a.name)));
+            let alone = flip(&plain, &added);
+            Item {
+                name: a.name,
+                swap: a.swap,
+                alone: alone.flip_mean,
+                left_alone: flip(&traced, &others).flip_mean,
+                error_map: alone.error_map,
+            }
+        })
+        .collect();
+    Budget {
+        whole: flip(&traced, &plain).flip_mean,
+        items,
+        floor: flip(&traced, &hybrid).flip_mean,
+        floor_causes: unswapped(scene, settings),
+        raster: plain,
+        traced,
+        hybrid,
+    }
+}
+
+impl Budget {
+    /// The report `mirador budget` prints.
+    pub fn report(&self) -> String {
+        let mut text = format!(
+            "raster against traced: FLIP {:.4} (differences of up to {ROUNDING_LEVELS} levels are rounding, not counted)\n",
+            self.whole
+        );
+        if self.items.is_empty() {
+            text += "the scene uses none of the approximations the hybrid can trace\n";
+        } else {
+            text += &format!("{:<18} {:>8} {:>11}  swapped\n", "approximation", "alone", "left alone");
+            let mut items: Vec<&Item> = self.items.iter().collect();
+            items.sort_by(|a, b| b.alone.total_cmp(&a.alone));
+            for item in items {
+                text += &format!("{:<18} {:>8.4} {:>11.4}  {}\n", item.name, item.alone, item.left_alone, item.swap);
+            }
+        }
+        text += &format!("every approximation traced: FLIP {:.4}, the floor:\n", self.floor);
+        for cause in &self.floor_causes {
+            text += &format!("  - {cause}\n");
+        }
+        text
+    }
+
+    /// The budget as JSON: `whole`, `floor`, `floor_causes` and, for each approximation in use,
+    /// its `name`, `alone` and `left_alone`.
+    pub fn json(&self) -> serde_json::Value {
+        let items: Vec<serde_json::Value> = self
+            .items
+            .iter()
+            .map(
+                |i| serde_json::json!({ "name": i.name, "alone": i.alone, "left_alone": i.left_alone, "swap": i.swap }),
+            )
+            .collect();
+        serde_json::json!({
+            "whole": self.whole,
+            "approximations": items,
+            "floor": self.floor,
+            "floor_causes": self.floor_causes,
+        })
+    }
+}

@@ -1,0 +1,215 @@
+//! The hybrid's traced terms in the raster frame (docs/course/12-error-budget.md): for every view
+//! of the frame (the main camera, each mirrored camera, each cube face due), the ray tracer
+//! computes the terms `settings.hybrid` asks for at each pixel's first opaque surface
+//! (`crate::trace::terms`), and the view's phases read them from its traced image
+//! (`ViewImage::Traced`) in place of the rasterizer's approximations: shadow rays for shadow maps
+//! and projected polygons, the traced `L(r)` for mirrored cameras and environment maps, the ray
+//! cone's filtering for trilinear filtering. `mirador budget` swaps them one at a time.
+//!
+//! A view's rays are its own camera's: the scene camera's primary rays for the main view (the
+//! tracer's own, so the two agree to the bit), and for the other views the ray through each
+//! pixel unprojected from the view's `clip_from_world`, starting on its clip plane (a mirrored
+//! camera sees only what lies beyond its mirror) and passing the object it looks out of. Each view
+//! is traced into a buffer before the frame is recorded, and copied into its image just before
+//! the view draws: the cube faces share one set of targets, so a copy made earlier would be
+//! overwritten by the next face's.
+
+use glam::{Vec2, Vec3, Vec4};
+
+use super::context::{Figure, FrameEncoder};
+use super::shadow::views::{MAX_SHADOWED_LIGHTS, ShadowLayout};
+use super::targets::{FrameTargets, TRACED_LAYERS, TRACED_REFLECTION, TRACED_SURFACE, TRACED_VISIBILITY, ViewImage};
+use super::view::{FrameView, View, ViewKind, ViewSlot};
+use crate::base::Ray;
+use crate::scene::Scene;
+use crate::settings::RenderSettings;
+use crate::texture::RayCone;
+use crate::trace::Tracer;
+use crate::trace::terms::{TracedTerms, ViewRays, Wanted};
+
+const _: () = assert!(TRACED_LAYERS as usize == TRACED_VISIBILITY as usize + MAX_SHADOWED_LIGHTS);
+
+/// The terms `settings` asks to trace, or `None`.
+pub fn wanted(settings: &RenderSettings) -> Option<Wanted> {
+    let hybrid = &settings.hybrid;
+    hybrid.any().then_some(Wanted {
+        visibility: hybrid.shadows && settings.shadows.enabled,
+        reflection: hybrid.reflections,
+        colour: hybrid.textures,
+    })
+}
+
+/// The settings the rasterizer's own passes draw with: where the reflections are traced, the
+/// mirrored cameras and environment maps they replace are left out.
+pub fn raster_settings(settings: &RenderSettings) -> Option<RenderSettings> {
+    settings.hybrid.reflections.then(|| {
+        let mut raster = settings.clone();
+        raster.mirrors.enabled = false;
+        raster.environment.enabled = false;
+        raster
+    })
+}
+
+/// Every view's traced terms, ready to be copied into its image.
+pub struct PreparedTraced {
+    views: Vec<(ViewSlot, wgpu::Buffer, (u32, u32))>,
+}
+
+/// Bytes of one pixel of one layer (`Rgba32Float`).
+const PIXEL_BYTES: u32 = 16;
+
+/// Traces the terms `wanted` for every view of `views`, each into a buffer of its image's
+/// layers. `lights` are the frame's shadowed lights, whose slots the visibility layers follow.
+pub fn prepare(
+    (device, scene, settings): (&wgpu::Device, &Scene, &RenderSettings),
+    frame: &mut FrameEncoder,
+    wanted: Wanted,
+    lights: &ShadowLayout,
+    views: &[(&FrameView, &FrameTargets)],
+) -> PreparedTraced {
+    let tracer = Tracer::new(scene, settings);
+    let slots: Vec<usize> =
+        lights.first_layer.iter().enumerate().filter(|(_, l)| l.is_some()).map(|(i, _)| i).collect();
+    let slots = &slots[..slots.len().min(MAX_SHADOWED_LIGHTS)];
+    let mut rays = 0;
+    let traced = views
+        .iter()
+        .map(|&(view, targets)| {
+            let size = targets.size;
+            let camera_ray = camera_rays(scene, view, size);
+            let rays_of_view = ViewRays {
+                size,
+                window: view.scissor.unwrap_or([0, 0, size.0, size.1]),
+                ray: &*camera_ray.0,
+                cone: camera_ray.1,
+                skip: view.skip,
+                lights: slots,
+            };
+            let terms = tracer.terms(&rays_of_view, wanted);
+            rays += terms.rays.total();
+            (view.slot, upload(device, &terms), size)
+        })
+        .collect();
+    frame.end("traced terms", &[("rays", Figure::Count(rays))]);
+    PreparedTraced { views: traced }
+}
+
+impl PreparedTraced {
+    /// Copies `view`'s terms into its traced image, which the view's shading then reads.
+    pub fn record(&self, frame: &mut FrameEncoder, view: &FrameView, targets: &FrameTargets) {
+        let Some((_, buffer, size)) = self.views.iter().find(|(slot, ..)| *slot == view.slot) else { return };
+        let image = targets.images.get(ViewImage::Traced);
+        debug_assert_eq!(*size, targets.size, "the view's image was made at its targets' size");
+        frame.encoder.copy_buffer_to_texture(
+            wgpu::TexelCopyBufferInfo {
+                buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row(size.0)),
+                    rows_per_image: Some(size.1),
+                },
+            },
+            image.texture.as_image_copy(),
+            wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: TRACED_LAYERS },
+        );
+    }
+}
+
+/// A row's bytes, padded to wgpu's copy alignment.
+fn padded_row(width: u32) -> u32 {
+    (width * PIXEL_BYTES).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+}
+
+/// The terms in the image's layout: layer by layer, row by row, rows padded.
+fn upload(device: &wgpu::Device, terms: &TracedTerms) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    let (width, height) = terms.size;
+    let pixels = (width * height) as usize;
+    let row = padded_row(width) as usize;
+    let mut bytes = vec![0u8; row * height as usize * TRACED_LAYERS as usize];
+    let mut layer = |k: u32, values: &[[f32; 4]]| {
+        let layer = &mut bytes[row * height as usize * k as usize..][..row * height as usize];
+        for (y, line) in values.chunks(width as usize).enumerate() {
+            layer[y * row..][..line.len() * PIXEL_BYTES as usize].copy_from_slice(bytemuck::cast_slice(line));
+        }
+    };
+    layer(TRACED_SURFACE, &terms.surface);
+    layer(TRACED_REFLECTION, &terms.reflection);
+    for (slot, values) in terms.visibility.chunks(pixels.max(1)).enumerate() {
+        layer(TRACED_VISIBILITY + slot as u32, values);
+    }
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("traced::terms"),
+        contents: &bytes,
+        usage: wgpu::BufferUsages::COPY_SRC,
+    })
+}
+
+type RayFn = Box<dyn Fn(f32, f32) -> Option<Ray> + Sync>;
+
+/// The rays of `view` drawn at `size`, and a pixel's cone along them.
+fn camera_rays(scene: &Scene, view: &FrameView, size: (u32, u32)) -> (RayFn, RayCone) {
+    let camera = scene.camera.clone();
+    if view.kind == ViewKind::Main {
+        // The tracer's own primary rays, scaled from the drawn size to the camera's.
+        let (sx, sy) = (camera.width as f32 / size.0 as f32, camera.height as f32 / size.1 as f32);
+        let cone = match camera.projection {
+            crate::scene::Projection::Perspective => RayCone::perspective(camera.fovy_degrees.to_radians(), size.1),
+            crate::scene::Projection::Orthographic => RayCone::orthographic(camera.window().0 / size.0 as f32),
+        };
+        return (Box::new(move |x, y| Some(camera.ray_through(x * sx, y * sy))), cone);
+    }
+    let unprojected = Unprojected::new(&view.view, size);
+    let centre = (size.0 as f32 / 2.0, size.1 as f32 / 2.0);
+    let (a, b) = (unprojected.line(centre.0, centre.1), unprojected.line(centre.0 + 1.0, centre.1));
+    let cone = if view.view.orthographic {
+        RayCone::orthographic(a.origin.distance(b.origin))
+    } else {
+        RayCone { width: 0.0, spread: a.direction.angle_between(b.direction) }
+    };
+    (Box::new(move |x, y| unprojected.ray(x, y)), cone)
+}
+
+/// A view's rays, unprojected from its `clip_from_world`.
+struct Unprojected {
+    world_from_clip: glam::Mat4,
+    size: Vec2,
+    eye: Option<Vec3>,
+    clip_plane: Option<Vec4>,
+}
+
+impl Unprojected {
+    fn new(view: &View, size: (u32, u32)) -> Unprojected {
+        Unprojected {
+            world_from_clip: view.clip_from_world.inverse(),
+            size: Vec2::new(size.0 as f32, size.1 as f32),
+            eye: (!view.orthographic).then_some(view.eye),
+            clip_plane: view.clip_plane,
+        }
+    }
+
+    /// The line through image point `(x, y)`: from the eye (or the near plane, orthographic).
+    fn line(&self, x: f32, y: f32) -> Ray {
+        let ndc = Vec2::new(2.0 * x / self.size.x - 1.0, 1.0 - 2.0 * y / self.size.y);
+        let near = self.world_from_clip.project_point3(ndc.extend(0.0));
+        let far = self.world_from_clip.project_point3(ndc.extend(1.0));
+        Ray { origin: self.eye.unwrap_or(near), direction: (far - near).normalize() }
+    }
+
+    /// The ray through `(x, y)` from where the view starts seeing: its clip plane, if the line
+    /// starts behind it; `None` if it never crosses into what the view sees.
+    fn ray(&self, x: f32, y: f32) -> Option<Ray> {
+        let mut ray = self.line(x, y);
+        if let Some(plane) = self.clip_plane {
+            let side = plane.truncate().dot(ray.origin) + plane.w;
+            if side < 0.0 {
+                let towards = plane.truncate().dot(ray.direction);
+                if towards <= 0.0 {
+                    return None;
+                }
+                ray.origin = ray.at(-side / towards);
+            }
+        }
+        Some(ray)
+    }
+}

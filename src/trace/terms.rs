@@ -1,0 +1,200 @@
+//! The hybrid's traced terms (docs/course/12-error-budget.md): for every pixel of one view of the
+//! raster frame, the terms the tracer computes at the surface that pixel shows, for the
+//! rasterizer to read in place of its own approximations (`crate::raster::traced`).
+//!
+//! The surface is the first *opaque* one along the pixel's ray: what the raster frame's opaque
+//! phase draws there. The ray goes on straight past transparent surfaces (`kt > 0` or blended),
+//! past a mask's holes, and past the object the view looks out of (a mirrored camera's mirror, a
+//! cube's own object). At that surface:
+//!
+//! - **visibility**: `V_i` of each shadowed light, the tracer's shadow ray (tinted by the
+//!   transparent occluders it passes), exactly as [`super::whitted`] weighs `L_dir`;
+//! - **reflection**: `L(r)`, the tracer's whole recursion along the mirror direction
+//!   `r = 2(n·v)n − v`, for surfaces with `kps > 0`; the rasterizer multiplies it by its own
+//!   `kps·MPS`;
+//! - **colour**: `C`, the material's colour times its texture filtered over the ray cone's
+//!   footprint, and the surface's object, so the shading uses the traced terms only on the
+//!   surface they were traced on.
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::Tracer;
+use super::whitted::{MAX_LAYERS, RayCounts, surface_offset};
+use crate::base::Ray;
+use crate::scene::AlphaMode;
+use crate::scene::shading::facing_viewer;
+use crate::texture::RayCone;
+
+/// Which terms to trace.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Wanted {
+    pub visibility: bool,
+    pub reflection: bool,
+    pub colour: bool,
+}
+
+/// One view of the raster frame, as the tracer looks through it.
+pub struct ViewRays<'a> {
+    /// The view's image, in pixels.
+    pub size: (u32, u32),
+    /// The part of it the view draws (`[x, y, width, height]`): the rest is left empty.
+    pub window: [u32; 4],
+    /// The ray through image point `(x, y)` (pixel `(i, j)` spans `[i, i+1] × [j, j+1]`), starting
+    /// where the view starts seeing; `None` where the view sees nothing.
+    pub ray: &'a (dyn Fn(f32, f32) -> Option<Ray> + Sync),
+    /// A pixel's footprint along the ray.
+    pub cone: RayCone,
+    /// The object the view looks out of, which its rays pass.
+    pub skip: Option<usize>,
+    /// The scene light of each shadowed light's slot (the rasterizer's `shadow_slot` order).
+    pub lights: &'a [usize],
+}
+
+/// What a pixel's surface keeps: nothing there, or its object (as the rasterizer numbers them)
+/// and terms.
+pub const NO_SURFACE: f32 = 0.0;
+
+/// The traced terms of one view, row by row, four floats a pixel.
+pub struct TracedTerms {
+    pub size: (u32, u32),
+    /// `C` and `object + 1` (0: no opaque surface).
+    pub surface: Vec<[f32; 4]>,
+    /// `L(r)` (0 where the surface is no mirror).
+    pub reflection: Vec<[f32; 4]>,
+    /// `V_i` of each slot's light, one image after another (`lights.len()` of them).
+    pub visibility: Vec<[f32; 4]>,
+    /// The rays traced, for the frame's figures.
+    pub rays: RayCounts,
+}
+
+/// One pixel's terms.
+#[derive(Clone, Copy, Default)]
+struct Pixel {
+    surface: [f32; 4],
+    reflection: [f32; 4],
+}
+
+impl Tracer<'_> {
+    /// The terms `wanted` at every pixel of `view`'s window.
+    pub fn terms(&self, view: &ViewRays, wanted: Wanted) -> TracedTerms {
+        let (width, height) = view.size;
+        let [x0, y0, w, h] = view.window;
+        let slots = if wanted.visibility { view.lights.len() } else { 0 };
+        let pixels = (width * height) as usize;
+        let rows: Vec<(u32, Vec<(Pixel, Vec<[f32; 4]>)>, RayCounts)> = (y0..(y0 + h).min(height))
+            .into_par_iter()
+            .map(|y| {
+                let mut counts = RayCounts::default();
+                let row = (x0..(x0 + w).min(width))
+                    .map(|x| self.pixel_terms(view, (x, y), wanted, slots, &mut counts))
+                    .collect();
+                (y, row, counts)
+            })
+            .collect();
+        let mut terms = TracedTerms {
+            size: view.size,
+            surface: vec![[0.0; 4]; pixels],
+            reflection: vec![[0.0; 4]; pixels],
+            visibility: vec![[1.0; 4]; pixels * slots],
+            rays: RayCounts::default(),
+        };
+        for (y, row, counts) in rows {
+            terms.rays += counts;
+            for (k, (pixel, visibility)) in row.into_iter().enumerate() {
+                let index = (y * width + x0) as usize + k;
+                terms.surface[index] = pixel.surface;
+                terms.reflection[index] = pixel.reflection;
+                for (slot, v) in visibility.into_iter().enumerate() {
+                    terms.visibility[slot * pixels + index] = v;
+                }
+            }
+        }
+        terms
+    }
+
+    fn pixel_terms(
+        &self,
+        view: &ViewRays,
+        (x, y): (u32, u32),
+        wanted: Wanted,
+        slots: usize,
+        counts: &mut RayCounts,
+    ) -> (Pixel, Vec<[f32; 4]>) {
+        let mut visibility = vec![[1.0; 4]; slots];
+        let Some(ray) = (view.ray)(x as f32 + 0.5, y as f32 + 0.5) else { return (Pixel::default(), visibility) };
+        counts.primary += 1;
+        let Some((hit, ray, cone)) = self.first_opaque_surface(&ray, view.cone, view.skip) else {
+            return (Pixel::default(), visibility);
+        };
+        let whitted = &self.whitted;
+        let material = &self.scene.materials[hit.material.0];
+        let v = -ray.direction;
+        let outside = facing_viewer(hit.geometric_normal, v);
+        let offset = surface_offset(hit.point);
+        let colour = if wanted.colour {
+            whitted.textures.colour(material, &hit, ray.direction, &cone, &whitted.texture_settings)
+        } else {
+            Vec3::ZERO
+        };
+        let mut pixel = Pixel { surface: [colour.x, colour.y, colour.z, hit.object as f32 + 1.0], ..Pixel::default() };
+        if wanted.visibility {
+            for (slot, &light) in view.lights.iter().enumerate() {
+                let Some(incidence) = self.scene.lights.get(light).and_then(|l| l.incidence(hit.point)) else {
+                    continue;
+                };
+                let origin = hit.point + offset * outside;
+                visibility[slot] =
+                    whitted.visibility(origin, incidence.l, incidence.distance, counts).extend(1.0).into();
+            }
+        }
+        let reflects = material.mirror * material.mirror_color != Vec3::ZERO;
+        if wanted.reflection && reflects && whitted.max_depth > 0 {
+            counts.reflected += 1;
+            let n = whitted.shading_normal(material, &hit, v);
+            let reflected = Ray { origin: hit.point + offset * outside, direction: 2.0 * n.dot(v) * n - v };
+            let radiance = whitted.radiance(&reflected, cone.continued(hit.t), 1, counts);
+            pixel.reflection = radiance.extend(1.0).into();
+        }
+        (pixel, visibility)
+    }
+
+    /// The first opaque surface along `ray`: past transparent surfaces, a mask's holes and the
+    /// object `skip`, the ray going on from just beyond each (its cone continued). Returns the
+    /// hit with the ray and cone that found it.
+    fn first_opaque_surface(
+        &self,
+        ray: &Ray,
+        cone: RayCone,
+        skip: Option<usize>,
+    ) -> Option<(super::geometry::SurfaceHit, Ray, RayCone)> {
+        let whitted = &self.whitted;
+        let (mut ray, mut cone) = (*ray, cone);
+        for _ in 0..MAX_LAYERS {
+            let hit = whitted.accelerator.closest(&whitted.primitives, &ray, 0.0, f32::INFINITY)?;
+            let surface = whitted.primitives[hit.primitive as usize].surface(&ray, hit.t);
+            let material = &self.scene.materials[surface.material.0];
+            let passed = Some(surface.object) == skip
+                || material.is_transparent()
+                || match material.alpha_mode {
+                    AlphaMode::Mask { cutoff } => {
+                        whitted.textures.coverage(
+                            material,
+                            &surface,
+                            ray.direction,
+                            Some(&cone),
+                            &whitted.texture_settings,
+                        ) < cutoff
+                    }
+                    AlphaMode::Opaque | AlphaMode::Blend => false,
+                };
+            if !passed {
+                return Some((surface, ray, cone));
+            }
+            let step = hit.t + surface_offset(surface.point);
+            ray.origin = ray.at(step);
+            cone = cone.continued(step);
+        }
+        None
+    }
+}
