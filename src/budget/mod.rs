@@ -102,8 +102,9 @@ pub struct Item {
     pub alone: f32,
     /// `FLIP(R−a, T)`.
     pub left_alone: f32,
-    /// `R` against `R+a`: where the approximation errs.
+    /// `R` against `R+a`: where the approximation errs, as a picture and per pixel.
     pub error_map: RgbaImage,
+    pub errors: Vec<f32>,
 }
 
 /// A scene's error budget.
@@ -153,6 +154,7 @@ pub fn budget(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, traced: RgbaI
                 alone: alone.flip_mean,
                 left_alone: flip(&traced, &others).flip_mean,
                 error_map: alone.error_map,
+                errors: alone.flip_errors,
             }
         })
         .collect();

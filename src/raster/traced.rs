@@ -175,6 +175,7 @@ struct Unprojected {
     world_from_clip: glam::Mat4,
     size: Vec2,
     eye: Option<Vec3>,
+    view_axis: Vec3,
     clip_plane: Option<Vec4>,
 }
 
@@ -184,16 +185,22 @@ impl Unprojected {
             world_from_clip: view.clip_from_world.inverse(),
             size: Vec2::new(size.0 as f32, size.1 as f32),
             eye: (!view.orthographic).then_some(view.eye),
+            view_axis: view.view_axis,
             clip_plane: view.clip_plane,
         }
     }
 
-    /// The line through image point `(x, y)`: from the eye (or the near plane, orthographic).
+    /// The line through image point `(x, y)`: from the eye through the point of the near plane,
+    /// or from that point along the view axis (orthographic). Not through the far plane's point:
+    /// a mirrored camera's far plane is tilted ([`super::mirror::oblique_near_plane`]) and may
+    /// lie behind the eye at a corner.
     fn line(&self, x: f32, y: f32) -> Ray {
         let ndc = Vec2::new(2.0 * x / self.size.x - 1.0, 1.0 - 2.0 * y / self.size.y);
         let near = self.world_from_clip.project_point3(ndc.extend(0.0));
-        let far = self.world_from_clip.project_point3(ndc.extend(1.0));
-        Ray { origin: self.eye.unwrap_or(near), direction: (far - near).normalize() }
+        match self.eye {
+            Some(eye) => Ray { origin: eye, direction: (near - eye).normalize() },
+            None => Ray { origin: near, direction: -self.view_axis },
+        }
     }
 
     /// The ray through `(x, y)` from where the view starts seeing: its clip plane, if the line
