@@ -13,6 +13,19 @@ fn scene_fragment(in: VertexOut) -> vec4f {
     if masked_out(in.uv) {
         discard;
     }
+    // The hybrid's traced transmission (src/raster/traced.rs): the frame draws transparent
+    // surfaces here, each its own α·Im and, where traced on it, what it lets through.
+    if (TRACED & TRACED_TRANSMISSION) != 0u && material.transparent != 0u {
+        var alpha = 1.0;
+        if ALPHA_MODE == ALPHA_BLEND {
+            alpha = coverage(in.uv);
+        }
+        var radiance = alpha * shade(in);
+        if traced_object(in.clip.xy) == in.object + 1u {
+            radiance += traced_term(in.clip.xy, TRACED_TRANSMISSION_LAYER);
+        }
+        return vec4f(radiance, 1.0);
+    }
     return vec4f(shade(in), 1.0);
 }
 

@@ -230,7 +230,7 @@ fn instance_attributes_match_the_wgsl_locations() {
 #[test]
 fn codes_shared_by_rust_and_wgsl_agree() {
     let module = surface_modules();
-    let codes: [(&str, f64); 43] = [
+    let codes: [(&str, f64); 51] = [
         ("MAX_LIGHTS", uniforms::MAX_LIGHTS as f64),
         ("MAX_SHADOW_LAYERS", MAX_LAYERS as f64),
         ("LIGHT_POINT", uniforms::LIGHT_POINT.into()),
@@ -256,6 +256,8 @@ fn codes_shared_by_rust_and_wgsl_agree() {
         ("TRACED_VISIBILITY", keys::TRACED_VISIBILITY.into()),
         ("TRACED_REFLECTION", keys::TRACED_REFLECTION.into()),
         ("TRACED_COLOUR", keys::TRACED_COLOUR.into()),
+        ("TRACED_TRANSMISSION", keys::TRACED_TRANSMISSION.into()),
+        ("TRACED_TRANSMISSION_LAYER", mirador::raster::targets::TRACED_TRANSMISSION.into()),
         ("TRACED_SURFACE_LAYER", mirador::raster::targets::TRACED_SURFACE.into()),
         ("TRACED_REFLECTION_LAYER", mirador::raster::targets::TRACED_REFLECTION.into()),
         ("TRACED_VISIBILITY_LAYER", mirador::raster::targets::TRACED_VISIBILITY.into()),

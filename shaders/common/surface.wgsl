@@ -42,10 +42,12 @@ const SHADOWS_PROJECTED: u32 = 2u;
 const TRACED_VISIBILITY: u32 = 1u;
 const TRACED_REFLECTION: u32 = 2u;
 const TRACED_COLOUR: u32 = 4u;
+const TRACED_TRANSMISSION: u32 = 8u;
 // The layers of the view's traced image.
 const TRACED_SURFACE_LAYER: i32 = 0;
 const TRACED_REFLECTION_LAYER: i32 = 1;
-const TRACED_VISIBILITY_LAYER: i32 = 2;
+const TRACED_TRANSMISSION_LAYER: i32 = 2;
+const TRACED_VISIBILITY_LAYER: i32 = 3;
 
 const BUMP_VIEW_NORMALS: u32 = 1u;
 const BUMP_VIEW_TANGENTS: u32 = 2u;

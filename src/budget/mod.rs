@@ -51,7 +51,7 @@ pub struct Approximation {
 }
 
 /// Every approximation the budget can swap, in the order it reports them.
-pub const APPROXIMATIONS: [Approximation; 3] = [
+pub const APPROXIMATIONS: [Approximation; 4] = [
     Approximation {
         name: "shadows",
         swap: "shadow maps or projected polygons → shadow rays from the visible surface",
@@ -63,6 +63,12 @@ pub const APPROXIMATIONS: [Approximation; 3] = [
         swap: "mirrored cameras and environment maps → the traced L(r)",
         in_use: |scene, _| scene.objects.iter().any(|o| reflects(&scene.materials[o.material.0])),
         traced: |hybrid| &mut hybrid.reflections,
+    },
+    Approximation {
+        name: "transmission",
+        swap: "sorted blending and screen-space refraction → the traced transmission",
+        in_use: |scene, _| scene.objects.iter().any(|o| scene.materials[o.material.0].is_transparent()),
+        traced: |hybrid| &mut hybrid.transmission,
     },
     Approximation {
         name: "texture filtering",
@@ -81,10 +87,6 @@ fn reflects(material: &crate::scene::Material) -> bool {
 pub fn unswapped(scene: &Scene, settings: &RenderSettings) -> Vec<&'static str> {
     let mut causes =
         vec!["primary visibility: triangles rasterized by coverage (curved shapes tessellated) against exact ray hits"];
-    let material = |o: &crate::scene::Object| &scene.materials[o.material.0];
-    if scene.objects.iter().any(|o| material(o).is_transparent()) {
-        causes.push("transmission: sorted blending and the screen-space refraction are not swapped yet");
-    }
     if !scene.volumes.is_empty() {
         causes.push("volumes: the rasterizer's marching is not swapped yet");
     }

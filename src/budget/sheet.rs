@@ -15,7 +15,7 @@ const FLOOR: Rgba<u8> = Rgba([140, 140, 140, 255]);
 
 /// The sheet of `budget`.
 pub fn sheet(budget: &Budget) -> RgbaImage {
-    let (width, height) = budget.raster.dimensions();
+    let width = budget.raster.width();
     let top = panels_sheet(&[
         Panel::new(format!("raster (FLIP {:.4})", budget.whole), budget.raster.clone()),
         Panel::new("ray traced", budget.traced.clone()),
@@ -25,8 +25,7 @@ pub fn sheet(budget: &Budget) -> RgbaImage {
     let mut lines = vec![top];
     for item in &budget.items {
         let bars = bars(
-            (width, height),
-            item.name,
+            width,
             &[
                 ("alone", item.alone, ALONE),
                 ("left alone", item.left_alone, LEFT_ALONE),
@@ -42,14 +41,13 @@ pub fn sheet(budget: &Budget) -> RgbaImage {
     with_footer(&rows(&lines), &flip_legend(width.clamp(200, 400)))
 }
 
-/// A panel of horizontal bars, each `(label, value, colour)`, on a common `scale`.
-fn bars((width, height): (u32, u32), title: &str, values: &[(&str, f32, Rgba<u8>)], scale: f32) -> RgbaImage {
-    let mut image = RgbaImage::from_pixel(width, height.min(40 + 44 * values.len() as u32).max(60), BACKGROUND);
-    draw_text(&mut image, title, 8.0, 6.0, 18.0, TEXT);
+/// A panel `width` wide of horizontal bars, each `(label, value, colour)`, on a common `scale`.
+fn bars(width: u32, values: &[(&str, f32, Rgba<u8>)], scale: f32) -> RgbaImage {
+    let mut image = RgbaImage::from_pixel(width, 8 + 44 * values.len() as u32, BACKGROUND);
     let left = 110u32;
     let length = width.saturating_sub(left + 80).max(1);
     for (k, &(label, value, colour)) in values.iter().enumerate() {
-        let y = 36 + 44 * k as u32;
+        let y = 8 + 44 * k as u32;
         draw_text(&mut image, label, 8.0, y as f32 + 4.0, 16.0, TEXT);
         let bar = ((value / scale.max(1e-6)).clamp(0.0, 1.0) * length as f32).round() as u32;
         for yy in y..(y + 24).min(image.height()) {

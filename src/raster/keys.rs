@@ -103,12 +103,14 @@ pub const ENV_MAP_DYNAMIC: u32 = 4;
 pub const TRACED_VISIBILITY: u32 = 1;
 pub const TRACED_REFLECTION: u32 = 2;
 pub const TRACED_COLOUR: u32 = 4;
+pub const TRACED_TRANSMISSION: u32 = 8;
 
 fn traced_code(hybrid: &HybridSettings) -> u32 {
     let bit = |on: bool, bit: u32| if on { bit } else { 0 };
     bit(hybrid.shadows, TRACED_VISIBILITY)
         | bit(hybrid.reflections, TRACED_REFLECTION)
         | bit(hybrid.textures, TRACED_COLOUR)
+        | bit(hybrid.transmission, TRACED_TRANSMISSION)
 }
 
 /// `SHADOW_METHOD`: no shadows at all (no light casts one, or shadows are off).

@@ -39,15 +39,17 @@ pub enum ViewImage {
     ProjectedMask,
     /// The hybrid's traced terms at each pixel's first opaque surface (`super::traced`, copied in
     /// before the view draws): layer [`TRACED_SURFACE`] holds `C` and the surface's object + 1,
-    /// layer [`TRACED_REFLECTION`] `L(r)`, and the layers from [`TRACED_VISIBILITY`] on each
-    /// shadowed light's `V_i`. Made at the targets' size only when a frame traces a term.
+    /// layer [`TRACED_REFLECTION`] `L(r)`, layer [`TRACED_TRANSMISSION`] what a transparent
+    /// surface lets through, and the layers from [`TRACED_VISIBILITY`] on each shadowed light's
+    /// `V_i`. Made at the targets' size only when a frame traces a term.
     Traced,
 }
 
 /// The layers of [`ViewImage::Traced`].
 pub const TRACED_SURFACE: u32 = 0;
 pub const TRACED_REFLECTION: u32 = 1;
-pub const TRACED_VISIBILITY: u32 = 2;
+pub const TRACED_TRANSMISSION: u32 = 2;
+pub const TRACED_VISIBILITY: u32 = 3;
 /// Its layers: a visibility layer for each of the rasterizer's shadowed lights (four).
 pub const TRACED_LAYERS: u32 = TRACED_VISIBILITY + 4;
 

@@ -3,8 +3,9 @@
 //! computes the terms `settings.hybrid` asks for at each pixel's first opaque surface
 //! (`crate::trace::terms`), and the view's phases read them from its traced image
 //! (`ViewImage::Traced`) in place of the rasterizer's approximations: shadow rays for shadow maps
-//! and projected polygons, the traced `L(r)` for mirrored cameras and environment maps, the ray
-//! cone's filtering for trilinear filtering. `mirador budget` swaps them one at a time.
+//! and projected polygons, the traced `L(r)` for mirrored cameras and environment maps, the
+//! traced transmission for sorted blending and refraction, the ray cone's filtering for trilinear
+//! filtering. `mirador budget` swaps them one at a time.
 //!
 //! A view's rays are its own camera's: the scene camera's primary rays for the main view (the
 //! tracer's own, so the two agree to the bit), and for the other views the ray through each
@@ -18,7 +19,9 @@ use glam::{Vec2, Vec3, Vec4};
 
 use super::context::{Figure, FrameEncoder};
 use super::shadow::views::{MAX_SHADOWED_LIGHTS, ShadowLayout};
-use super::targets::{FrameTargets, TRACED_LAYERS, TRACED_REFLECTION, TRACED_SURFACE, TRACED_VISIBILITY, ViewImage};
+use super::targets::{
+    FrameTargets, TRACED_LAYERS, TRACED_REFLECTION, TRACED_SURFACE, TRACED_TRANSMISSION, TRACED_VISIBILITY, ViewImage,
+};
 use super::view::{FrameView, View, ViewKind, ViewSlot};
 use crate::base::Ray;
 use crate::scene::Scene;
@@ -35,17 +38,26 @@ pub fn wanted(settings: &RenderSettings) -> Option<Wanted> {
     hybrid.any().then_some(Wanted {
         visibility: hybrid.shadows && settings.shadows.enabled,
         reflection: hybrid.reflections,
+        transmission: hybrid.transmission,
         colour: hybrid.textures,
     })
 }
 
-/// The settings the rasterizer's own passes draw with: where the reflections are traced, the
-/// mirrored cameras and environment maps they replace are left out.
+/// The settings the rasterizer's own passes draw with: what a traced term replaces is left out.
+/// Traced reflections replace the mirrored cameras and the environment maps; traced transmission
+/// replaces the transparency pass and refraction (transparent surfaces are then drawn with the
+/// opaque ones, each adding what the tracer says it lets through).
 pub fn raster_settings(settings: &RenderSettings) -> Option<RenderSettings> {
-    settings.hybrid.reflections.then(|| {
+    let hybrid = &settings.hybrid;
+    (hybrid.reflections || hybrid.transmission).then(|| {
         let mut raster = settings.clone();
-        raster.mirrors.enabled = false;
-        raster.environment.enabled = false;
+        if hybrid.reflections {
+            raster.mirrors.enabled = false;
+            raster.environment.enabled = false;
+        }
+        if hybrid.transmission {
+            raster.transparency.enabled = false;
+        }
         raster
     })
 }
@@ -135,6 +147,7 @@ fn upload(device: &wgpu::Device, terms: &TracedTerms) -> wgpu::Buffer {
     };
     layer(TRACED_SURFACE, &terms.surface);
     layer(TRACED_REFLECTION, &terms.reflection);
+    layer(TRACED_TRANSMISSION, &terms.transmission);
     for (slot, values) in terms.visibility.chunks(pixels.max(1)).enumerate() {
         layer(TRACED_VISIBILITY + slot as u32, values);
     }
@@ -145,7 +158,7 @@ fn upload(device: &wgpu::Device, terms: &TracedTerms) -> wgpu::Buffer {
     })
 }
 
-type RayFn = Box<dyn Fn(f32, f32) -> Option<Ray> + Sync>;
+type RayFn = Box<dyn Fn(f32, f32) -> Option<(Ray, f32)> + Sync>;
 
 /// The rays of `view` drawn at `size`, and a pixel's cone along them.
 fn camera_rays(scene: &Scene, view: &FrameView, size: (u32, u32)) -> (RayFn, RayCone) {
@@ -157,7 +170,7 @@ fn camera_rays(scene: &Scene, view: &FrameView, size: (u32, u32)) -> (RayFn, Ray
             crate::scene::Projection::Perspective => RayCone::perspective(camera.fovy_degrees.to_radians(), size.1),
             crate::scene::Projection::Orthographic => RayCone::orthographic(camera.window().0 / size.0 as f32),
         };
-        return (Box::new(move |x, y| Some(camera.ray_through(x * sx, y * sy))), cone);
+        return (Box::new(move |x, y| Some((camera.ray_through(x * sx, y * sy), 0.0))), cone);
     }
     let unprojected = Unprojected::new(&view.view, size);
     let centre = (size.0 as f32 / 2.0, size.1 as f32 / 2.0);
@@ -203,10 +216,12 @@ impl Unprojected {
         }
     }
 
-    /// The ray through `(x, y)` from where the view starts seeing: its clip plane, if the line
-    /// starts behind it; `None` if it never crosses into what the view sees.
-    fn ray(&self, x: f32, y: f32) -> Option<Ray> {
+    /// The ray through `(x, y)` from where the view starts seeing, its clip plane if the line
+    /// starts behind it, and how far along the line that is; `None` if the line never crosses
+    /// into what the view sees.
+    fn ray(&self, x: f32, y: f32) -> Option<(Ray, f32)> {
         let mut ray = self.line(x, y);
+        let mut start = 0.0;
         if let Some(plane) = self.clip_plane {
             let side = plane.truncate().dot(ray.origin) + plane.w;
             if side < 0.0 {
@@ -214,9 +229,10 @@ impl Unprojected {
                 if towards <= 0.0 {
                     return None;
                 }
-                ray.origin = ray.at(-side / towards);
+                start = -side / towards;
+                ray.origin = ray.at(start);
             }
         }
-        Some(ray)
+        Some((ray, start))
     }
 }

@@ -19,6 +19,10 @@ section! {
         /// the reflected ray), in place of the mirrored cameras of planar mirrors and the
         /// environment maps of curved ones.
         reflections: bool = false,
+        /// What transparent surfaces let through, traced (`α·((1 − F)·kt·MT·L(t) + F·kt·MT·L(r))
+        /// + (1 − α)·L(behind)`), in place of sorted blending and the screen-space refraction:
+        /// the frame draws transparent surfaces as opaque ones, each adding its traced share.
+        transmission: bool = false,
         /// The surface colour `C` filtered as the tracer filters it (its mip level from a ray
         /// cone), in place of trilinear filtering from screen derivatives. The swap goes the
         /// tracer's way: neither filter is exact, the tracer's is the reference's.
@@ -29,6 +33,6 @@ section! {
 impl HybridSettings {
     /// Whether any term is traced.
     pub fn any(&self) -> bool {
-        self.shadows || self.reflections || self.textures
+        self.shadows || self.reflections || self.transmission || self.textures
     }
 }

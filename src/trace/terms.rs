@@ -5,13 +5,17 @@
 //! The surface is the first *opaque* one along the pixel's ray: what the raster frame's opaque
 //! phase draws there. The ray goes on straight past transparent surfaces (`kt > 0` or blended),
 //! past a mask's holes, and past the object the view looks out of (a mirrored camera's mirror, a
-//! cube's own object). At that surface:
+//! cube's own object). Where transmission is traced, the frame draws transparent surfaces as
+//! opaque ones and the surface is the first one, transparent or not. At that surface:
 //!
 //! - **visibility**: `V_i` of each shadowed light, the tracer's shadow ray (tinted by the
 //!   transparent occluders it passes), exactly as [`super::whitted`] weighs `L_dir`;
 //! - **reflection**: `L(r)`, the tracer's whole recursion along the mirror direction
 //!   `r = 2(n·v)n − v`, for surfaces with `kps > 0`; the rasterizer multiplies it by its own
 //!   `kps·MPS`;
+//! - **transmission**: what a transparent surface lets through, as the tracer adds it to the
+//!   surface's own `α·Im`: `α·((1 − F)·kt·MT·L(t) + F·kt·MT·L(r)) + (1 − α)·L(behind)` (without
+//!   Fresnel `F = 0`; on total internal reflection all of `kt·MT` is reflected);
 //! - **colour**: `C`, the material's colour times its texture filtered over the ray cone's
 //!   footprint, and the surface's object, so the shading uses the traced terms only on the
 //!   surface they were traced on.
@@ -20,6 +24,8 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::Tracer;
+use super::explain::Unobserved;
+use super::geometry::SurfaceHit;
 use super::whitted::{MAX_LAYERS, RayCounts, surface_offset};
 use crate::base::Ray;
 use crate::scene::AlphaMode;
@@ -31,6 +37,7 @@ use crate::texture::RayCone;
 pub struct Wanted {
     pub visibility: bool,
     pub reflection: bool,
+    pub transmission: bool,
     pub colour: bool,
 }
 
@@ -41,9 +48,11 @@ pub struct ViewRays<'a> {
     /// The part of it the view draws (`[x, y, width, height]`): the rest is left empty.
     pub window: [u32; 4],
     /// The ray through image point `(x, y)` (pixel `(i, j)` spans `[i, i+1] × [j, j+1]`), starting
-    /// where the view starts seeing; `None` where the view sees nothing.
-    pub ray: &'a (dyn Fn(f32, f32) -> Option<Ray> + Sync),
-    /// A pixel's footprint along the ray.
+    /// where the view starts seeing, and how far that is from where its cone starts (a mirrored
+    /// camera's rays start on the mirror, their cones at the mirrored eye); `None` where the view
+    /// sees nothing.
+    pub ray: &'a (dyn Fn(f32, f32) -> Option<(Ray, f32)> + Sync),
+    /// A pixel's footprint along the ray, from where it starts.
     pub cone: RayCone,
     /// The object the view looks out of, which its rays pass.
     pub skip: Option<usize>,
@@ -62,6 +71,8 @@ pub struct TracedTerms {
     pub surface: Vec<[f32; 4]>,
     /// `L(r)` (0 where the surface is no mirror).
     pub reflection: Vec<[f32; 4]>,
+    /// What a transparent surface lets through (0 on others).
+    pub transmission: Vec<[f32; 4]>,
     /// `V_i` of each slot's light, one image after another (`lights.len()` of them).
     pub visibility: Vec<[f32; 4]>,
     /// The rays traced, for the frame's figures.
@@ -73,6 +84,7 @@ pub struct TracedTerms {
 struct Pixel {
     surface: [f32; 4],
     reflection: [f32; 4],
+    transmission: [f32; 4],
 }
 
 impl Tracer<'_> {
@@ -96,6 +108,7 @@ impl Tracer<'_> {
             size: view.size,
             surface: vec![[0.0; 4]; pixels],
             reflection: vec![[0.0; 4]; pixels],
+            transmission: vec![[0.0; 4]; pixels],
             visibility: vec![[1.0; 4]; pixels * slots],
             rays: RayCounts::default(),
         };
@@ -105,6 +118,7 @@ impl Tracer<'_> {
                 let index = (y * width + x0) as usize + k;
                 terms.surface[index] = pixel.surface;
                 terms.reflection[index] = pixel.reflection;
+                terms.transmission[index] = pixel.transmission;
                 for (slot, v) in visibility.into_iter().enumerate() {
                     terms.visibility[slot * pixels + index] = v;
                 }
@@ -122,9 +136,12 @@ impl Tracer<'_> {
         counts: &mut RayCounts,
     ) -> (Pixel, Vec<[f32; 4]>) {
         let mut visibility = vec![[1.0; 4]; slots];
-        let Some(ray) = (view.ray)(x as f32 + 0.5, y as f32 + 0.5) else { return (Pixel::default(), visibility) };
+        let Some((ray, start)) = (view.ray)(x as f32 + 0.5, y as f32 + 0.5) else {
+            return (Pixel::default(), visibility);
+        };
         counts.primary += 1;
-        let Some((hit, ray, cone)) = self.first_opaque_surface(&ray, view.cone, view.skip) else {
+        let cone = view.cone.continued(start);
+        let Some((hit, ray, cone)) = self.first_surface(&ray, cone, view.skip, !wanted.transmission) else {
             return (Pixel::default(), visibility);
         };
         let whitted = &self.whitted;
@@ -148,26 +165,61 @@ impl Tracer<'_> {
                     whitted.visibility(origin, incidence.l, incidence.distance, counts).extend(1.0).into();
             }
         }
+        let n = whitted.shading_normal(material, &hit, v);
         let reflects = material.mirror * material.mirror_color != Vec3::ZERO;
         if wanted.reflection && reflects && whitted.max_depth > 0 {
-            counts.reflected += 1;
-            let n = whitted.shading_normal(material, &hit, v);
-            let reflected = Ray { origin: hit.point + offset * outside, direction: 2.0 * n.dot(v) * n - v };
-            let radiance = whitted.radiance(&reflected, cone.continued(hit.t), 1, counts);
+            let radiance =
+                whitted.reflected((&hit, n, v), cone.continued(hit.t), 0, (counts, &mut Unobserved), (Vec3::ONE, ""));
             pixel.reflection = radiance.extend(1.0).into();
+        }
+        if wanted.transmission && material.is_transparent() {
+            pixel.transmission = self.transmitted((&ray, cone), (&hit, n), counts).extend(1.0).into();
         }
         (pixel, visibility)
     }
 
-    /// The first opaque surface along `ray`: past transparent surfaces, a mask's holes and the
-    /// object `skip`, the ray going on from just beyond each (its cone continued). Returns the
-    /// hit with the ray and cone that found it.
-    fn first_opaque_surface(
+    /// What the transparent surface `hit` lets through, as [`super::whitted`] adds it to the
+    /// surface's own `α·Im`.
+    fn transmitted(&self, (ray, cone): (&Ray, RayCone), (hit, n): (&SurfaceHit, Vec3), counts: &mut RayCounts) -> Vec3 {
+        let whitted = &self.whitted;
+        if whitted.max_depth == 0 {
+            return Vec3::ZERO;
+        }
+        let material = &self.scene.materials[hit.material.0];
+        let alpha = match material.alpha_mode {
+            AlphaMode::Blend => whitted
+                .textures
+                .coverage(material, hit, ray.direction, Some(&cone), &whitted.texture_settings)
+                .clamp(0.0, 1.0),
+            AlphaMode::Opaque | AlphaMode::Mask { .. } => 1.0,
+        };
+        let v = -ray.direction;
+        let mut through = Vec3::ZERO;
+        if alpha > 0.0 {
+            let continued = cone.continued(hit.t);
+            let transmission = whitted.transmission((hit, n, v), continued, 0, counts, &mut Unobserved);
+            through += alpha * transmission.refracted;
+            if transmission.reflected_weight != Vec3::ZERO {
+                let weight = (transmission.reflected_weight, "");
+                through += alpha * whitted.reflected((hit, n, v), continued, 0, (counts, &mut Unobserved), weight);
+            }
+        }
+        if alpha < 1.0 {
+            through += whitted.behind(ray, cone, hit, (0, alpha), counts, &mut Unobserved);
+        }
+        through
+    }
+
+    /// The first surface along `ray` (the first opaque one if `opaque`): past a mask's holes, the
+    /// object `skip` and, if `opaque`, transparent surfaces, the ray going on from just beyond
+    /// each (its cone continued). Returns the hit with the ray and cone that found it.
+    fn first_surface(
         &self,
         ray: &Ray,
         cone: RayCone,
         skip: Option<usize>,
-    ) -> Option<(super::geometry::SurfaceHit, Ray, RayCone)> {
+        opaque: bool,
+    ) -> Option<(SurfaceHit, Ray, RayCone)> {
         let whitted = &self.whitted;
         let (mut ray, mut cone) = (*ray, cone);
         for _ in 0..MAX_LAYERS {
@@ -175,7 +227,7 @@ impl Tracer<'_> {
             let surface = whitted.primitives[hit.primitive as usize].surface(&ray, hit.t);
             let material = &self.scene.materials[surface.material.0];
             let passed = Some(surface.object) == skip
-                || material.is_transparent()
+                || (opaque && material.is_transparent())
                 || match material.alpha_mode {
                     AlphaMode::Mask { cutoff } => {
                         whitted.textures.coverage(

@@ -123,6 +123,16 @@ pub struct Whitted<'s> {
     pub volumes: TracedVolumes<'s>,
 }
 
+/// Where a transparent surface sends its `kt·MT` ([`Whitted::transmission`]).
+pub struct Transmission {
+    /// The refracted radiance, weighted.
+    pub refracted: Vec3,
+    /// The weight the reflected ray gains.
+    pub reflected_weight: Vec3,
+    /// The reflected ray's name where it gains one.
+    pub reflected_name: Option<&'static str>,
+}
+
 /// The most surfaces one ray passes (masked-out hits, shadow rays through transparent
 /// occluders) before it gives up: far more layers than a scene has, and a bound on the loop
 /// whatever the geometry.
@@ -315,15 +325,29 @@ impl Whitted<'_> {
             observer.unscale();
         }
         if alpha < 1.0 && depth < self.max_depth {
-            counts.refracted += 1;
-            let origin = hit.point - surface_offset(hit.point) * facing_viewer(hit.geometric_normal, v);
-            let behind = Ray { origin, direction: ray.direction };
-            let kind = (depth + 1, RayKind::Continued);
-            let through = self.radiance_observed(&behind, cone.continued(hit.t), kind, counts, observer);
-            observer.term(format!("behind the blended surface × (1 − α), α = {alpha:.3}"), (1.0 - alpha) * through);
-            rad += (1.0 - alpha) * through;
+            rad += self.behind(ray, cone, hit, (depth, alpha), counts, observer);
         }
         rad
+    }
+
+    /// `(1 − α)·L`, `L` the radiance of `ray` continued straight past a blended surface it hit at
+    /// `depth` that covers `α` of it.
+    pub(super) fn behind<O: Observer>(
+        &self,
+        ray: &Ray,
+        cone: RayCone,
+        hit: &SurfaceHit,
+        (depth, alpha): (u32, f32),
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> Vec3 {
+        counts.refracted += 1;
+        let origin = hit.point - surface_offset(hit.point) * facing_viewer(hit.geometric_normal, -ray.direction);
+        let behind = Ray { origin, direction: ray.direction };
+        let kind = (depth + 1, RayKind::Continued);
+        let through = self.radiance_observed(&behind, cone.continued(hit.t), kind, counts, observer);
+        observer.term(format!("behind the blended surface × (1 − α), α = {alpha:.3}"), (1.0 - alpha) * through);
+        (1.0 - alpha) * through
     }
 
     /// `EvaluaMILRec`: the local model at the hit plus the mirror and transmission terms.
@@ -379,51 +403,81 @@ impl Whitted<'_> {
         if depth >= self.max_depth {
             return rad;
         }
-        let reflected = 2.0 * n.dot(v) * n - v;
         let cone = cone.continued(hit.t);
-        let mut reflect_weight = material.mirror * material.mirror_color;
-        let mut reflected_name = "mirror kps·MPS·L(r)";
-        if material.transmission > 0.0 {
-            let weight = material.transmission * material.transmission_color;
-            // Fresnel splits kt·MT between the two directions; without it, all goes on through.
-            let reflectance = if self.fresnel {
-                fresnel(n.dot(v), relative_index(v, hit.geometric_normal, material.ior))
-            } else {
-                0.0
-            };
-            match refract(v, hit.geometric_normal, n, material.ior) {
-                Some(t) => {
-                    counts.refracted += 1;
-                    let origin = hit.point - offset * outside;
-                    let kind = (depth + 1, RayKind::Refracted);
-                    let through = self.radiance_observed(&Ray { origin, direction: t }, cone, kind, counts, observer);
-                    let (name, weight_t) = if self.fresnel {
-                        (format!("transmitted (1 − F)·kt·MT·L(t), F = {reflectance:.4}"), (1.0 - reflectance) * weight)
-                    } else {
-                        ("transmitted kt·MT·L(t)".to_string(), weight)
-                    };
-                    observer.term(name, weight_t * through);
-                    rad += weight_t * through;
-                    if reflectance > 0.0 {
-                        reflect_weight += reflectance * weight;
-                        reflected_name = "mirror kps·MPS·L(r), and F·kt·MT·L(r) by Fresnel";
-                    }
-                }
-                None => {
-                    reflect_weight += weight;
-                    reflected_name = "mirror kps·MPS·L(r), and kt·MT·L(r) by total internal reflection";
-                }
-            }
-        }
+        let transmission = self.transmission((hit, n, v), cone, depth, counts, observer);
+        rad += transmission.refracted;
+        let reflect_weight = material.mirror * material.mirror_color + transmission.reflected_weight;
         if reflect_weight != Vec3::ZERO {
-            counts.reflected += 1;
-            let origin = hit.point + offset * outside;
-            let kind = (depth + 1, RayKind::Reflected);
-            let mirrored = self.radiance_observed(&Ray { origin, direction: reflected }, cone, kind, counts, observer);
-            observer.term(reflected_name.into(), reflect_weight * mirrored);
-            rad += reflect_weight * mirrored;
+            let name = transmission.reflected_name.unwrap_or("mirror kps·MPS·L(r)");
+            rad += self.reflected((hit, n, v), cone, depth, (counts, observer), (reflect_weight, name));
         }
         rad
+    }
+
+    /// `weight·L(r)`, `L(r)` the radiance along the mirror direction `r = 2(n·v)n − v` of a hit at
+    /// `depth` (its ray starting just off the surface, on the viewer's side), reported as `name`.
+    pub(super) fn reflected<O: Observer>(
+        &self,
+        (hit, n, v): (&SurfaceHit, Vec3, Vec3),
+        cone: RayCone,
+        depth: u32,
+        (counts, observer): (&mut RayCounts, &mut O),
+        (weight, name): (Vec3, &str),
+    ) -> Vec3 {
+        counts.reflected += 1;
+        let origin = hit.point + surface_offset(hit.point) * facing_viewer(hit.geometric_normal, v);
+        let kind = (depth + 1, RayKind::Reflected);
+        let direction = 2.0 * n.dot(v) * n - v;
+        let mirrored = self.radiance_observed(&Ray { origin, direction }, cone, kind, counts, observer);
+        observer.term(name.into(), weight * mirrored);
+        weight * mirrored
+    }
+
+    /// Where a transparent surface's `kt·MT` goes (none for others): the refracted radiance,
+    /// weighted (`(1 − F)·kt·MT·L(t)` with Fresnel, `kt·MT·L(t)` without), and the weight it adds
+    /// to the reflected ray (`F·kt·MT`, or all of `kt·MT` on total internal reflection) with that
+    /// ray's name.
+    pub(super) fn transmission<O: Observer>(
+        &self,
+        (hit, n, v): (&SurfaceHit, Vec3, Vec3),
+        cone: RayCone,
+        depth: u32,
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> Transmission {
+        let material = &self.scene.materials[hit.material.0];
+        let mut out = Transmission { refracted: Vec3::ZERO, reflected_weight: Vec3::ZERO, reflected_name: None };
+        if !(material.transmission > 0.0) {
+            return out;
+        }
+        let weight = material.transmission * material.transmission_color;
+        // Fresnel splits kt·MT between the two directions; without it, all goes on through.
+        let reflectance =
+            if self.fresnel { fresnel(n.dot(v), relative_index(v, hit.geometric_normal, material.ior)) } else { 0.0 };
+        match refract(v, hit.geometric_normal, n, material.ior) {
+            Some(t) => {
+                counts.refracted += 1;
+                let origin = hit.point - surface_offset(hit.point) * facing_viewer(hit.geometric_normal, v);
+                let kind = (depth + 1, RayKind::Refracted);
+                let through = self.radiance_observed(&Ray { origin, direction: t }, cone, kind, counts, observer);
+                let (name, weight_t) = if self.fresnel {
+                    (format!("transmitted (1 − F)·kt·MT·L(t), F = {reflectance:.4}"), (1.0 - reflectance) * weight)
+                } else {
+                    ("transmitted kt·MT·L(t)".to_string(), weight)
+                };
+                observer.term(name, weight_t * through);
+                out.refracted = weight_t * through;
+                if reflectance > 0.0 {
+                    out.reflected_weight = reflectance * weight;
+                    out.reflected_name = Some("mirror kps·MPS·L(r), and F·kt·MT·L(r) by Fresnel");
+                }
+            }
+            None => {
+                out.reflected_weight = weight;
+                out.reflected_name = Some("mirror kps·MPS·L(r), and kt·MT·L(r) by total internal reflection");
+            }
+        }
+        out
     }
 
     /// The shading normal at the hit: bumped on the unturned normal, then turned to the viewer

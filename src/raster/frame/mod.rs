@@ -243,7 +243,7 @@ impl Renderer {
         targets: &mut FrameTargets,
         output: &wgpu::TextureView,
     ) -> FrameReport {
-        // Where the hybrid traces reflections, the passes draw without what they replace.
+        // Where the hybrid traces a term, the passes draw without what it replaces.
         let raster_settings = traced::raster_settings(settings);
         let settings = raster_settings.as_ref().unwrap_or(settings);
         let wanted = traced::wanted(settings);
@@ -258,27 +258,7 @@ impl Renderer {
         let targets = &*targets;
         let mut frame = FrameEncoder::new(gpu, self.profile);
         let mut plan = self.plan(gpu, scene, settings, size, &mut frame);
-        if let Some(inspector) = self.inspector.as_mut()
-            && let Some(pixel) = inspector.pixel
-        {
-            inspector.begin(&gpu.queue, pixel);
-            self.inspected_through = self.through.and_then(|(object, point)| {
-                let mirrors = &self.mirrors.mirrors;
-                let distance = |node: &MirrorNode| mirrors[node.mirror].plane.distance(point).abs();
-                (0..plan.mirror_nodes.len())
-                    .filter(|&k| {
-                        plan.mirror_nodes[k].level == 1 && mirrors[plan.mirror_nodes[k].mirror].object == object
-                    })
-                    .min_by(|&a, &b| distance(&plan.mirror_nodes[a]).total_cmp(&distance(&plan.mirror_nodes[b])))
-            });
-            match self.inspected_through {
-                Some(node) => plan.mirror_views[node].key.inspect = true,
-                None if self.through.is_some() => {}
-                None => plan.main.key.inspect = true,
-            }
-            self.facts = facts(&plan, &self.mirrors, &self.environment, self.scene_gpu.geometry.bounds);
-            self.facts.blend_by_hand = self.surface.wgsl.routes("BLEND_BY_HAND");
-        }
+        self.begin_inspection(gpu, &mut plan);
         if wanted.is_some() {
             self.mirrors.ensure_images(&gpu.device, ViewImage::Traced);
             self.environment.ensure_images(&gpu.device, ViewImage::Traced);
@@ -343,6 +323,29 @@ impl Renderer {
         frame.report.drawn_size = size;
         frame.report.triangles = self.scene_gpu.geometry.triangles();
         frame.finish()
+    }
+
+    /// Where an inspecting renderer has a pixel to inspect: clears its record, chooses the view
+    /// that records (the main one, or the mirrored camera [`Self::inspect_through`] names) and
+    /// keeps what the frame decided ([`FrameFacts`]).
+    fn begin_inspection(&mut self, gpu: &Gpu, plan: &mut FramePlan) {
+        let Some(inspector) = self.inspector.as_mut() else { return };
+        let Some(pixel) = inspector.pixel else { return };
+        inspector.begin(&gpu.queue, pixel);
+        self.inspected_through = self.through.and_then(|(object, point)| {
+            let mirrors = &self.mirrors.mirrors;
+            let distance = |node: &MirrorNode| mirrors[node.mirror].plane.distance(point).abs();
+            (0..plan.mirror_nodes.len())
+                .filter(|&k| plan.mirror_nodes[k].level == 1 && mirrors[plan.mirror_nodes[k].mirror].object == object)
+                .min_by(|&a, &b| distance(&plan.mirror_nodes[a]).total_cmp(&distance(&plan.mirror_nodes[b])))
+        });
+        match self.inspected_through {
+            Some(node) => plan.mirror_views[node].key.inspect = true,
+            None if self.through.is_some() => {}
+            None => plan.main.key.inspect = true,
+        }
+        self.facts = facts(plan, &self.mirrors, &self.environment, self.scene_gpu.geometry.bounds);
+        self.facts.blend_by_hand = self.surface.wgsl.routes("BLEND_BY_HAND");
     }
 
     /// Prepares what the plan depends on (materials for the texture filter, tessellations, the
