@@ -49,6 +49,9 @@ const SCREENSHOT_PATIENCE: Duration = Duration::from_secs(2);
 const TRACE_TIMEOUT: Duration = Duration::from_secs(600);
 
 /// Everything the viewer holds, grouped by concern.
+/// The widest view the panel's error budget is measured at: wider views are measured smaller.
+const BUDGET_WIDTH: u32 = 480;
+
 pub struct Viewer {
     pub scene: SceneState,
     pub settings: RenderSettings,
@@ -85,6 +88,9 @@ pub struct Viewer {
     /// The inspected pixel, and a pixel to inspect once the view has its size.
     inspection: Option<Inspection>,
     inspect_next: Option<Vec2>,
+    /// The last error budget measured, and whether one is due once the view has its size.
+    error_budget: Option<String>,
+    budget_next: bool,
     /// Lab mode (`mirador view --lab DIR`): the student's functions drawn, reloaded when saved.
     pub lab: Option<LabMode>,
     /// The settings changed in each scene opened before (`super::config`), by scene key.
@@ -165,6 +171,8 @@ impl Viewer {
             cursor: None,
             inspection: None,
             inspect_next: None,
+            error_budget: None,
+            budget_next: false,
             lab,
             remembered,
             changed: Default::default(),
@@ -378,6 +386,7 @@ impl Viewer {
             seen: self.seen.shown(),
             lab: self.lab.as_ref().map(LabMode::panel),
             changed_settings: &self.changed.2,
+            error_budget: self.error_budget.as_deref(),
         };
         let full = screen.egui.run_ui(raw, |ui| output = ui::draw(ui, &mut model));
         (output, full)
@@ -423,6 +432,9 @@ impl Viewer {
         self.request_traced((width, height), scale == 1.0, screen);
         if let Some(pixel) = self.inspect_next.take() {
             self.inspect(screen, pixel, (width, height));
+        }
+        if std::mem::take(&mut self.budget_next) {
+            self.measure_budget(screen, (width, height));
         }
         drawn
     }
@@ -540,6 +552,7 @@ impl Viewer {
                 }
                 Action::DismissError => self.scene.error = None,
                 Action::ResetSettings => self.reset_settings(),
+                Action::Budget => self.budget_next = true,
             }
         }
         for assignment in &output.settings {
@@ -627,6 +640,27 @@ impl Viewer {
             }
             Err(e) => self.notice(format!("cannot inspect ({}, {}): {e:#}", at.0, at.1)),
         }
+    }
+
+    /// Measures the error budget of the view of `size` as it is, at most [`BUDGET_WIDTH`] pixels
+    /// wide (it draws the view ten times or so and traces it once, while the window waits).
+    #[cfg(not(target_arch = "wasm32"))]
+    fn measure_budget(&mut self, screen: &Screen, size: (u32, u32)) {
+        let mut scene = self.scene.scene.clone();
+        let width = size.0.min(BUDGET_WIDTH);
+        (scene.camera.width, scene.camera.height) = (width, (size.1 * width).div_ceil(size.0.max(1)).max(1));
+        let traced = crate::trace::render_image(&scene, &self.settings);
+        let budget = crate::budget::budget(&screen.gpu, &scene, &self.settings, traced);
+        let report = budget.report();
+        println!("{report}");
+        self.notice(format!("error budget measured: FLIP {:.4}, floor {:.4}", budget.whole, budget.floor));
+        self.error_budget = Some(report);
+    }
+
+    /// The page measures no budget: `mirador budget` does, natively.
+    #[cfg(target_arch = "wasm32")]
+    fn measure_budget(&mut self, _: &Screen, _: (u32, u32)) {
+        self.notice("the error budget is measured natively: `mirador budget SCENE`".into());
     }
 
     /// Starts (or keeps) the traced request for the current view at its full size; in the
@@ -730,6 +764,7 @@ impl Viewer {
             Step::Load(path) => self.open(&path),
             Step::Scale(scale) => self.view.motion_scale = scale,
             Step::Fps(fps) => self.view.motion_fps = fps,
+            Step::Budget => self.budget_next = true,
             Step::Measure => {
                 self.script.measured = true;
                 self.script.reset_stats = true;

@@ -73,6 +73,8 @@ pub enum Step {
     WaitFor(std::time::Duration),
     WaitTraced,
     Measure,
+    /// Measure the error budget of the view (the panel's button).
+    Budget,
     Screenshot(PathBuf),
     Lab(LabShown),
     ResetSettings,
@@ -165,6 +167,7 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
             Step::Fps(fps)
         }
         "measure" => Step::Measure,
+        "budget" => Step::Budget,
         "help" => Step::Help(switch(args).ok_or_else(|| fail("help on or help off"))?),
         "panel" => Step::Panel(switch(args).ok_or_else(|| fail("panel on or panel off"))?),
         "overlay" => Step::Overlay(switch(args).ok_or_else(|| fail("overlay on or overlay off"))?),
@@ -209,6 +212,7 @@ mod tests {
         assert_eq!(parse("fps 20").unwrap(), Step::Fps(20.0));
         assert_eq!(parse("fps off").unwrap(), Step::Fps(0.0));
         assert_eq!(parse("measure").unwrap(), Step::Measure);
+        assert_eq!(parse("budget").unwrap(), Step::Budget);
         assert_eq!(parse("screenshot out.png").unwrap(), Step::Screenshot("out.png".into()));
         for bad in [
             "view sideways",

@@ -48,6 +48,8 @@ pub struct UiModel<'a> {
     pub lab: Option<LabPanel<'a>>,
     /// The settings changed from the scene file's own, as `key = value`.
     pub changed_settings: &'a [String],
+    /// The last error budget measured (`crate::budget`), as its report.
+    pub error_budget: Option<&'a str>,
 }
 
 /// Requests the UI makes of the frame.
@@ -59,6 +61,8 @@ pub enum Action {
     DismissError,
     /// Every setting back to the scene file's own.
     ResetSettings,
+    /// Measure the error budget of the view as it is.
+    Budget,
 }
 
 /// What the UI gathered this frame.
@@ -216,6 +220,7 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
             }
         });
     }
+    error_budget(ui, model.error_budget, output);
     egui::CollapsingHeader::new(egui::RichText::new("lights").strong()).id_salt("lights").show(ui, |ui| {
         output.lights_edited |= scene_panel::lights_ui(ui, &mut model.scene.scene.lights);
     });
@@ -243,6 +248,21 @@ fn side_panel(ui: &mut egui::Ui, model: &mut UiModel, output: &mut UiOutput) {
     for notice in model.notices.iter().rev().take(3) {
         ui.small(notice);
     }
+}
+
+/// The error budget of the view (docs/course/12-error-budget.md): a button that measures it, and
+/// the last one measured.
+fn error_budget(ui: &mut egui::Ui, report: Option<&str>, output: &mut UiOutput) {
+    egui::CollapsingHeader::new(egui::RichText::new("error budget").strong()).id_salt("error budget").show(ui, |ui| {
+        let hint = "What each of the rasterizer's approximations costs, each swapped for its traced term: the \
+                    view drawn ten times or so and traced once (seconds; the window waits).";
+        if ui.button("measure the view").on_hover_text(hint).clicked() {
+            output.actions.push(Action::Budget);
+        }
+        if let Some(report) = report {
+            ui.label(egui::RichText::new(report).monospace().small());
+        }
+    });
 }
 
 /// Lab mode's section: the lab, the student's file, what the view shows, the file's problems.
