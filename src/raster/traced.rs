@@ -31,6 +31,7 @@ use crate::trace::Tracer;
 use crate::trace::terms::{TracedTerms, ViewRays, Wanted};
 
 const _: () = assert!(TRACED_LAYERS as usize == TRACED_VISIBILITY as usize + MAX_SHADOWED_LIGHTS);
+const _: () = assert!(crate::trace::terms::MAX_SLOTS == MAX_SHADOWED_LIGHTS);
 
 /// The terms `settings` asks to trace, or `None`.
 pub fn wanted(settings: &RenderSettings) -> Option<Wanted> {
@@ -62,9 +63,17 @@ pub fn raster_settings(settings: &RenderSettings) -> Option<RenderSettings> {
     })
 }
 
-/// Every view's traced terms, ready to be copied into its image.
+/// Every view's traced terms, ready to be copied into its image: each view's buffer holds the
+/// layers traced, one after another, each the view's window.
 pub struct PreparedTraced {
-    views: Vec<(ViewSlot, wgpu::Buffer, (u32, u32))>,
+    views: Vec<(ViewSlot, Upload)>,
+}
+
+/// One view's terms in a buffer: the window they cover and the image layer of each.
+struct Upload {
+    buffer: wgpu::Buffer,
+    window: [u32; 4],
+    layers: Vec<u32>,
 }
 
 /// Bytes of one pixel of one layer (`Rgba32Float`).
@@ -99,7 +108,7 @@ pub fn prepare(
             };
             let terms = tracer.terms(&rays_of_view, wanted);
             rays += terms.rays.total();
-            (view.slot, upload(device, &terms), size)
+            (view.slot, upload(device, &terms))
         })
         .collect();
     frame.end("traced terms", &[("rays", Figure::Count(rays))]);
@@ -109,21 +118,29 @@ pub fn prepare(
 impl PreparedTraced {
     /// Copies `view`'s terms into its traced image, which the view's shading then reads.
     pub fn record(&self, frame: &mut FrameEncoder, view: &FrameView, targets: &FrameTargets) {
-        let Some((_, buffer, size)) = self.views.iter().find(|(slot, ..)| *slot == view.slot) else { return };
-        let image = targets.images.get(ViewImage::Traced);
-        debug_assert_eq!(*size, targets.size, "the view's image was made at its targets' size");
-        frame.encoder.copy_buffer_to_texture(
-            wgpu::TexelCopyBufferInfo {
-                buffer,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(padded_row(size.0)),
-                    rows_per_image: Some(size.1),
+        let Some((_, upload)) = self.views.iter().find(|(slot, _)| *slot == view.slot) else { return };
+        let image = &targets.images.get(ViewImage::Traced).texture;
+        let [x, y, width, height] = upload.window;
+        let layer_bytes = u64::from(padded_row(width) * height);
+        for (k, &layer) in upload.layers.iter().enumerate() {
+            frame.encoder.copy_buffer_to_texture(
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &upload.buffer,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: k as u64 * layer_bytes,
+                        bytes_per_row: Some(padded_row(width)),
+                        rows_per_image: Some(height),
+                    },
                 },
-            },
-            image.texture.as_image_copy(),
-            wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: TRACED_LAYERS },
-        );
+                wgpu::TexelCopyTextureInfo {
+                    texture: image,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d { x, y, z: layer },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            );
+        }
     }
 }
 
@@ -132,30 +149,28 @@ fn padded_row(width: u32) -> u32 {
     (width * PIXEL_BYTES).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
 }
 
-/// The terms in the image's layout: layer by layer, row by row, rows padded.
-fn upload(device: &wgpu::Device, terms: &TracedTerms) -> wgpu::Buffer {
+/// The terms traced, layer after layer, each row padded; and each one's layer in the image.
+fn upload(device: &wgpu::Device, terms: &TracedTerms) -> Upload {
     use wgpu::util::DeviceExt;
-    let (width, height) = terms.size;
-    let pixels = (width * height) as usize;
+    let mut layers: Vec<(u32, &[[f32; 4]])> = vec![(TRACED_SURFACE, &terms.surface)];
+    layers.extend(terms.reflection.as_deref().map(|r| (TRACED_REFLECTION, r)));
+    layers.extend(terms.transmission.as_deref().map(|t| (TRACED_TRANSMISSION, t)));
+    layers.extend(terms.visibility.iter().enumerate().map(|(slot, v)| (TRACED_VISIBILITY + slot as u32, &v[..])));
+    let [_, _, width, height] = terms.window;
     let row = padded_row(width) as usize;
-    let mut bytes = vec![0u8; row * height as usize * TRACED_LAYERS as usize];
-    let mut layer = |k: u32, values: &[[f32; 4]]| {
-        let layer = &mut bytes[row * height as usize * k as usize..][..row * height as usize];
-        for (y, line) in values.chunks(width as usize).enumerate() {
+    let mut bytes = vec![0u8; (row * height as usize * layers.len()).max(PIXEL_BYTES as usize)];
+    for (k, (_, values)) in layers.iter().enumerate() {
+        let layer = &mut bytes[row * height as usize * k..];
+        for (y, line) in values.chunks(width.max(1) as usize).enumerate() {
             layer[y * row..][..line.len() * PIXEL_BYTES as usize].copy_from_slice(bytemuck::cast_slice(line));
         }
-    };
-    layer(TRACED_SURFACE, &terms.surface);
-    layer(TRACED_REFLECTION, &terms.reflection);
-    layer(TRACED_TRANSMISSION, &terms.transmission);
-    for (slot, values) in terms.visibility.chunks(pixels.max(1)).enumerate() {
-        layer(TRACED_VISIBILITY + slot as u32, values);
     }
-    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("traced::terms"),
         contents: &bytes,
         usage: wgpu::BufferUsages::COPY_SRC,
-    })
+    });
+    Upload { buffer, window: terms.window, layers: layers.iter().map(|(layer, _)| *layer).collect() }
 }
 
 type RayFn = Box<dyn Fn(f32, f32) -> Option<(Ray, f32)> + Sync>;

@@ -60,31 +60,39 @@ pub struct ViewRays<'a> {
     pub lights: &'a [usize],
 }
 
-/// What a pixel's surface keeps: nothing there, or its object (as the rasterizer numbers them)
-/// and terms.
-pub const NO_SURFACE: f32 = 0.0;
+/// The most shadowed lights whose visibility is traced (the rasterizer's four).
+pub const MAX_SLOTS: usize = 4;
 
-/// The traced terms of one view, row by row, four floats a pixel.
+/// The traced terms of one view's window, row by row, four floats a pixel; a term not asked for
+/// is `None` (visibility: empty).
 pub struct TracedTerms {
-    pub size: (u32, u32),
-    /// `C` and `object + 1` (0: no opaque surface).
+    /// The window of the view's image the terms cover: `[x, y, width, height]`.
+    pub window: [u32; 4],
+    /// `C` and `object + 1` (0: no surface).
     pub surface: Vec<[f32; 4]>,
     /// `L(r)` (0 where the surface is no mirror).
-    pub reflection: Vec<[f32; 4]>,
+    pub reflection: Option<Vec<[f32; 4]>>,
     /// What a transparent surface lets through (0 on others).
-    pub transmission: Vec<[f32; 4]>,
-    /// `V_i` of each slot's light, one image after another (`lights.len()` of them).
-    pub visibility: Vec<[f32; 4]>,
+    pub transmission: Option<Vec<[f32; 4]>>,
+    /// `V_i` of each slot's light.
+    pub visibility: Vec<Vec<[f32; 4]>>,
     /// The rays traced, for the frame's figures.
     pub rays: RayCounts,
 }
 
 /// One pixel's terms.
-#[derive(Clone, Copy, Default)]
+#[derive(Clone, Copy)]
 struct Pixel {
     surface: [f32; 4],
     reflection: [f32; 4],
     transmission: [f32; 4],
+    visibility: [[f32; 4]; MAX_SLOTS],
+}
+
+impl Default for Pixel {
+    fn default() -> Pixel {
+        Pixel { surface: [0.0; 4], reflection: [0.0; 4], transmission: [0.0; 4], visibility: [[1.0; 4]; MAX_SLOTS] }
+    }
 }
 
 impl Tracer<'_> {
@@ -92,39 +100,31 @@ impl Tracer<'_> {
     pub fn terms(&self, view: &ViewRays, wanted: Wanted) -> TracedTerms {
         let (width, height) = view.size;
         let [x0, y0, w, h] = view.window;
-        let slots = if wanted.visibility { view.lights.len() } else { 0 };
-        let pixels = (width * height) as usize;
-        let rows: Vec<(u32, Vec<(Pixel, Vec<[f32; 4]>)>, RayCounts)> = (y0..(y0 + h).min(height))
+        let (x1, y1) = ((x0 + w).min(width), (y0 + h).min(height));
+        let slots = if wanted.visibility { view.lights.len().min(MAX_SLOTS) } else { 0 };
+        let rows: Vec<(Vec<Pixel>, RayCounts)> = (y0..y1)
             .into_par_iter()
             .map(|y| {
                 let mut counts = RayCounts::default();
-                let row = (x0..(x0 + w).min(width))
-                    .map(|x| self.pixel_terms(view, (x, y), wanted, slots, &mut counts))
-                    .collect();
-                (y, row, counts)
+                let row = (x0..x1).map(|x| self.pixel_terms(view, (x, y), wanted, slots, &mut counts)).collect();
+                (row, counts)
             })
             .collect();
-        let mut terms = TracedTerms {
-            size: view.size,
-            surface: vec![[0.0; 4]; pixels],
-            reflection: vec![[0.0; 4]; pixels],
-            transmission: vec![[0.0; 4]; pixels],
-            visibility: vec![[1.0; 4]; pixels * slots],
-            rays: RayCounts::default(),
-        };
-        for (y, row, counts) in rows {
-            terms.rays += counts;
-            for (k, (pixel, visibility)) in row.into_iter().enumerate() {
-                let index = (y * width + x0) as usize + k;
-                terms.surface[index] = pixel.surface;
-                terms.reflection[index] = pixel.reflection;
-                terms.transmission[index] = pixel.transmission;
-                for (slot, v) in visibility.into_iter().enumerate() {
-                    terms.visibility[slot * pixels + index] = v;
-                }
-            }
+        let mut rays = RayCounts::default();
+        let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+        for (row, counts) in rows {
+            rays += counts;
+            pixels.extend(row);
         }
-        terms
+        let layer = |term: fn(&Pixel) -> [f32; 4]| pixels.iter().map(term).collect::<Vec<_>>();
+        TracedTerms {
+            window: [x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0)],
+            surface: layer(|p| p.surface),
+            reflection: wanted.reflection.then(|| layer(|p| p.reflection)),
+            transmission: wanted.transmission.then(|| layer(|p| p.transmission)),
+            visibility: (0..slots).map(|slot| pixels.iter().map(|p| p.visibility[slot]).collect()).collect(),
+            rays,
+        }
     }
 
     fn pixel_terms(
@@ -134,15 +134,13 @@ impl Tracer<'_> {
         wanted: Wanted,
         slots: usize,
         counts: &mut RayCounts,
-    ) -> (Pixel, Vec<[f32; 4]>) {
-        let mut visibility = vec![[1.0; 4]; slots];
-        let Some((ray, start)) = (view.ray)(x as f32 + 0.5, y as f32 + 0.5) else {
-            return (Pixel::default(), visibility);
-        };
+    ) -> Pixel {
+        let mut pixel = Pixel::default();
+        let Some((ray, start)) = (view.ray)(x as f32 + 0.5, y as f32 + 0.5) else { return pixel };
         counts.primary += 1;
         let cone = view.cone.continued(start);
         let Some((hit, ray, cone)) = self.first_surface(&ray, cone, view.skip, !wanted.transmission) else {
-            return (Pixel::default(), visibility);
+            return pixel;
         };
         let whitted = &self.whitted;
         let material = &self.scene.materials[hit.material.0];
@@ -154,14 +152,14 @@ impl Tracer<'_> {
         } else {
             Vec3::ZERO
         };
-        let mut pixel = Pixel { surface: [colour.x, colour.y, colour.z, hit.object as f32 + 1.0], ..Pixel::default() };
+        pixel.surface = [colour.x, colour.y, colour.z, hit.object as f32 + 1.0];
         if wanted.visibility {
-            for (slot, &light) in view.lights.iter().enumerate() {
+            for (slot, &light) in view.lights.iter().enumerate().take(slots) {
                 let Some(incidence) = self.scene.lights.get(light).and_then(|l| l.incidence(hit.point)) else {
                     continue;
                 };
                 let origin = hit.point + offset * outside;
-                visibility[slot] =
+                pixel.visibility[slot] =
                     whitted.visibility(origin, incidence.l, incidence.distance, counts).extend(1.0).into();
             }
         }
@@ -175,7 +173,7 @@ impl Tracer<'_> {
         if wanted.transmission && material.is_transparent() {
             pixel.transmission = self.transmitted((&ray, cone), (&hit, n), counts).extend(1.0).into();
         }
-        (pixel, visibility)
+        pixel
     }
 
     /// What the transparent surface `hit` lets through, as [`super::whitted`] adds it to the
