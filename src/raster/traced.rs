@@ -151,25 +151,31 @@ fn padded_row(width: u32) -> u32 {
 
 /// The terms traced, layer after layer, each row padded; and each one's layer in the image.
 fn upload(device: &wgpu::Device, terms: &TracedTerms) -> Upload {
-    use wgpu::util::DeviceExt;
     let mut layers: Vec<(u32, &[[f32; 4]])> = vec![(TRACED_SURFACE, &terms.surface)];
     layers.extend(terms.reflection.as_deref().map(|r| (TRACED_REFLECTION, r)));
     layers.extend(terms.transmission.as_deref().map(|t| (TRACED_TRANSMISSION, t)));
     layers.extend(terms.visibility.iter().enumerate().map(|(slot, v)| (TRACED_VISIBILITY + slot as u32, &v[..])));
     let [_, _, width, height] = terms.window;
     let row = padded_row(width) as usize;
-    let mut bytes = vec![0u8; (row * height as usize * layers.len()).max(PIXEL_BYTES as usize)];
-    for (k, (_, values)) in layers.iter().enumerate() {
-        let layer = &mut bytes[row * height as usize * k..];
-        for (y, line) in values.chunks(width.max(1) as usize).enumerate() {
-            layer[y * row..][..line.len() * PIXEL_BYTES as usize].copy_from_slice(bytemuck::cast_slice(line));
+    let layer_bytes = row * height as usize;
+    // Written where the copy reads it, in the buffer as it is made.
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("traced::terms"),
+        size: (layer_bytes * layers.len()).max(PIXEL_BYTES as usize) as u64,
+        usage: wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: true,
+    });
+    {
+        let mut bytes = buffer.slice(..).get_mapped_range_mut().expect("a buffer mapped at its creation");
+        for (k, (_, values)) in layers.iter().enumerate() {
+            for (y, line) in values.chunks(width.max(1) as usize).enumerate() {
+                let start = layer_bytes * k + y * row;
+                let line: &[u8] = bytemuck::cast_slice(line);
+                bytes.slice(start..start + line.len()).copy_from_slice(line);
+            }
         }
     }
-    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("traced::terms"),
-        contents: &bytes,
-        usage: wgpu::BufferUsages::COPY_SRC,
-    });
+    buffer.unmap();
     Upload { buffer, window: terms.window, layers: layers.iter().map(|(layer, _)| *layer).collect() }
 }
 

@@ -9,7 +9,8 @@
 //! opaque ones and the surface is the first one, transparent or not. At that surface:
 //!
 //! - **visibility**: `V_i` of each shadowed light, the tracer's shadow ray (tinted by the
-//!   transparent occluders it passes), exactly as [`super::whitted`] weighs `L_dir`;
+//!   transparent occluders it passes), exactly as [`super::whitted`] weighs `L_dir`: 0 for a light
+//!   the tracer does not add at all there (behind the surface, with no ambient term to light);
 //! - **reflection**: `L(r)`, the tracer's whole recursion along the mirror direction
 //!   `r = 2(n·v)n − v`, for surfaces with `kps > 0`; the rasterizer multiplies it by its own
 //!   `kps·MPS`;
@@ -29,7 +30,7 @@ use super::geometry::SurfaceHit;
 use super::whitted::{MAX_LAYERS, RayCounts, surface_offset};
 use crate::base::Ray;
 use crate::scene::AlphaMode;
-use crate::scene::shading::facing_viewer;
+use crate::scene::shading::{facing_viewer, lights_surface};
 use crate::texture::RayCone;
 
 /// Which terms to trace.
@@ -153,17 +154,22 @@ impl Tracer<'_> {
             Vec3::ZERO
         };
         pixel.surface = [colour.x, colour.y, colour.z, hit.object as f32 + 1.0];
+        let n = whitted.shading_normal(material, &hit, v);
         if wanted.visibility {
             for (slot, &light) in view.lights.iter().enumerate().take(slots) {
                 let Some(incidence) = self.scene.lights.get(light).and_then(|l| l.incidence(hit.point)) else {
                     continue;
                 };
-                let origin = hit.point + offset * outside;
-                pixel.visibility[slot] =
-                    whitted.visibility(origin, incidence.l, incidence.distance, counts).extend(1.0).into();
+                // A light the tracer does not add here (behind the surface, no ambient term) is
+                // weighted 0, with no ray cast.
+                pixel.visibility[slot] = if lights_surface(n, incidence.l, material.ka, whitted.terms) {
+                    let origin = hit.point + offset * outside;
+                    whitted.visibility(origin, incidence.l, incidence.distance, counts).extend(1.0).into()
+                } else {
+                    [0.0, 0.0, 0.0, 1.0]
+                };
             }
         }
-        let n = whitted.shading_normal(material, &hit, v);
         let reflects = material.mirror * material.mirror_color != Vec3::ZERO;
         if wanted.reflection && reflects && whitted.max_depth > 0 {
             let radiance =
