@@ -123,3 +123,31 @@ fn chapter_9_exercise_2_every_accelerator_draws_the_same_image() {
         assert!(image(accel) == bvh, "{accel} draws another image than the BVH");
     }
 }
+
+/// Chapter 12's budget of an exercise scene with `sets`: each approximation's cost alone, by name.
+fn budget_alone(relative: &str, sets: &[&str]) -> std::collections::BTreeMap<&'static str, f32> {
+    let (scene, settings) = scene_with(relative, sets);
+    let traced = mirador::trace::render_image(&scene, &settings);
+    let budget = mirador::budget::budget(common::gpu(), &scene, &settings, traced);
+    eprintln!("{relative} {sets:?}\n{}", budget.report());
+    budget.items.iter().map(|i| (i.name, i.alone)).collect()
+}
+
+#[test]
+fn chapter_12_exercise_1_the_mirrors_cost_falls_with_the_depth_and_the_filtering_stays() {
+    let flat = budget_alone("scenes/course/mirror-pair.toml", &["mirrors.depth=0"]);
+    let deep = budget_alone("scenes/course/mirror-pair.toml", &["mirrors.depth=3"]);
+    // Measured: reflections 0.171 and 0.0024, filtering 0.0144 and 0.0159.
+    assert!(flat["reflections"] > 20.0 * deep["reflections"], "{flat:?} {deep:?}");
+    let (a, b) = (flat["texture filtering"], deep["texture filtering"]);
+    assert!((a - b).abs() < 0.2 * b, "the filtering at depth 0 and 3: {a}, {b}");
+    assert!(b > 4.0 * deep["reflections"], "at depth 3 the filtering costs more than the mirrors: {deep:?}");
+}
+
+#[test]
+fn chapter_12_exercise_3_screen_refraction_removes_most_of_the_transmissions_cost() {
+    let none = budget_alone("scenes/course/transparency-refraction.toml", &["transparency.refraction=\"none\""]);
+    let screen = budget_alone("scenes/course/transparency-refraction.toml", &["transparency.refraction=\"screen\""]);
+    // Measured 0.062 and 0.0073.
+    assert!(none["transmission"] > 5.0 * screen["transmission"], "{none:?} {screen:?}");
+}

@@ -84,6 +84,9 @@ mirador compare "$course/aliasing-edges.toml" "${mid[@]}" --aa adaptive -o "$out
 example volume volume.png
 mirador compare "$course/volume-phantom.toml" "${mid[@]}" -o "$out/volume-compare.png"
 
+# 12. Where the error comes from
+mirador budget "$course/mirror-pair.toml" "${mid[@]}" --set mirrors.depth=1 --sheet "$out/budget-mirror-pair.png"
+
 # Mirador writes PNGs quickly rather than small, with an alpha channel that is always opaque.
 # Stored again as RGB at zlib's best compression, they take about half the space, pixel for
 # pixel the same (Python's Pillow does it; without Pillow they are left as written).
