@@ -50,6 +50,7 @@ const TRACE_TIMEOUT: Duration = Duration::from_secs(600);
 
 /// Everything the viewer holds, grouped by concern.
 /// The widest view the panel's error budget is measured at: wider views are measured smaller.
+#[cfg(not(target_arch = "wasm32"))]
 const BUDGET_WIDTH: u32 = 480;
 
 pub struct Viewer {
