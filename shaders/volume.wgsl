@@ -62,7 +62,7 @@ struct Volume {
 @group(3) @binding(3) var<uniform> volume: Volume;
 @group(3) @binding(4) var volume_texture: texture_3d<f32>;
 @group(3) @binding(5) var volume_sampler: sampler;
-@group(3) @binding(6) var transfer_table: texture_2d<f32>;
+@group(3) @binding(6) var<uniform> transfer_table: array<vec4f, VOLUME_TABLE_SIZE>;
 
 struct VolumeVertex {
     @builtin(position) clip: vec4f,
@@ -189,8 +189,8 @@ fn volume_gradient(local: vec3f) -> vec3f {
 fn classify(x: f32) -> vec4f {
     let position = clamp(x, 0.0, 1.0) * f32(VOLUME_TABLE_SIZE - 1u);
     let i = min(u32(floor(position)), VOLUME_TABLE_SIZE - 2u);
-    let a = textureLoad(transfer_table, vec2i(i32(i), 0), 0);
-    let b = textureLoad(transfer_table, vec2i(i32(i) + 1, 0), 0);
+    let a = transfer_table[i];
+    let b = transfer_table[i + 1u];
     return mix(a, b, position - f32(i));
 }
 

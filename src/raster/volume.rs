@@ -2,8 +2,8 @@
 //! the twin of `crate::volume::march` (`shaders/volume.wgsl`).
 //!
 //! Per scene, each volume's normalized field becomes a 3D texture (`R16Float`, filterable, so the
-//! hardware does the nearest or trilinear reconstruction) and its transfer function a 256 × 1
-//! table ([`VolumePass::load`]). In every view (the main camera, mirrored cameras, cube faces),
+//! hardware does the nearest or trilinear reconstruction) and its transfer function a uniform
+//! array of 256 entries ([`VolumePass::load`]). In every view (the main camera, mirrored cameras, cube faces),
 //! each volume's box is drawn, back faces only, so a camera inside the box still marches it:
 //! - **isosurfaces** with the opaque surfaces ([`PreparedVolumes::record_isosurfaces`]): the
 //!   view's depth is copied (by drawing, [`DepthCopy`]: GL cannot copy a depth texture), rays end
@@ -96,7 +96,7 @@ pub fn gradient_code(gradient: VolumeGradient) -> u32 {
 /// One volume on the GPU, made once per scene.
 pub struct VolumeGpu {
     field: wgpu::TextureView,
-    table: wgpu::TextureView,
+    table: wgpu::Buffer,
     uniform: UniformBuffer<GpuVolume>,
     /// The grid the texture holds (smaller than the scene's when it was resampled to fit).
     grid_on_gpu: Grid,
@@ -128,33 +128,19 @@ impl VolumeGpu {
             },
             size,
         );
-        let table = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(&format!("volume::transfer_table {}", volume.name)),
-            size: wgpu::Extent3d { width: TABLE_SIZE as u32, height: 1, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        queue.write_texture(
-            table.as_image_copy(),
-            bytemuck::cast_slice(&volume.table.0),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(16 * TABLE_SIZE as u32),
-                rows_per_image: None,
-            },
-            table.size(),
-        );
+        // A uniform array rather than a texture: the surface passes' fragment stage already reads
+        // as many sampled textures as the downlevel limits allow (16, with an inspecting group).
+        debug_assert_eq!(volume.table.0.len(), TABLE_SIZE);
+        let table = {
+            use wgpu::util::DeviceExt;
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(&format!("volume::transfer_table {}", volume.name)),
+                contents: bytemuck::cast_slice(&volume.table.0),
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+        };
         let uniform = UniformBuffer::new(device, "volume::uniform", &GpuVolume::zeroed());
-        VolumeGpu {
-            field: texture.create_view(&Default::default()),
-            table: table.create_view(&Default::default()),
-            uniform,
-            grid_on_gpu: grid,
-        }
+        VolumeGpu { field: texture.create_view(&Default::default()), table, uniform, grid_on_gpu: grid }
     }
 
     fn uniform_of(&self, volume: &Volume, settings: &VolumeSettings) -> GpuVolume {
@@ -258,11 +244,7 @@ impl VolumePass {
                 layout::uniform(3, wgpu::ShaderStages::VERTEX_FRAGMENT),
                 layout::texture(4, wgpu::TextureSampleType::Float { filterable: true }, wgpu::TextureViewDimension::D3),
                 layout::sampler(5, wgpu::SamplerBindingType::Filtering),
-                layout::texture(
-                    6,
-                    wgpu::TextureSampleType::Float { filterable: false },
-                    wgpu::TextureViewDimension::D2,
-                ),
+                layout::uniform(6, wgpu::ShaderStages::FRAGMENT),
             ],
         });
         let layout = shader.layout_with(device, layouts, "volume::layout", &group_layout);
@@ -426,7 +408,7 @@ impl PreparedVolumes<'_> {
                 wgpu::BindGroupEntry { binding: 3, resource: gpu.uniform.binding() },
                 texture(4, &gpu.field),
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::Sampler(sampler) },
-                texture(6, &gpu.table),
+                wgpu::BindGroupEntry { binding: 6, resource: gpu.table.as_entire_binding() },
             ],
         })
     }
