@@ -63,3 +63,44 @@ fn every_scene_with_every_term_traced_is_the_tracers_image() {
     let shown = report.iter().filter(|(_, plain, hybrid)| *plain > 0.02 && *plain > 10.0 * hybrid).count();
     assert!(shown >= 5, "scenes whose raster frame the swaps bring from over 0.02 to a tenth: {shown}");
 }
+
+/// The viewer's coarse traced terms (`stride` > 1) are the full terms at one pixel of each block,
+/// given to the whole block; refined to stride 1 they are every pixel's own.
+#[test]
+fn coarse_traced_terms_are_the_full_terms_of_each_blocks_first_pixel() {
+    use mirador::trace::terms::{ViewRays, Wanted};
+    let scene = smaller(common::load("scenes/mirrors.toml"), 96);
+    let tracer = mirador::trace::Tracer::new(&scene, &scene.settings);
+    let camera = scene.camera.clone();
+    let ray = move |x: f32, y: f32| Some((camera.ray_through(x, y), 0.0));
+    let size = (scene.camera.width, scene.camera.height);
+    let rays = |stride| ViewRays {
+        size,
+        window: [0, 0, size.0, size.1],
+        ray: &ray,
+        cone: mirador::trace::primary_cone(&scene.camera),
+        skip: None,
+        lights: &[0],
+        stride,
+    };
+    let wanted = Wanted { visibility: true, reflection: true, transmission: false, colour: true };
+    let full = tracer.terms(&rays(1), wanted);
+    let coarse = tracer.terms(&rays(4), wanted);
+    let width = size.0 as usize;
+    let mut differing = 0;
+    for (i, (c, f)) in coarse.surface.iter().zip(&full.surface).enumerate() {
+        let (x, y) = (i % width, i / width);
+        let first = (y - y % 4) * width + (x - x % 4);
+        assert_eq!(*c, full.surface[first], "pixel ({x}, {y}) holds its block's first pixel's terms");
+        assert_eq!(coarse.visibility[0][i], full.visibility[0][first]);
+        differing += usize::from(c != f);
+    }
+    // The other side: the coarse image is not the full one.
+    assert!(differing > coarse.surface.len() / 10, "{differing} of {} pixels differ", coarse.surface.len());
+    assert!(
+        coarse.rays.primary * 10 < full.rays.primary,
+        "{} against {} primary rays",
+        coarse.rays.primary,
+        full.rays.primary
+    );
+}

@@ -84,7 +84,7 @@ const PIXEL_BYTES: u32 = 16;
 pub fn prepare(
     (device, scene, settings): (&wgpu::Device, &Scene, &RenderSettings),
     frame: &mut FrameEncoder,
-    wanted: Wanted,
+    (wanted, stride): (Wanted, u32),
     lights: &ShadowLayout,
     views: &[(&FrameView, &FrameTargets)],
 ) -> PreparedTraced {
@@ -105,6 +105,7 @@ pub fn prepare(
                 cone: camera_ray.1,
                 skip: view.skip,
                 lights: slots,
+                stride,
             };
             let terms = tracer.terms(&rays_of_view, wanted);
             rays += terms.rays.total();

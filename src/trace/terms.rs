@@ -59,6 +59,9 @@ pub struct ViewRays<'a> {
     pub skip: Option<usize>,
     /// The scene light of each shadowed light's slot (the rasterizer's `shadow_slot` order).
     pub lights: &'a [usize],
+    /// Trace one pixel in each block of `stride × stride` and give the block its terms: a coarse
+    /// image for a viewer to refine (1: every pixel).
+    pub stride: u32,
 }
 
 /// The most shadowed lights whose visibility is traced (the rasterizer's four).
@@ -103,19 +106,29 @@ impl Tracer<'_> {
         let [x0, y0, w, h] = view.window;
         let (x1, y1) = ((x0 + w).min(width), (y0 + h).min(height));
         let slots = if wanted.visibility { view.lights.len().min(MAX_SLOTS) } else { 0 };
-        let rows: Vec<(Vec<Pixel>, RayCounts)> = (y0..y1)
+        let stride = view.stride.max(1);
+        // The traced rows and columns: the first of each block.
+        let traced_rows: Vec<(Vec<Pixel>, RayCounts)> = (y0..y1)
+            .step_by(stride as usize)
+            .collect::<Vec<_>>()
             .into_par_iter()
             .map(|y| {
                 let mut counts = RayCounts::default();
-                let row = (x0..x1).map(|x| self.pixel_terms(view, (x, y), wanted, slots, &mut counts)).collect();
+                let row = (x0..x1)
+                    .step_by(stride as usize)
+                    .map(|x| self.pixel_terms(view, (x, y), wanted, slots, &mut counts))
+                    .collect();
                 (row, counts)
             })
             .collect();
         let mut rays = RayCounts::default();
         let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-        for (row, counts) in rows {
-            rays += counts;
-            pixels.extend(row);
+        for y in 0..y1 - y0 {
+            let (row, counts) = &traced_rows[(y / stride) as usize];
+            if y % stride == 0 {
+                rays += *counts;
+            }
+            pixels.extend((0..x1 - x0).map(|x| row[(x / stride) as usize]));
         }
         let layer = |term: fn(&Pixel) -> [f32; 4]| pixels.iter().map(term).collect::<Vec<_>>();
         TracedTerms {

@@ -430,7 +430,7 @@ impl Viewer {
         if let Drawn::New(time) = drawn {
             times.raster = Some(time);
         }
-        self.request_traced((width, height), scale == 1.0, screen);
+        self.request_traced((width, height), scale == 1.0 && !self.raster.refining(), screen);
         if let Some(pixel) = self.inspect_next.take() {
             self.inspect(screen, pixel, (width, height));
         }
@@ -488,9 +488,13 @@ impl Viewer {
         let settle = (scale < 1.0).then(|| self.moving_until.map_or(now, |t| t.max(now)));
         let animation = repaint.filter(|d| *d < Duration::from_secs(3600)).map(|d| now + d);
         let retry = (presented == Presented::Skipped).then(|| now + RETRY);
-        // In the browser the tracer works between frames ([`super::traced`]), and readbacks
-        // arrive a frame or two after they are asked for.
-        let busy = self.traced.worker.busy() || self.raster.reading_back() || screen.screenshots_pending();
+        // In the browser the tracer works between frames ([`super::traced`]), readbacks arrive a
+        // frame or two after they are asked for, and the hybrid's traced terms are refined frame
+        // by frame while the camera rests.
+        let busy = self.traced.worker.busy()
+            || self.raster.reading_back()
+            || self.raster.refining()
+            || screen.screenshots_pending();
         let working = busy.then_some(now);
         let at = self.probe_at();
         let behind = !self.probe.is_current(&self.scene, &self.settings, at)
@@ -508,7 +512,7 @@ impl Viewer {
         self.screenshot.as_ref()?;
         let since = *self.screenshot_waiting.get_or_insert_with(Instant::now);
         let animating = repaint.is_some_and(|delay| delay.is_zero());
-        if (animating || scale < 1.0) && since.elapsed() < SCREENSHOT_PATIENCE {
+        if (animating || scale < 1.0 || self.raster.refining()) && since.elapsed() < SCREENSHOT_PATIENCE {
             return None;
         }
         self.screenshot_waiting = None;

@@ -12,7 +12,9 @@
 //!
 //! A frame whose inputs (camera, lights, settings, scene revision, size) are those of the image
 //! already drawn is not drawn again: the window shows the kept image. Hovering, the panel and the
-//! overlays then cost only the window's composition.
+//! overlays then cost only the window's composition. Where the hybrid traces terms
+//! (`settings.hybrid`), a new image's are traced at one pixel in 16 and refined, one pixel in 4
+//! then every pixel, in the frames that follow while its inputs stay, as the traced view refines.
 
 use std::time::Duration;
 
@@ -51,7 +53,13 @@ pub struct RasterView {
     pub report: FrameReport,
     /// The image on its way back to the CPU ([`RasterView::read_back`]).
     readback: Option<PendingImage>,
+    /// The stride the hybrid's traced terms of the image shown were traced at (1: every pixel):
+    /// a new image's are traced coarse, and refined frame by frame while its inputs stay.
+    traced_stride: u32,
 }
+
+/// The stride a new image's traced terms start at: one pixel in 16, refined to 4, then to all.
+const COARSE_TRACED_STRIDE: u32 = 4;
 
 /// Everything a raster image depends on.
 #[derive(Clone, PartialEq)]
@@ -107,6 +115,7 @@ impl RasterView {
             readback: None,
             bound: None,
             report: FrameReport::default(),
+            traced_stride: 1,
         }
     }
 
@@ -144,7 +153,12 @@ impl RasterView {
         let inputs =
             Inputs { camera: scene.camera.clone(), lights: scene.lights.clone(), settings: settings.clone(), revision };
         if self.drawn.as_ref() == Some(&inputs) {
-            return Drawn::Kept;
+            if !self.refining() {
+                return Drawn::Kept;
+            }
+            self.traced_stride /= 2;
+        } else {
+            self.traced_stride = if settings.hybrid.any() { COARSE_TRACED_STRIDE } else { 1 };
         }
         let gpu = &screen.gpu;
         if revision != self.revision {
@@ -158,6 +172,7 @@ impl RasterView {
         let frame = self.frame.as_mut().expect("made just above");
         let start = Instant::now();
         self.renderer.profile = profile;
+        self.renderer.traced_stride = self.traced_stride;
         self.report = self.renderer.render(gpu, scene, settings, &mut frame.targets, &frame.image.view);
         if let Some((display, _)) = &frame.display {
             let mut encoder = gpu
@@ -181,6 +196,11 @@ impl RasterView {
         self.drawn = Some(inputs);
         self.readback = None;
         Drawn::New(elapsed)
+    }
+
+    /// Whether the image shown has traced terms still to refine: the viewer draws again at once.
+    pub fn refining(&self) -> bool {
+        self.traced_stride > 1 && self.drawn.as_ref().is_some_and(|d| d.settings.hybrid.any())
     }
 
     fn sized_targets(&self, gpu: &Gpu, size: (u32, u32), settings: &RenderSettings) -> SizedTargets {

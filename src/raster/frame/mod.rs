@@ -99,6 +99,10 @@ pub struct Renderer {
     /// Submit and time each pass on its own (`render --stats`): slower, but it says where the
     /// frame's time goes.
     pub profile: bool,
+    /// The hybrid's traced terms are traced at one pixel in each block of this many pixels on a
+    /// side, the block given its terms: the viewer's coarse frames, refined while the camera
+    /// rests (1, the default: every pixel).
+    pub traced_stride: u32,
 }
 
 /// The phases every view draws, prepared for one frame.
@@ -169,6 +173,7 @@ impl Renderer {
             inspected_through: None,
             facts: FrameFacts::default(),
             profile: false,
+            traced_stride: 1,
         }
     }
 
@@ -275,8 +280,10 @@ impl Renderer {
                 ViewKind::CubeFace { .. } => (view, environment.capture_targets()),
             })
             .collect();
-        let traced =
-            wanted.map(|w| traced::prepare((&gpu.device, scene, settings), &mut frame, w, &plan.lights, &views));
+        let traced = wanted.map(|w| {
+            let (inputs, wanted) = ((&gpu.device, scene, settings), (w, self.traced_stride));
+            traced::prepare(inputs, &mut frame, wanted, &plan.lights, &views)
+        });
         let inspection = self.inspector.as_ref().map(|i| &i.buffer);
         let inputs = frame_inputs(&maps, environment, inspection);
         self.view_groups.prepare(&gpu.device, &self.layouts.view, &inputs, &views);
