@@ -88,7 +88,9 @@ pub fn unswapped(scene: &Scene, settings: &RenderSettings) -> Vec<&'static str> 
     let mut causes =
         vec!["primary visibility: triangles rasterized by coverage (curved shapes tessellated) against exact ray hits"];
     if !scene.volumes.is_empty() {
-        causes.push("volumes: marched by the same algorithm in both (the grid in half floats on the GPU); no traced swap");
+        causes.push(
+            "volumes: marched by the same algorithm in both (the grid in half floats on the GPU); no traced swap",
+        );
     }
     if settings.trace.anti_aliasing != crate::settings::AntiAliasing::Center {
         causes.push("anti-aliasing: the tracer samples more than each pixel's centre");

@@ -27,7 +27,7 @@ use rayon::prelude::*;
 use super::Tracer;
 use super::explain::Unobserved;
 use super::geometry::SurfaceHit;
-use super::whitted::{MAX_LAYERS, RayCounts, surface_offset};
+use super::whitted::{RayCounts, surface_offset};
 use crate::base::Ray;
 use crate::scene::AlphaMode;
 use crate::scene::shading::{facing_viewer, lights_surface};
@@ -228,8 +228,8 @@ impl Tracer<'_> {
     }
 
     /// The first surface along `ray` (the first opaque one if `opaque`): past a mask's holes, the
-    /// object `skip` and, if `opaque`, transparent surfaces, the ray going on from just beyond
-    /// each (its cone continued). Returns the hit with the ray and cone that found it.
+    /// object `skip` and, if `opaque`, transparent surfaces. Returns the hit with the ray and cone
+    /// that found it.
     fn first_surface(
         &self,
         ray: &Ray,
@@ -237,33 +237,9 @@ impl Tracer<'_> {
         skip: Option<usize>,
         opaque: bool,
     ) -> Option<(SurfaceHit, Ray, RayCone)> {
-        let whitted = &self.whitted;
-        let (mut ray, mut cone) = (*ray, cone);
-        for _ in 0..MAX_LAYERS {
-            let hit = whitted.accelerator.closest(&whitted.primitives, &ray, 0.0, f32::INFINITY)?;
-            let surface = whitted.primitives[hit.primitive as usize].surface(&ray, hit.t);
-            let material = &self.scene.materials[surface.material.0];
-            let passed = Some(surface.object) == skip
-                || (opaque && material.is_transparent())
-                || match material.alpha_mode {
-                    AlphaMode::Mask { cutoff } => {
-                        whitted.textures.coverage(
-                            material,
-                            &surface,
-                            ray.direction,
-                            Some(&cone),
-                            &whitted.texture_settings,
-                        ) < cutoff
-                    }
-                    AlphaMode::Opaque | AlphaMode::Blend => false,
-                };
-            if !passed {
-                return Some((surface, ray, cone));
-            }
-            let step = hit.t + surface_offset(surface.point);
-            ray.origin = ray.at(step);
-            cone = cone.continued(step);
-        }
-        None
+        let passed = |surface: &SurfaceHit, material: &crate::scene::Material| {
+            Some(surface.object) == skip || (opaque && material.is_transparent())
+        };
+        self.whitted.nearest_surface_past(ray, cone, passed)
     }
 }

@@ -263,6 +263,17 @@ impl Whitted<'_> {
     /// the hit with the ray and the cone that found it (`hit.t` counts from that ray's origin), or
     /// `None` if the ray leaves the scene or passes [`MAX_LAYERS`] masked hits.
     pub(super) fn nearest_surface(&self, ray: &Ray, cone: RayCone) -> Option<(SurfaceHit, Ray, RayCone)> {
+        self.nearest_surface_past(ray, cone, |_, _| false)
+    }
+
+    /// [`Self::nearest_surface`], passing also the surfaces `passed` says to: the hybrid's terms
+    /// look past transparent surfaces and the object a view looks out of (`super::terms`).
+    pub(super) fn nearest_surface_past(
+        &self,
+        ray: &Ray,
+        cone: RayCone,
+        passed: impl Fn(&SurfaceHit, &Material) -> bool,
+    ) -> Option<(SurfaceHit, Ray, RayCone)> {
         let (mut ray, mut cone) = (*ray, cone);
         for _ in 0..MAX_LAYERS {
             let hit = self.accelerator.closest(&self.primitives, &ray, 0.0, f32::INFINITY)?;
@@ -275,7 +286,7 @@ impl Whitted<'_> {
                 }
                 AlphaMode::Opaque | AlphaMode::Blend => false,
             };
-            if !masked_out {
+            if !masked_out && !passed(&surface, material) {
                 return Some((surface, ray, cone));
             }
             let step = hit.t + surface_offset(surface.point);
