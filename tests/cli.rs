@@ -425,3 +425,22 @@ fn a_closed_pipe_ends_the_output_quietly() {
     assert!(!stderr(&output).contains("panicked"), "{}", stderr(&output));
     assert_eq!(output.status.code(), Some(141));
 }
+
+#[test]
+fn budget_writes_its_json_and_its_sheet_even_for_a_tiny_image() {
+    let dir = scratch("budget");
+    let sheet = dir.join("budget.png");
+    let scene = asset("scenes/seed-simple.toml");
+    let args = ["budget", &scene, "--width", "48", "--height", "32", "--json", "-", "--sheet", sheet.to_str().unwrap()];
+    let output = mirador(&args);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).expect("the budget's JSON on standard output");
+    assert!(json["whole"].as_f64().is_some() && json["floor"].as_f64().is_some(), "{json}");
+    assert_eq!(json["approximations"][0]["name"], "shadows", "{json}");
+    let image = image::open(&sheet).expect("the sheet");
+    assert!(image.width() > 48 && image.height() > 32);
+    // The other side: a sheet that is no PNG is refused before anything is drawn.
+    let wrong = dir.join("budget.jpg");
+    let output = mirador(&["budget", &scene, "--sheet", wrong.to_str().unwrap()]);
+    assert!(!output.status.success() && !wrong.exists(), "{}", stderr(&output));
+}

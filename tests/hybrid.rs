@@ -1,6 +1,6 @@
 //! The hybrid (`settings.hybrid`, `src/raster/traced.rs`): with every approximation the rasterizer
 //! makes swapped for its traced term, the raster frame is the tracer's image, up to what no swap
-//! removes (primary visibility). Checked on every scene the course and the tests use, and
+//! removes (primary visibility). Checked on every scene of `assets/scenes/` and its course, and
 //! two-sided: each scene's plain raster frame must be measurably farther from the tracer wherever
 //! the scene uses something the hybrid swaps, so a swap that did nothing would fail.
 
@@ -55,8 +55,9 @@ fn every_scene_with_every_term_traced_is_the_tracers_image() {
         report.push((name, plain, hybrid));
     }
     for (name, plain, hybrid) in &report {
-        // Measured at most 0.0010 (the silhouettes of tessellated shapes), at 240 pixels wide.
-        assert!(*hybrid < 0.01, "{name}: every term traced vs the tracer: FLIP {hybrid}");
+        // Measured at most 0.0010 (the silhouettes of tessellated shapes), at 240 pixels wide;
+        // the bound is 0.01.
+        assert!(*hybrid < 0.003, "{name}: every term traced vs the tracer: FLIP {hybrid}");
         assert!(hybrid <= plain, "{name}: the hybrid {hybrid} is farther from the tracer than the raster {plain}");
     }
     // The other side: where the approximations show, the swaps are what closes the gap.

@@ -3,7 +3,7 @@
 //!
 //! - the crate's layers, each importing only from those below it:
 //!   `settings | shaders | files | base` ← `output | compare | settings_doc | volume`
-//!   ← `scene | linear_output` ← `texture` ← `trace | gpu` ← `raster` ← `explain | lab` ← `viewer`
+//!   ← `scene | linear_output` ← `texture` ← `trace | gpu` ← `raster` ← `budget | explain | lab` ← `viewer`
 //!   ← `web` (← `main.rs`), where modules of one layer never import each other: `base` holds
 //!   what `scene` and `volume` share (the ray, the material and texture indices), so the scene
 //!   holds volumes and reads their files while `volume` knows nothing of the scene;

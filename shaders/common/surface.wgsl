@@ -389,7 +389,11 @@ fn shade_surface(in: VertexOut) -> Shaded {
         // object reflects through a map.
         let r = 2.0 * dot(n, v) * n - v;
         environment_radiance = select(vec3f(0.0), environment_lookup(in.world, r, in.env_layer), in.env_layer != ENV_LAYER_NONE);
-        radiance += material.reflectance * environment_radiance;
+        // Where the hybrid traced this surface's reflection, that is added below instead (the
+        // lookup stays: glass reads it).
+        if (TRACED & TRACED_REFLECTION) == 0u || !here {
+            radiance += material.reflectance * environment_radiance;
+        }
         if INSPECT {
             probe.environment = material.reflectance * environment_radiance;
             probe.env_direction = r;

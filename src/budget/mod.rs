@@ -29,6 +29,8 @@ use crate::Scene;
 use crate::compare::difference_beyond;
 use crate::gpu::Gpu;
 use crate::raster::Headless;
+use crate::raster::shadow::views::MAX_SHADOWED_LIGHTS;
+use crate::raster::uniforms::MAX_LIGHTS;
 use crate::settings::{HybridSettings, RenderSettings};
 
 /// Differences of up to this many levels (of 255, in every channel) are not counted: they are
@@ -61,7 +63,7 @@ pub const APPROXIMATIONS: [Approximation; 4] = [
     Approximation {
         name: "reflections",
         swap: "mirrored cameras and environment maps → the traced L(r)",
-        in_use: |scene, _| scene.objects.iter().any(|o| reflects(&scene.materials[o.material.0])),
+        in_use: |scene, _| scene.objects.iter().any(|o| scene.materials[o.material.0].reflects()),
         traced: |hybrid| &mut hybrid.reflections,
     },
     Approximation {
@@ -78,10 +80,6 @@ pub const APPROXIMATIONS: [Approximation; 4] = [
     },
 ];
 
-fn reflects(material: &crate::scene::Material) -> bool {
-    material.mirror * material.mirror_color != glam::Vec3::ZERO
-}
-
 /// What keeps the fully swapped frame from the tracer's image in `scene`: the approximations
 /// without a traced counterpart that it uses, and what no swap removes.
 pub fn unswapped(scene: &Scene, settings: &RenderSettings) -> Vec<&'static str> {
@@ -91,6 +89,19 @@ pub fn unswapped(scene: &Scene, settings: &RenderSettings) -> Vec<&'static str> 
         causes.push(
             "volumes: marched by the same algorithm in both (the grid in half floats on the GPU); no traced swap",
         );
+        if settings.shadows.enabled {
+            causes.push("volumes' shadows (isosurfaces, volume.shadows): shadow maps, not traced");
+        }
+    }
+    let shadowed = scene.lights.len().min(MAX_LIGHTS);
+    if settings.shadows.enabled && shadowed > MAX_SHADOWED_LIGHTS {
+        causes.push("lights past the fourth: the rasterizer shadows four, the tracer every light");
+    }
+    if scene.lights.len() > MAX_LIGHTS {
+        causes.push("lights past the sixteenth: the rasterizer draws sixteen");
+    }
+    if settings.raster.render_scale < 1.0 {
+        causes.push("raster.render_scale < 1: the frame is drawn smaller and stretched");
     }
     if settings.trace.anti_aliasing != crate::settings::AntiAliasing::Center {
         causes.push("anti-aliasing: the tracer samples more than each pixel's centre");

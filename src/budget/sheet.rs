@@ -44,8 +44,8 @@ pub fn sheet(budget: &Budget) -> RgbaImage {
 /// A panel `width` wide of horizontal bars, each `(label, value, colour)`, on a common `scale`.
 fn bars(width: u32, values: &[(&str, f32, Rgba<u8>)], scale: f32) -> RgbaImage {
     let mut image = RgbaImage::from_pixel(width, 8 + 44 * values.len() as u32, BACKGROUND);
-    let left = 110u32;
-    let length = width.saturating_sub(left + 80).max(1);
+    let left = 110.min(width / 3);
+    let length = width.saturating_sub(left + 80);
     for (k, &(label, value, colour)) in values.iter().enumerate() {
         let y = 8 + 44 * k as u32;
         draw_text(&mut image, label, 8.0, y as f32 + 4.0, 16.0, TEXT);

@@ -222,6 +222,9 @@ impl<'s> Explainer<'s> {
         }
         let mut settings = settings.clone();
         settings.raster.render_scale = 1.0;
+        // The rasterizer's own approximations are what is explained: a term the hybrid traces is
+        // the tracer's, which the tracer's side shows already.
+        settings.hybrid = crate::settings::HybridSettings::default();
         let size = (scene.camera.width, scene.camera.height);
         Ok(Explainer {
             scene,

@@ -105,7 +105,8 @@ impl ViewImages {
         &self.images[image.index()]
     }
 
-    /// Makes `image` at `size` if it is smaller (an image made on demand).
+    /// Makes `image` at `size` if it has another size (an image made on demand; once made, it
+    /// stays until the targets are remade).
     pub fn ensure(&mut self, device: &wgpu::Device, image: ViewImage, size: (u32, u32)) {
         let made = self.images[image.index()].texture.size();
         if (made.width, made.height) != size {

@@ -36,25 +36,27 @@ const _: () = assert!(crate::trace::terms::MAX_SLOTS == MAX_SHADOWED_LIGHTS);
 /// The terms `settings` asks to trace, or `None`.
 pub fn wanted(settings: &RenderSettings) -> Option<Wanted> {
     let hybrid = &settings.hybrid;
-    hybrid.any().then_some(Wanted {
+    let wanted = Wanted {
         visibility: hybrid.shadows && settings.shadows.enabled,
         reflection: hybrid.reflections,
         transmission: hybrid.transmission,
         colour: hybrid.textures,
-    })
+    };
+    (wanted != Wanted::default()).then_some(wanted)
 }
 
 /// The settings the rasterizer's own passes draw with: what a traced term replaces is left out.
-/// Traced reflections replace the mirrored cameras and the environment maps; traced transmission
-/// replaces the transparency pass and refraction (transparent surfaces are then drawn with the
-/// opaque ones, each adding what the tracer says it lets through).
+/// Traced reflections replace the mirrored cameras (the environment maps stay: glass reads them,
+/// and the opaque surfaces the terms were traced on skip their lookup, `TRACED_REFLECTION` in
+/// shaders/common/surface.wgsl); traced transmission replaces the transparency pass and
+/// refraction (transparent surfaces are then drawn with the opaque ones, each adding what the
+/// tracer says it lets through).
 pub fn raster_settings(settings: &RenderSettings) -> Option<RenderSettings> {
     let hybrid = &settings.hybrid;
     (hybrid.reflections || hybrid.transmission).then(|| {
         let mut raster = settings.clone();
         if hybrid.reflections {
             raster.mirrors.enabled = false;
-            raster.environment.enabled = false;
         }
         if hybrid.transmission {
             raster.transparency.enabled = false;
@@ -95,21 +97,18 @@ pub fn prepare(
     let mut rays = 0;
     let traced = views
         .iter()
-        .map(|&(view, targets)| {
+        .filter_map(|&(view, targets)| {
             let size = targets.size;
-            let camera_ray = camera_rays(scene, view, size);
-            let rays_of_view = ViewRays {
-                size,
-                window: view.scissor.unwrap_or([0, 0, size.0, size.1]),
-                ray: &*camera_ray.0,
-                cone: camera_ray.1,
-                skip: view.skip,
-                lights: slots,
-                stride,
-            };
-            let terms = tracer.terms(&rays_of_view, wanted);
+            let window = view.scissor.unwrap_or([0, 0, size.0, size.1]);
+            // A mirror at the screen's edge may leave its camera an empty window.
+            if window[2] == 0 || window[3] == 0 {
+                return None;
+            }
+            let (ray, cone) = camera_rays(scene, view, size);
+            let view_rays = ViewRays { size, window, ray: &*ray, cone, skip: view.skip, lights: slots, stride };
+            let terms = tracer.terms(&view_rays, wanted);
             rays += terms.rays.total();
-            (view.slot, upload(device, &terms))
+            Some((view.slot, upload(device, &terms)))
         })
         .collect();
     frame.end("traced terms", &[("rays", Figure::Count(rays))]);

@@ -129,6 +129,11 @@ pub struct Material {
 }
 
 impl Material {
+    /// Whether it reflects a mirror term `kps·MPS·L(r)` (a planar or curved mirror).
+    pub fn reflects(&self) -> bool {
+        self.mirror * self.mirror_color != glam::Vec3::ZERO
+    }
+
     /// Whether light passes through (kt > 0, or alpha blending): such surfaces are drawn after the
     /// opaque ones, and tint shadows instead of blocking them.
     pub fn is_transparent(&self) -> bool {

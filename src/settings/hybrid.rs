@@ -17,7 +17,8 @@ section! {
         shadows: bool = false,
         /// The mirror term `kps·MPS·L(r)` with `L(r)` traced (the tracer's whole recursion along
         /// the reflected ray), in place of the mirrored cameras of planar mirrors and the
-        /// environment maps of curved ones.
+        /// environment maps of curved ones (glass still reads the maps: its reflection and
+        /// refraction are transmission's to swap).
         reflections: bool = false,
         /// What transparent surfaces let through, traced (`α·((1 − F)·kt·MT·L(t) + F·kt·MT·L(r))
         /// + (1 − α)·L(behind)`), in place of sorted blending and the screen-space refraction:

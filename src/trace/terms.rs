@@ -20,6 +20,12 @@
 //! - **colour**: `C`, the material's colour times its texture filtered over the ray cone's
 //!   footprint, and the surface's object, so the shading uses the traced terms only on the
 //!   surface they were traced on.
+//!
+//! Limits: visibility is traced for the rasterizer's four shadowed lights ([`MAX_SLOTS`]); the
+//! surfaces are the tracer's, so an isosurface (which the rasterizer draws as a surface) is looked
+//! past, its pixels keeping the rasterizer's own terms; glass's mirror term and its Fresnel share
+//! each trace their `L(r)`, where the tracer casts one ray for both (the same value, twice the
+//! rays).
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -29,7 +35,6 @@ use super::explain::Unobserved;
 use super::geometry::SurfaceHit;
 use super::whitted::{RayCounts, surface_offset};
 use crate::base::Ray;
-use crate::scene::AlphaMode;
 use crate::scene::shading::{facing_viewer, lights_surface};
 use crate::texture::RayCone;
 
@@ -105,6 +110,7 @@ impl Tracer<'_> {
         let (width, height) = view.size;
         let [x0, y0, w, h] = view.window;
         let (x1, y1) = ((x0 + w).min(width), (y0 + h).min(height));
+        let (x0, y0) = (x0.min(x1), y0.min(y1));
         let slots = if wanted.visibility { view.lights.len().min(MAX_SLOTS) } else { 0 };
         let stride = view.stride.max(1);
         // The traced rows and columns: the first of each block.
@@ -183,8 +189,7 @@ impl Tracer<'_> {
                 };
             }
         }
-        let reflects = material.mirror * material.mirror_color != Vec3::ZERO;
-        if wanted.reflection && reflects && whitted.max_depth > 0 {
+        if wanted.reflection && material.reflects() && whitted.max_depth > 0 {
             let radiance =
                 whitted.reflected((&hit, n, v), cone.continued(hit.t), 0, (counts, &mut Unobserved), (Vec3::ONE, ""));
             pixel.reflection = radiance.extend(1.0).into();
@@ -202,14 +207,7 @@ impl Tracer<'_> {
         if whitted.max_depth == 0 {
             return Vec3::ZERO;
         }
-        let material = &self.scene.materials[hit.material.0];
-        let alpha = match material.alpha_mode {
-            AlphaMode::Blend => whitted
-                .textures
-                .coverage(material, hit, ray.direction, Some(&cone), &whitted.texture_settings)
-                .clamp(0.0, 1.0),
-            AlphaMode::Opaque | AlphaMode::Mask { .. } => 1.0,
-        };
+        let alpha = whitted.blended_coverage(ray, cone, hit);
         let v = -ray.direction;
         let mut through = Vec3::ZERO;
         if alpha > 0.0 {

@@ -322,13 +322,7 @@ impl Whitted<'_> {
                 return shown;
             }
         }
-        let alpha = match material.alpha_mode {
-            AlphaMode::Blend => self
-                .textures
-                .coverage(material, hit, ray.direction, Some(&cone), &self.texture_settings)
-                .clamp(0.0, 1.0),
-            AlphaMode::Opaque | AlphaMode::Mask { .. } => 1.0,
-        };
+        let alpha = self.blended_coverage(ray, cone, hit);
         let mut rad = Vec3::ZERO;
         if alpha > 0.0 {
             observer.scale(Vec3::splat(alpha));
@@ -339,6 +333,18 @@ impl Whitted<'_> {
             rad += self.behind(ray, cone, hit, (depth, alpha), counts, observer);
         }
         rad
+    }
+
+    /// `α`, the share of `ray` a blended surface covers at `hit` (1 for any other surface).
+    pub(super) fn blended_coverage(&self, ray: &Ray, cone: RayCone, hit: &SurfaceHit) -> f32 {
+        let material = &self.scene.materials[hit.material.0];
+        match material.alpha_mode {
+            AlphaMode::Blend => self
+                .textures
+                .coverage(material, hit, ray.direction, Some(&cone), &self.texture_settings)
+                .clamp(0.0, 1.0),
+            AlphaMode::Opaque | AlphaMode::Mask { .. } => 1.0,
+        }
     }
 
     /// `(1 − α)·L`, `L` the radiance of `ray` continued straight past a blended surface it hit at

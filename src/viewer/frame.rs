@@ -48,11 +48,11 @@ const SCREENSHOT_PATIENCE: Duration = Duration::from_secs(2);
 /// The longest a `wait traced` step waits.
 const TRACE_TIMEOUT: Duration = Duration::from_secs(600);
 
-/// Everything the viewer holds, grouped by concern.
 /// The widest view the panel's error budget is measured at: wider views are measured smaller.
 #[cfg(not(target_arch = "wasm32"))]
 const BUDGET_WIDTH: u32 = 480;
 
+/// Everything the viewer holds, grouped by concern.
 pub struct Viewer {
     pub scene: SceneState,
     pub settings: RenderSettings,
@@ -641,6 +641,9 @@ impl Viewer {
                 let summary = inspection.summary();
                 println!("{summary}");
                 self.notice(summary);
+                if self.settings.hybrid.any() {
+                    self.notice("explained without the hybrid: its traced terms are the tracer's side".into());
+                }
                 self.inspection = Some(inspection);
             }
             Err(e) => self.notice(format!("cannot inspect ({}, {}): {e:#}", at.0, at.1)),
@@ -655,8 +658,15 @@ impl Viewer {
         let width = size.0.min(BUDGET_WIDTH);
         (scene.camera.width, scene.camera.height) = (width, (size.1 * width).div_ceil(size.0.max(1)).max(1));
         let traced = crate::trace::render_image(&scene, &self.settings);
-        let budget = crate::budget::budget(&screen.gpu, &scene, &self.settings, traced);
-        let report = budget.report();
+        let measured = screen.gpu.checked(|| crate::budget::budget(&screen.gpu, &scene, &self.settings, traced));
+        let budget = match measured {
+            Ok(budget) => budget,
+            Err(e) => return self.notice(format!("cannot measure the error budget: {e:#}")),
+        };
+        let mut report = budget.report();
+        if self.lab.is_some() {
+            report = format!("(Mirador's own functions, not the lab's)\n{report}");
+        }
         println!("{report}");
         self.notice(format!("error budget measured: FLIP {:.4}, floor {:.4}", budget.whole, budget.floor));
         self.error_budget = Some(report);

@@ -130,7 +130,6 @@ impl EnvironmentPass {
         self.maps.as_ref().expect("EnvironmentPass::prepare makes the maps before a frame reads them")
     }
 
-    /// The target a cube face is drawn into (a face is due only after [`Self::prepare`] made it).
     /// Makes `image` at full size in the capture targets, if there are any (an image made on
     /// demand).
     pub fn ensure_images(&mut self, device: &wgpu::Device, image: ViewImage) {
@@ -139,6 +138,7 @@ impl EnvironmentPass {
         }
     }
 
+    /// The target a cube face is drawn into (a face is due only after [`Self::prepare`] made it).
     pub fn capture_targets(&self) -> &FrameTargets {
         self.capture.as_ref().expect("made by prepare with the faces due")
     }

@@ -280,9 +280,9 @@ impl Renderer {
                 ViewKind::CubeFace { .. } => (view, environment.capture_targets()),
             })
             .collect();
-        let traced = wanted.map(|w| {
-            let (inputs, wanted) = ((&gpu.device, scene, settings), (w, self.traced_stride));
-            traced::prepare(inputs, &mut frame, wanted, &plan.lights, &views)
+        let traced = wanted.map(|terms| {
+            let inputs = (&gpu.device, scene, settings);
+            traced::prepare(inputs, &mut frame, (terms, self.traced_stride), &plan.lights, &views)
         });
         let inspection = self.inspector.as_ref().map(|i| &i.buffer);
         let inputs = frame_inputs(&maps, environment, inspection);
