@@ -154,3 +154,16 @@ fn the_budgets_json_names_each_approximation_with_its_two_figures() {
     }
     assert!(json["floor_causes"][0].as_str().is_some_and(|c| c.starts_with("primary visibility")), "{json}");
 }
+
+#[test]
+fn the_floor_names_what_no_swap_removes() {
+    let mut scene = acne(true);
+    let first = |s: &Scene| mirador::budget::unswapped(s, &s.settings);
+    assert_eq!(first(&scene).len(), 1, "primary visibility alone: {:?}", first(&scene));
+    // A fifth light: the rasterizer shadows four.
+    let light = scene.lights[0].clone();
+    scene.lights.extend(std::iter::repeat_n(light, 4));
+    assert!(first(&scene).iter().any(|c| c.starts_with("lights past the fourth")), "{:?}", first(&scene));
+    scene.settings.raster.render_scale = 0.5;
+    assert!(first(&scene).iter().any(|c| c.starts_with("raster.render_scale")), "{:?}", first(&scene));
+}
