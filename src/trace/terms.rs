@@ -104,6 +104,26 @@ impl Default for Pixel {
     }
 }
 
+/// One layer of [`TracedTerms`].
+#[derive(Clone, Copy)]
+enum Layer {
+    Surface,
+    Reflection,
+    Transmission,
+    Visibility(usize),
+}
+
+impl Layer {
+    fn of(self, pixel: &Pixel) -> [f32; 4] {
+        match self {
+            Layer::Surface => pixel.surface,
+            Layer::Reflection => pixel.reflection,
+            Layer::Transmission => pixel.transmission,
+            Layer::Visibility(slot) => pixel.visibility[slot],
+        }
+    }
+}
+
 impl Tracer<'_> {
     /// The terms `wanted` at every pixel of `view`'s window.
     pub fn terms(&self, view: &ViewRays, wanted: Wanted) -> TracedTerms {
@@ -113,36 +133,50 @@ impl Tracer<'_> {
         let (x0, y0) = (x0.min(x1), y0.min(y1));
         let slots = if wanted.visibility { view.lights.len().min(MAX_SLOTS) } else { 0 };
         let stride = view.stride.max(1);
+        // The layers asked for, each row holding them one after another: no image of whole
+        // pixels is made.
+        let mut layers = vec![Layer::Surface];
+        layers.extend(wanted.reflection.then_some(Layer::Reflection));
+        layers.extend(wanted.transmission.then_some(Layer::Transmission));
+        layers.extend((0..slots).map(Layer::Visibility));
         // The traced rows and columns: the first of each block.
-        let traced_rows: Vec<(Vec<Pixel>, RayCounts)> = (y0..y1)
+        let row_width = (x1 - x0).div_ceil(stride) as usize;
+        let traced_rows: Vec<(Vec<[f32; 4]>, RayCounts)> = (y0..y1)
             .step_by(stride as usize)
             .collect::<Vec<_>>()
             .into_par_iter()
             .map(|y| {
                 let mut counts = RayCounts::default();
-                let row = (x0..x1)
-                    .step_by(stride as usize)
-                    .map(|x| self.pixel_terms(view, (x, y), wanted, slots, &mut counts))
-                    .collect();
+                let mut row = vec![[0.0; 4]; row_width * layers.len()];
+                for (i, x) in (x0..x1).step_by(stride as usize).enumerate() {
+                    let pixel = self.pixel_terms(view, (x, y), wanted, slots, &mut counts);
+                    for (k, layer) in layers.iter().enumerate() {
+                        row[k * row_width + i] = layer.of(&pixel);
+                    }
+                }
                 (row, counts)
             })
             .collect();
-        let mut rays = RayCounts::default();
-        let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-        for y in 0..y1 - y0 {
-            let (row, counts) = &traced_rows[(y / stride) as usize];
-            if y % stride == 0 {
-                rays += *counts;
+        let rays = traced_rows.iter().fold(RayCounts::default(), |mut all, (_, counts)| {
+            all += *counts;
+            all
+        });
+        // Each layer in turn, every pixel given its block's terms.
+        let mut images = (0..layers.len()).map(|k| {
+            let mut values = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+            for y in 0..y1 - y0 {
+                let row = &traced_rows[(y / stride) as usize].0[k * row_width..][..row_width];
+                values.extend((0..x1 - x0).map(|x| row[(x / stride) as usize]));
             }
-            pixels.extend((0..x1 - x0).map(|x| row[(x / stride) as usize]));
-        }
-        let layer = |term: fn(&Pixel) -> [f32; 4]| pixels.iter().map(term).collect::<Vec<_>>();
+            values
+        });
+        let mut next = || images.next().expect("one image a layer");
         TracedTerms {
-            window: [x0, y0, x1.saturating_sub(x0), y1.saturating_sub(y0)],
-            surface: layer(|p| p.surface),
-            reflection: wanted.reflection.then(|| layer(|p| p.reflection)),
-            transmission: wanted.transmission.then(|| layer(|p| p.transmission)),
-            visibility: (0..slots).map(|slot| pixels.iter().map(|p| p.visibility[slot]).collect()).collect(),
+            window: [x0, y0, x1 - x0, y1 - y0],
+            surface: next(),
+            reflection: wanted.reflection.then(&mut next),
+            transmission: wanted.transmission.then(&mut next),
+            visibility: (0..slots).map(|_| next()).collect(),
             rays,
         }
     }
@@ -173,6 +207,9 @@ impl Tracer<'_> {
             Vec3::ZERO
         };
         pixel.surface = [colour.x, colour.y, colour.z, hit.object as f32 + 1.0];
+        if !(wanted.visibility || wanted.reflection || wanted.transmission) {
+            return pixel;
+        }
         let n = whitted.shading_normal(material, &hit, v);
         if wanted.visibility {
             for (slot, &light) in view.lights.iter().enumerate().take(slots) {
