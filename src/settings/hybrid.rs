@@ -31,9 +31,37 @@ section! {
     }
 }
 
+/// Each technique's section of `RenderSettings` whose approximation a switch of the hybrid
+/// replaces, and that switch: the viewer's panel shows the switch in the section as its traced
+/// choice.
+pub const TRACED_CHOICES: [(&str, &str); 5] = [
+    ("shadows", "shadows"),
+    ("mirrors", "reflections"),
+    ("environment", "reflections"),
+    ("transparency", "transmission"),
+    ("textures", "textures"),
+];
+
 impl HybridSettings {
     /// Whether any term is traced.
     pub fn any(&self) -> bool {
         self.shadows || self.reflections || self.transmission || self.textures
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::TRACED_CHOICES;
+    use crate::RenderSettings;
+
+    #[test]
+    fn each_traced_choice_names_a_section_and_a_switch_of_the_hybrid() {
+        let table = toml::Table::try_from(RenderSettings::default()).expect("the settings serialise");
+        for (section, switch) in TRACED_CHOICES {
+            assert!(table.get(section).is_some_and(toml::Value::is_table), "no section `{section}`");
+            let mut settings = RenderSettings::default();
+            settings.set(&format!("hybrid.{switch}=true")).unwrap_or_else(|e| panic!("{e}"));
+            assert!(settings.hybrid.any(), "`hybrid.{switch}` switched nothing on");
+        }
     }
 }

@@ -30,7 +30,7 @@ mod volume;
 
 pub use bump::{BumpSettings, BumpView, TangentSource};
 pub use environment::{EnvironmentMap, EnvironmentSettings, EnvironmentView, Parallax, SphereView};
-pub use hybrid::HybridSettings;
+pub use hybrid::{HybridSettings, TRACED_CHOICES};
 pub use mirrors::{MAX_MIRROR_DEPTH, MirrorSettings, MirrorView};
 pub use raster::{Prepass, RasterSettings};
 pub use shadows::{ShadowFilter, ShadowFit, ShadowMethod, ShadowSettings, ShadowView};

@@ -12,6 +12,7 @@
 use egui::collapsing_header::CollapsingState;
 
 use crate::RenderSettings;
+use crate::settings::TRACED_CHOICES;
 use crate::settings_doc::{FieldDoc, describe};
 
 /// The name a key shows: its last part, words separated (`shadows.map_size` → "map size").
@@ -42,14 +43,33 @@ pub fn settings_ui(ui: &mut egui::Ui, settings: &RenderSettings) -> Vec<String> 
     }
     for (name, value) in &table {
         if let toml::Value::Table(section) = value {
-            section_ui(ui, name, section, &mut changes);
+            let traced = TRACED_CHOICES.iter().find(|(s, _)| s == name).map(|(_, switch)| *switch);
+            let traced = traced.and_then(|switch| Some((switch, table.get("hybrid")?.get(switch)?.as_bool()?)));
+            section_ui(ui, name, section, traced, &mut changes);
         }
     }
     changes
 }
 
-/// One technique: a collapsible section with its switch in the header.
-fn section_ui(ui: &mut egui::Ui, key: &str, section: &toml::Table, changes: &mut Vec<String>) {
+/// A technique's traced choice: the hybrid's switch that replaces its approximation by the
+/// tracer's term (docs/course/12-error-budget.md), shown in the technique's own section.
+fn traced_choice(ui: &mut egui::Ui, (switch, on): (&str, bool), changes: &mut Vec<String>) {
+    let key = format!("hybrid.{switch}");
+    let mut on = on;
+    if ui.checkbox(&mut on, format!("traced ({key})")).on_hover_text(tooltip(&key).tooltip).changed() {
+        changes.push(format!("{key}={on}"));
+    }
+}
+
+/// One technique: a collapsible section with its switch in the header, and its traced choice
+/// first where the hybrid has one.
+fn section_ui(
+    ui: &mut egui::Ui,
+    key: &str,
+    section: &toml::Table,
+    traced: Option<(&str, bool)>,
+    changes: &mut Vec<String>,
+) {
     let id = ui.make_persistent_id(("settings", key));
     let doc = tooltip(key);
     CollapsingState::load_with_default_open(ui.ctx(), id, false)
@@ -66,10 +86,13 @@ fn section_ui(ui: &mut egui::Ui, key: &str, section: &toml::Table, changes: &mut
             }
         })
         .body(|ui| {
+            if let Some(traced) = traced {
+                traced_choice(ui, traced, changes);
+            }
             for (name, value) in section {
                 let child = format!("{key}.{name}");
                 match value {
-                    toml::Value::Table(inner) => section_ui(ui, &child, inner, changes),
+                    toml::Value::Table(inner) => section_ui(ui, &child, inner, None, changes),
                     _ if name == "enabled" => {}
                     _ => field(ui, &child, value, changes),
                 }
