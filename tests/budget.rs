@@ -111,11 +111,16 @@ fn a_mirror_over_a_checker_floor_splits_into_the_mirror_and_the_floors_filtering
     let (deep_mirror, deep_mirror_share) = item(&deep, "reflections");
     let (flat_floor, floor_in_mirror) = item(&flat, "texture filtering");
     let (deep_floor, _) = item(&deep, "texture filtering");
-    // The mirror's error lies on the mirror, and it is what the depth changes.
-    assert!(flat_mirror_share > 0.9 && deep_mirror_share > 0.8, "{flat_mirror_share}, {deep_mirror_share}");
+    eprintln!(
+        "mirror shares {flat_mirror_share:.3} {deep_mirror_share:.3}, filtering in the mirror {floor_in_mirror:.3}"
+    );
+    // The mirror's error lies on the mirror (measured 0.945 and 0.926 of it), and it is what the
+    // depth changes.
+    assert!(flat_mirror_share > 0.85 && deep_mirror_share > 0.8, "{flat_mirror_share}, {deep_mirror_share}");
     // Measured 0.18 and 0.0019 (filtering 0.011 at both, floors 0.0005).
     assert!(flat_mirror > 4.0 * deep_mirror, "mirror at depth 0: {flat_mirror}, at depth 3: {deep_mirror}");
-    // The floor's filtering is mostly outside the mirror, and the same at either depth.
+    // The floor's filtering is outside the mirror (measured 0.001 of it inside), and the same at
+    // either depth.
     assert!(floor_in_mirror < 0.5, "the filtering's error inside the mirror: {floor_in_mirror}");
     assert!((flat_floor - deep_floor).abs() < 0.2 * deep_floor, "filtering {flat_floor} vs {deep_floor}");
     // With every approximation traced, what is left is small at either depth.
