@@ -37,16 +37,8 @@ impl GpuTexture {
         layers: u32,
         format: wgpu::TextureFormat,
     ) -> GpuTexture {
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: layers },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
+        let texture = Self::layered(device, label, (size, layers), format, usage);
         let view = texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
@@ -62,18 +54,29 @@ impl GpuTexture {
         format: wgpu::TextureFormat,
         usage: wgpu::TextureUsages,
     ) -> GpuTexture {
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
+        let texture = Self::layered(device, label, (size, 1), format, usage);
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        GpuTexture { texture, view }
+    }
+
+    /// A 2D texture of one level and `layers` layers, with `usage`.
+    fn layered(
+        device: &wgpu::Device,
+        label: &str,
+        (size, layers): ((u32, u32), u32),
+        format: wgpu::TextureFormat,
+        usage: wgpu::TextureUsages,
+    ) -> wgpu::Texture {
+        device.create_texture(&wgpu::TextureDescriptor {
             label: Some(label),
-            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: layers },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
             format,
             usage,
             view_formats: &[],
-        });
-        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-        GpuTexture { texture, view }
+        })
     }
 
     pub fn from_rgba8(
