@@ -22,12 +22,12 @@
 
 use std::time::{Duration, Instant};
 
-use glam::{Vec2, Vec3, Vec3A};
-use mirador::base::{MaterialId, Ray};
+use glam::{Vec3, Vec3A};
+use mirador::base::Ray;
 use mirador::trace::accel::Accelerator;
 use mirador::trace::accel::bvh::Bvh;
 use mirador::trace::accel::wide::Wide;
-use mirador::trace::geometry::{Primitive, Triangle};
+use mirador::trace::geometry::Primitive;
 use rayon::prelude::*;
 
 const SLICES: u32 = 1024;
@@ -188,19 +188,7 @@ fn mirador_row<A: Accelerator>(
     primary: &[Query],
     shadow: &[Query],
 ) -> Row {
-    let prims: Vec<Primitive> = tris
-        .iter()
-        .map(|&positions| {
-            let n = (positions[1] - positions[0]).cross(positions[2] - positions[0]).normalize_or_zero();
-            Primitive::Triangle(Triangle {
-                positions,
-                normals: [n; 3],
-                uvs: [Vec2::ZERO; 3],
-                object: 0,
-                material: MaterialId(0),
-            })
-        })
-        .collect();
+    let prims: Vec<Primitive> = tris.iter().copied().map(Primitive::flat_triangle).collect();
     let (build_time, accel) = timed(true, || build(&prims));
     println!("{}", accel.stats());
     let ray = |q: &Query| Ray { origin: q.origin, direction: q.direction };
@@ -283,18 +271,7 @@ fn main() {
     let primary = primary_rays();
     // Shadow rays from Mirador's primary hits toward a point light.
     let shadow: Vec<Query> = {
-        let prims: Vec<Primitive> = tris
-            .iter()
-            .map(|&positions| {
-                Primitive::Triangle(Triangle {
-                    positions,
-                    normals: [Vec3::Y; 3],
-                    uvs: [Vec2::ZERO; 3],
-                    object: 0,
-                    material: MaterialId(0),
-                })
-            })
-            .collect();
+        let prims: Vec<Primitive> = tris.iter().copied().map(Primitive::flat_triangle).collect();
         let accel = Bvh::build(&prims);
         let light = Vec3::new(3.0, 4.0, 2.0);
         primary

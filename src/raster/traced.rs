@@ -24,7 +24,7 @@ use super::targets::{
 };
 use super::view::{FrameView, View, ViewKind, ViewSlot};
 use crate::base::Ray;
-use crate::scene::Scene;
+use crate::scene::{Camera, Scene};
 use crate::settings::RenderSettings;
 use crate::texture::RayCone;
 use crate::trace::Tracer;
@@ -185,12 +185,10 @@ type RayFn = Box<dyn Fn(f32, f32) -> Option<(Ray, f32)> + Sync>;
 fn camera_rays(scene: &Scene, view: &FrameView, size: (u32, u32)) -> (RayFn, RayCone) {
     let camera = scene.camera.clone();
     if view.kind == ViewKind::Main {
-        // The tracer's own primary rays, scaled from the drawn size to the camera's.
+        // The tracer's own primary rays, scaled from the drawn size to the camera's, and a pixel
+        // of the drawn size's cone.
         let (sx, sy) = (camera.width as f32 / size.0 as f32, camera.height as f32 / size.1 as f32);
-        let cone = match camera.projection {
-            crate::scene::Projection::Perspective => RayCone::perspective(camera.fovy_degrees.to_radians(), size.1),
-            crate::scene::Projection::Orthographic => RayCone::orthographic(camera.window().0 / size.0 as f32),
-        };
+        let cone = crate::trace::primary_cone(&Camera { width: size.0, height: size.1, ..camera.clone() });
         return (Box::new(move |x, y| Some((camera.ray_through(x * sx, y * sy), 0.0))), cone);
     }
     let unprojected = Unprojected::new(&view.view, size);

@@ -131,7 +131,7 @@ pub struct Material {
 impl Material {
     /// Whether it reflects a mirror term `kps·MPS·L(r)` (a planar or curved mirror).
     pub fn reflects(&self) -> bool {
-        self.mirror * self.mirror_color != glam::Vec3::ZERO
+        self.mirror > 0.0 && self.mirror_color != glam::Vec3::ZERO
     }
 
     /// Whether light passes through (kt > 0, or alpha blending): such surfaces are drawn after the

@@ -765,6 +765,19 @@ pub struct SurfaceHit {
 }
 
 impl Primitive {
+    /// A triangle alone: its face normal at every corner, no texture coordinates, object 0 and
+    /// material 0 (the accelerators' tests and benchmarks, which look at hits only).
+    pub fn flat_triangle(positions: [Vec3; 3]) -> Primitive {
+        let n = (positions[1] - positions[0]).cross(positions[2] - positions[0]).normalize_or_zero();
+        Primitive::Triangle(Triangle {
+            positions,
+            normals: [n; 3],
+            uvs: [Vec2::ZERO; 3],
+            object: 0,
+            material: MaterialId(0),
+        })
+    }
+
     pub fn bounds(&self) -> Aabb {
         match self {
             Primitive::Triangle(tri) => Aabb::from_points(tri.positions),

@@ -62,8 +62,7 @@ pub fn reflective_objects(scene: &Scene, planar_mirrors: &[usize]) -> (Vec<usize
     let mut objects: Vec<usize> = (0..scene.objects.len())
         .filter(|&i| {
             let material = &scene.materials[scene.objects[i].material.0];
-            let mirror = material.mirror > 0.0 && material.mirror_color != Vec3::ZERO;
-            (mirror || material.bends_light()) && !planar_mirrors.contains(&i)
+            (material.reflects() || material.bends_light()) && !planar_mirrors.contains(&i)
         })
         .collect();
     let mut warnings = Vec::new();

@@ -715,24 +715,12 @@ impl Accelerator for Wide {
 
 #[cfg(test)]
 mod tests {
-    use glam::{Vec2, Vec3};
+    use glam::Vec3;
 
     use super::*;
-    use crate::base::MaterialId;
-    use crate::trace::geometry::Triangle;
 
     fn triangles(corners: impl Iterator<Item = [Vec3; 3]>) -> Vec<Primitive> {
-        corners
-            .map(|positions| {
-                Primitive::Triangle(Triangle {
-                    positions,
-                    normals: [Vec3::Z; 3],
-                    uvs: [Vec2::ZERO; 3],
-                    object: 0,
-                    material: MaterialId(0),
-                })
-            })
-            .collect()
+        corners.map(Primitive::flat_triangle).collect()
     }
 
     /// The stack's highest over walks that enter every child of every node, pushing and popping
