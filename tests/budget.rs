@@ -130,12 +130,14 @@ fn a_mirror_over_a_checker_floor_splits_into_the_mirror_and_the_floors_filtering
 #[test]
 fn swapping_an_approximation_a_scene_does_not_use_changes_nothing() {
     // No mirror and no texture in the acne scene: tracing reflections and textures draws the
-    // same bytes.
+    // same image (the same bytes here; beyond the level or two another CPU may round the other
+    // shader variant to, nothing).
     let scene = acne(true);
     let plain = common::raster(&scene, &scene.settings);
     let mut swapped = scene.settings.clone();
     (swapped.hybrid.reflections, swapped.hybrid.textures) = (true, true);
-    assert!(plain == common::raster(&scene, &swapped), "reflections and textures traced in a scene with neither");
+    let change = common::flip(&plain, &common::raster(&scene, &swapped));
+    assert!(change == 0.0, "reflections and textures traced in a scene with neither: FLIP {change}");
     // The other side: the same swaps where the scene has both change the image.
     let mut mirrors = common::load("scenes/mirrors.toml");
     (mirrors.camera.width, mirrors.camera.height) = (160, 100);

@@ -58,7 +58,12 @@ fn every_scene_with_every_term_traced_is_the_tracers_image() {
         // Measured at most 0.0010 (the silhouettes of tessellated shapes), at 240 pixels wide;
         // the bound is 0.01.
         assert!(*hybrid < 0.003, "{name}: every term traced vs the tracer: FLIP {hybrid}");
-        assert!(hybrid <= plain, "{name}: the hybrid {hybrid} is farther from the tracer than the raster {plain}");
+        // Where nothing is swapped (volumes) the two are equal but for the shader variant, which
+        // another CPU may round a level apart: a tenth of the bound of tolerance.
+        assert!(
+            *hybrid <= plain + 0.0003,
+            "{name}: the hybrid {hybrid} is farther from the tracer than the raster {plain}"
+        );
     }
     // The other side: where the approximations show, the swaps are what closes the gap.
     let shown = report.iter().filter(|(_, plain, hybrid)| *plain > 0.02 && *plain > 10.0 * hybrid).count();
