@@ -17,7 +17,7 @@
 @group(0) @binding(3) var source_cube: texture_cube<f32>;
 // The reflective objects' dynamic cubes, for the cross view of the first. A cube of the array
 // cannot be viewed as a cube of its own on GL (src/gpu/texture.rs, Layers).
-@group(0) @binding(4) var source_cubes: texture_cube_array<f32>;
+@group(0) @binding(4) var source_cubes: CubeArray;
 
 struct ConvertOut {
     @builtin(position) clip: vec4f,
@@ -125,7 +125,7 @@ fn fs_view_cross(in: ConvertOut) -> @location(0) vec4f {
 @fragment
 fn fs_view_cross_dynamic(in: ConvertOut) -> @location(0) vec4f {
     let at = cross_point(in.uv);
-    let radiance = textureSampleLevel(source_cubes, env_sampler, at.direction, 0, 0.0).rgb;
+    let radiance = cube_array_sample_level(source_cubes, env_sampler, at.direction, 0, 0.0).rgb;
     return select(OUTSIDE, vec4f(radiance, 1.0), at.inside);
 }
 

@@ -13,7 +13,7 @@
 // The cube whose face is copied, its mip level 0, read with a nearest sampler.
 @group(0) @binding(1) var face_sampler: sampler;
 @group(0) @binding(2) var face_cube: texture_cube<f32>;
-@group(0) @binding(3) var face_cubes: texture_cube_array<f32>;
+@group(0) @binding(3) var face_cubes: CubeArray;
 
 // The source texels one output texel averages along an axis of n texels: `count` texels from
 // `first` with `weights`. Even n: 2j, 2j+1 at ½ each; odd n = 2h + 1: 2j, 2j+1, 2j+2 at
@@ -93,5 +93,5 @@ fn fs_mipmap_face_cube(in: FaceOut) -> @location(0) vec4f {
 @fragment
 fn fs_mipmap_face_cubes(in: FaceOut) -> @location(0) vec4f {
     let d = face_texel_direction(in.position, in.layer % 6u, textureDimensions(face_cubes).x);
-    return textureSampleLevel(face_cubes, face_sampler, d, in.layer / 6u, 0.0);
+    return cube_array_sample_level(face_cubes, face_sampler, d, i32(in.layer / 6u), 0.0);
 }

@@ -138,7 +138,7 @@ fn screen_march(depth: texture_2d<f32>, p: vec3f, d: vec3f, distance: f32) -> Sc
 fn refracted_environment(p: vec3f, d: vec3f, layer: i32) -> vec3f {
     if ENVIRONMENT == ENV_MAP_DYNAMIC && layer >= 0 {
         let lookup = parallax_direction(environment, p, d, environment.cube_centres[layer].xyz);
-        return textureSampleLevel(env_cubes, env_sampler, lookup, layer, 0.0).rgb;
+        return cube_array_sample_level(env_cubes, env_sampler, lookup, layer, 0.0).rgb;
     }
     return textureSampleLevel(env_cube, env_sampler, d, 0.0).rgb;
 }

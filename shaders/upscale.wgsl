@@ -28,3 +28,14 @@ fn vs_upscale(@builtin(vertex_index) index: u32) -> Stretched {
 fn fs_upscale(in: Stretched) -> @location(0) vec4f {
     return textureSample(image, image_sampler, in.uv);
 }
+
+// The image's own bytes drawn into a plain 8-bit texture, where a copy cannot move them (WebGL2
+// copies no sRGB texture into a plain one; src/viewer/upscale.rs, Reencode): each texel is read
+// decoded, as an sRGB texture reads, and encoded again by the sRGB curve, which gives back the
+// byte it was (the curve is exact to far less than half a step in 32-bit floats).
+@fragment
+fn fs_reencode(in: Stretched) -> @location(0) vec4f {
+    let c = textureLoad(image, vec2i(in.position.xy), 0);
+    let encoded = select(1.055 * pow(c.rgb, vec3f(1.0 / 2.4)) - 0.055, 12.92 * c.rgb, c.rgb <= vec3f(0.0031308));
+    return vec4f(encoded, c.a);
+}

@@ -1,6 +1,50 @@
-//! WGSL composition, in one place: every pass's shader is the shared files of `shaders/common/`
-//! followed by the pass's own file; the passes that draw the scene's surfaces get the surface
-//! code ([`SURFACE`]) between the two. Shared code is never copied between shaders.
+//! WGSL composition, in one place: every pass's shader is the device's profile
+//! (`shaders/profile/`, [`Profile`]) and the shared files of `shaders/common/`, followed by the
+//! pass's own file; the passes that draw the scene's surfaces get the surface code ([`SURFACE`])
+//! between the two. Shared code is never copied between shaders.
+
+/// What the device's shaders may use. Mirador's WGSL calls a few functions for what a small
+/// device lacks, and each profile's file defines them (`shaders/profile/`): the same passes,
+/// the same bindings, compiled for either.
+///
+/// A device's profile is fixed when it is made (`gpu::Gpu::with_adapter`): `WebGl2` where the
+/// adapter has no cube-map arrays (WebGL2, OpenGL ES 3.0), or where `MIRADOR_LIMITS=webgl2`
+/// asks for it (to try those paths natively, on wgpu's GL backend). Such a device is made with
+/// wgpu's WebGL2 limits, which allow no storage buffers, and that is how [`Profile::of`] reads
+/// it back from the device alone.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Profile {
+    /// WebGPU, Vulkan, desktop GL and OpenGL ES 3.2: cube-map arrays and `textureGather`.
+    #[default]
+    Standard,
+    /// WebGL2 and OpenGL ES 3.0: no cube-map arrays (each cube is six layers of a 2D array), no
+    /// `textureGather`, no storage buffers (so no `explain` and no lab checks), no compute.
+    WebGl2,
+}
+
+impl Profile {
+    /// The profile `device` was made for: [`Profile::WebGl2`] when it has no storage buffers.
+    pub fn of(device: &wgpu::Device) -> Profile {
+        if device.limits().max_storage_buffers_per_shader_stage == 0 { Profile::WebGl2 } else { Profile::Standard }
+    }
+
+    /// The file that defines the profile's functions.
+    pub fn wgsl(self) -> (&'static str, &'static str) {
+        match self {
+            Profile::Standard => ("profile/standard.wgsl", include_str!("../shaders/profile/standard.wgsl")),
+            Profile::WebGl2 => ("profile/webgl2.wgsl", include_str!("../shaders/profile/webgl2.wgsl")),
+        }
+    }
+
+    /// The view dimension a binding declared as `dimension` has on this profile: a cube array is
+    /// a 2D array on WebGL2 (the WGSL's `CubeArray`).
+    pub fn view_dimension(self, dimension: wgpu::TextureViewDimension) -> wgpu::TextureViewDimension {
+        match (self, dimension) {
+            (Profile::WebGl2, wgpu::TextureViewDimension::CubeArray) => wgpu::TextureViewDimension::D2Array,
+            (_, dimension) => dimension,
+        }
+    }
+}
 
 /// The shared WGSL, in dependency order.
 pub const COMMON: &[(&str, &str)] = &[
@@ -69,6 +113,8 @@ pub struct Wgsl {
     replaced: Vec<String>,
     /// What is compiled in their place, appended to every module.
     code: String,
+    /// The device profile the text is composed for; [`Wgsl::module`] takes the device's own.
+    profile: Profile,
 }
 
 impl Wgsl {
@@ -79,7 +125,12 @@ impl Wgsl {
 
     /// Mirador's WGSL with the declarations named `replaced` left out and `code` appended.
     pub fn replacing(replaced: Vec<String>, code: String) -> Wgsl {
-        Wgsl { replaced, code }
+        Wgsl { replaced, code, profile: Profile::Standard }
+    }
+
+    /// The same WGSL composed for a device of `profile`.
+    pub fn for_profile(&self, profile: Profile) -> Wgsl {
+        Wgsl { profile, ..self.clone() }
     }
 
     /// Whether this is Mirador's own WGSL.
@@ -135,7 +186,8 @@ impl Wgsl {
 
     fn compose_after<'a>(&self, shared: impl Iterator<Item = &'a (&'a str, &'a str)>, pass: &str) -> String {
         let mut source = String::new();
-        for (name, text) in shared {
+        let (profile, profile_text) = self.profile.wgsl();
+        for (name, text) in std::iter::once((profile, profile_text)).chain(shared.map(|&(name, text)| (name, text))) {
             source.push_str("// ---- ");
             source.push_str(name);
             source.push('\n');
@@ -160,18 +212,19 @@ impl Wgsl {
         text
     }
 
+    /// A pass's module ([`Self::compose`]), for `device`'s profile.
     pub fn module(&self, device: &wgpu::Device, label: &str, pass: &str) -> wgpu::ShaderModule {
         device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(label),
-            source: wgpu::ShaderSource::Wgsl(self.compose(pass).into()),
+            source: wgpu::ShaderSource::Wgsl(self.for_profile(Profile::of(device)).compose(pass).into()),
         })
     }
 
-    /// A surface pass's module ([`Self::compose_surface`]).
+    /// A surface pass's module ([`Self::compose_surface`]), for `device`'s profile.
     pub fn surface_module(&self, device: &wgpu::Device, label: &str, pass: &str) -> wgpu::ShaderModule {
         device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some(label),
-            source: wgpu::ShaderSource::Wgsl(self.compose_surface(pass).into()),
+            source: wgpu::ShaderSource::Wgsl(self.for_profile(Profile::of(device)).compose_surface(pass).into()),
         })
     }
 }

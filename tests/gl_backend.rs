@@ -43,10 +43,13 @@ const TOLERANCE: Tolerance = Tolerance { flip_mean: 0.001, worst_region: 0.01 };
 /// maps off 0.62.
 const BALL_TOLERANCE: f32 = 0.05;
 
-/// The two devices, made once for every test of this binary, after the error log is installed.
+/// The three devices, made once for every test of this binary, after the error log is installed.
 struct Devices {
     vulkan: Gpu,
     gl: Gpu,
+    /// GL with WebGL2's limits and the WebGL2 profile's shaders (`MIRADOR_LIMITS=webgl2`): what
+    /// the page draws with where the browser has no WebGPU.
+    webgl2: Gpu,
 }
 
 fn devices() -> &'static Devices {
@@ -57,7 +60,9 @@ fn devices() -> &'static Devices {
             Gpu::headless_on(backends)
                 .unwrap_or_else(|e| panic!("the GL comparison needs a {backends:?} adapter (see README.md): {e}"))
         };
-        let devices = Devices { vulkan: on(wgpu::Backends::VULKAN), gl: on(wgpu::Backends::GL) };
+        let webgl2 = Gpu::headless_webgl2_on(wgpu::Backends::GL)
+            .unwrap_or_else(|e| panic!("the WebGL2 comparison needs a GL adapter (see README.md): {e}"));
+        let devices = Devices { vulkan: on(wgpu::Backends::VULKAN), gl: on(wgpu::Backends::GL), webgl2 };
         // Mesa's EGL logs a failed driver probe while it looks for llvmpipe: not a rendering error.
         ErrorLog::take();
         devices
@@ -205,4 +210,64 @@ fn screen_refraction_on_gl_matches_vulkan() {
     let (vulkan, gl, errors) = both(&scene, &settings);
     assert_gl_matches("screen refraction", &vulkan, &gl);
     assert_no_errors(&errors);
+}
+
+/// What the WebGL2 profile's image may differ from Vulkan's by, on every scene of
+/// `assets/scenes/` (set from the measurements in [`webgl2_profile_matches_vulkan_on_every_scene`]).
+const WEBGL2_TOLERANCE: Tolerance = Tolerance { flip_mean: 0.001, worst_region: 0.03 };
+
+/// The WebGL2 profile (`shaders/profile/webgl2.wgsl`, issue 36) draws every scene as Vulkan does,
+/// within the two places it may differ: its dynamic cubes are six 2D layers whose lookups do not
+/// filter across a face's edge, and its shadow filters read four comparisons where Vulkan
+/// gathers them (exactly the same texels and weights). Each scene is drawn with its own settings.
+#[test]
+fn webgl2_profile_matches_vulkan_on_every_scene() {
+    assert_eq!(devices().webgl2.profile(), mirador::gpu::Profile::WebGl2);
+    let mut failures = Vec::new();
+    for path in common::scene_files() {
+        let mut scene = mirador::Scene::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let (w, h) = (scene.camera.width, scene.camera.height);
+        (scene.camera.width, scene.camera.height) = (320, (320 * h / w).max(1));
+        let vulkan = mirador::raster::render_image(&devices().vulkan, &scene, &scene.settings);
+        let webgl2 = mirador::raster::render_image(&devices().webgl2, &scene, &scene.settings);
+        let error = GoldenError::between(&vulkan, &webgl2).unwrap_or_else(|e| panic!("{e}"));
+        eprintln!(
+            "{}: WebGL2 profile against Vulkan: mean FLIP {:.5}, worst {REGION}×{REGION} region {:.5}",
+            path.display(),
+            error.flip_mean,
+            error.worst_region
+        );
+        let excesses = error.excesses(WEBGL2_TOLERANCE);
+        if !excesses.is_empty() {
+            failures.push(format!("{}: {}", path.display(), excesses.join("; ")));
+        }
+    }
+    assert_no_errors(&ErrorLog::take());
+    assert!(failures.is_empty(), "the WebGL2 profile differs from Vulkan:\n{}", failures.join("\n"));
+}
+
+/// Every shadow filter on the WebGL2 profile: the tent filters' four lookups at texel centres
+/// give what the gather gives, and the red ball's dynamic cube is read, not missed.
+#[test]
+fn webgl2_profile_shadow_filters_and_cubes_match_vulkan() {
+    use mirador::settings::ShadowFilter;
+    let mut scene = common::load("scenes/showcase.toml");
+    (scene.camera.width, scene.camera.height) = (480, 270);
+    for filter in [ShadowFilter::None, ShadowFilter::Hardware, ShadowFilter::Pcf3x3, ShadowFilter::Pcf5x5] {
+        let mut settings = scene.settings.clone();
+        settings.shadows.filter = filter;
+        let vulkan = mirador::raster::render_image(&devices().vulkan, &scene, &settings);
+        let webgl2 = mirador::raster::render_image(&devices().webgl2, &scene, &settings);
+        let error = GoldenError::between(&vulkan, &webgl2).unwrap_or_else(|e| panic!("{e}"));
+        eprintln!("{filter:?}: mean FLIP {:.5}, worst region {:.5}", error.flip_mean, error.worst_region);
+        let excesses = error.excesses(TOLERANCE);
+        assert!(excesses.is_empty(), "{filter:?} on the WebGL2 profile: {}", excesses.join("; "));
+    }
+    let ball = inside_sphere(&scene, "shiny sphere");
+    let vulkan = mirador::raster::render_image(&devices().vulkan, &scene, &scene.settings);
+    let webgl2 = mirador::raster::render_image(&devices().webgl2, &scene, &scene.settings);
+    let error = common::flip(&crop(&vulkan, ball), &crop(&webgl2, ball));
+    eprintln!("the ball {ball:?}: WebGL2 profile against Vulkan {error:.5}");
+    assert!(error <= BALL_TOLERANCE, "the WebGL2 profile's ball differs by mean FLIP {error:.5}");
+    assert_no_errors(&ErrorLog::take());
 }

@@ -6,24 +6,9 @@
 
 mod common;
 
-use std::path::PathBuf;
 
 use mirador::Scene;
 use mirador::settings::RenderSettings;
-
-/// Every scene under `assets/scenes/` and `assets/scenes/course/`.
-fn scene_files() -> Vec<PathBuf> {
-    let mut files = Vec::new();
-    for folder in ["scenes", "scenes/course"] {
-        let folder = common::asset(folder);
-        let entries = std::fs::read_dir(&folder).unwrap_or_else(|e| panic!("{}: {e}", folder.display()));
-        files.extend(
-            entries.map(|e| e.expect("a folder entry").path()).filter(|p| p.extension().is_some_and(|x| x == "toml")),
-        );
-    }
-    files.sort();
-    files
-}
 
 /// `scene` drawn at most `width` pixels wide, its aspect kept.
 fn smaller(mut scene: Scene, width: u32) -> Scene {
@@ -45,7 +30,7 @@ fn every_term_traced(settings: &RenderSettings) -> RenderSettings {
 #[test]
 fn every_scene_with_every_term_traced_is_the_tracers_image() {
     let mut report = Vec::new();
-    for path in scene_files() {
+    for path in common::scene_files() {
         let scene = smaller(Scene::load(&path).unwrap_or_else(|e| panic!("{e}")), 240);
         let traced = mirador::trace::render_image(&scene, &scene.settings);
         let hybrid = common::flip(&traced, &common::raster(&scene, &every_term_traced(&scene.settings)));

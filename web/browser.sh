@@ -13,13 +13,17 @@ serve_page() {
     sleep 1
 }
 
-# open_page WORK PORT: opens the served page's `index.html?test` (web/test.js drives it), its
-# console in WORK/browser.log, and waits up to 600 s for it to post `done` or `failed`. Sets
-# `browser`, and closes it before returning.
+# open_page WORK PORT [webgl2]: opens the served page's `index.html?test` (web/test.js drives it),
+# its console in WORK/browser.log, and waits up to 600 s for it to post `done` or `failed`. By
+# default Chromium has WebGPU on SwiftShader; with `webgl2` it has no WebGPU (as on most Linux
+# machines: `navigator.gpu` is there and gives no adapter) and WebGL2 on SwiftShader, so the page
+# falls back to WebGL2 on its own. Sets `browser`, and closes it before returning.
 open_page() {
+    local gpu=(--enable-unsafe-webgpu --enable-features=Vulkan --use-angle=vulkan --use-vulkan=swiftshader
+        --disable-vulkan-surface)
+    [ "${3:-}" = webgl2 ] && gpu=(--use-angle=swiftshader)
     xvfb-run -a -s "-screen 0 1280x900x24" chromium --no-sandbox --no-first-run --window-size=1280,800 \
-        --user-data-dir="$1/profile" --enable-unsafe-webgpu --enable-features=Vulkan --use-angle=vulkan \
-        --use-vulkan=swiftshader --disable-vulkan-surface --enable-logging=stderr --v=0 \
+        --user-data-dir="$1/profile" "${gpu[@]}" --enable-logging=stderr --v=0 \
         "http://127.0.0.1:$2/course/mirador/index.html?test" 2>"$1/browser.log" &
     browser=$!
     for _ in $(seq 600); do

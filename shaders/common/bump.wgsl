@@ -21,7 +21,7 @@ const MIP_LEVEL_PALETTE = array<vec3f, 8>(
 
 // The level-colour view: the palette blended between levels floor(lod) and floor(lod) + 1, as
 // trilinear filtering blends texels. Clamp lod to the texture's last level first
-// (f32(textureNumLevels(t) - 1u)) to show the level actually read.
+// (f32(texture_level_count(t) - 1u)) to show the level actually read.
 fn mip_level_colour(lod: f32) -> vec3f {
     let l = clamp(lod, 0.0, f32(MIP_PALETTE_LAST));
     let lo = floor(l);
@@ -60,7 +60,7 @@ fn bilinear_level(t: texture_2d<f32>, uv: vec2f, level: i32) -> vec4f {
 // ⌊lod⌋ + 1, blended by lod's fraction. What the sampler does when a lab routes the colour
 // texture through this function (TRILINEAR_BY_HAND in surface.wgsl).
 fn trilinear_sample(t: texture_2d<f32>, uv: vec2f, lod: f32) -> vec4f {
-    let last = f32(textureNumLevels(t) - 1u);
+    let last = f32(texture_level_count(t) - 1u);
     let l = clamp(lod, 0.0, last);
     let lo = floor(l);
     let hi = min(lo + 1.0, last);

@@ -136,7 +136,7 @@ fn shadow_filtered(
 }
 
 // (2r+1)² bilinear comparison taps one texel apart around uv, as one separable kernel over
-// (2r+2)² texels, gathered 2×2 texels at a time (textureGatherCompare's components are the
+// (2r+2)² texels, gathered 2×2 texels at a time (gather_compare's components are the
 // texels (0, 1), (1, 1), (1, 0), (0, 0) of its footprint); texels outside the map repeat its
 // edge (the sampler clamps to edge).
 fn shadow_tent(map: texture_depth_2d_array, cmp: sampler_comparison, uv: vec2f, depth: f32, layer: u32, map_size: u32, r: i32) -> f32 {
@@ -151,7 +151,7 @@ fn shadow_tent(map: texture_depth_2d_array, cmp: sampler_comparison, uv: vec2f, 
         for (var bx = 0; bx < r + 1; bx++) {
             // The corner shared by the block's four texels.
             let corner = (first + vec2f(f32(2 * bx + 1), f32(2 * by + 1))) / size;
-            let g = textureGatherCompare(map, cmp, corner, layer, depth);
+            let g = gather_compare(map, cmp, corner, layer, depth);
             let i = 2 * bx;
             let j = 2 * by;
             let wx0 = select(select(1.0, f.x, i == n - 1), 1.0 - f.x, i == 0);

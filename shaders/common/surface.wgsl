@@ -242,7 +242,7 @@ fn surface_color(uv: vec2f, duv_dx: vec2f, duv_dy: vec2f) -> vec3f {
     if LEVEL_COLOUR {
         let size = vec2f(textureDimensions(color_texture));
         let lod = mip_lod(duv_dx, duv_dy, size, frame.lod_bias);
-        return mip_level_colour(clamp(lod, 0.0, f32(textureNumLevels(color_texture) - 1u)));
+        return mip_level_colour(clamp(lod, 0.0, f32(texture_level_count(color_texture) - 1u)));
     }
     return material.color * textureSampleBias(color_texture, color_sampler, uv, frame.lod_bias).rgb;
 }
@@ -444,7 +444,7 @@ fn environment_lookup(p: vec3f, d: vec3f, layer: i32) -> vec3f {
         return textureSampleGrad(env_latlong, env_sampler, uv, latlong_gradient(dpdx(uv)), latlong_gradient(dpdy(uv))).rgb;
     }
     if ENVIRONMENT == ENV_MAP_DYNAMIC && layer >= 0 {
-        return textureSampleGrad(env_cubes, env_sampler, lookup, layer, dx, dy).rgb;
+        return cube_array_sample_grad(env_cubes, env_sampler, lookup, layer, dx, dy).rgb;
     }
     return textureSampleGrad(env_cube, env_sampler, d, dx, dy).rgb;
 }

@@ -21,7 +21,7 @@ pub mod text;
 use glam::{Vec2, Vec3};
 use serde::Serialize;
 
-use crate::gpu::Gpu;
+use crate::gpu::{Gpu, Profile};
 use crate::gpu::texture::GpuTexture;
 pub use crate::raster::environment::EnvironmentLookup;
 use crate::raster::frame::{FrameFacts, record_kinds};
@@ -175,7 +175,8 @@ pub enum ExplainError {
     #[error("pixel ({0}, {1}) lies outside the {2}×{3} image")]
     Outside(u32, u32, u32, u32),
     #[error(
-        "this device cannot inspect pixels: it lacks storage buffers written by fragment shaders (try the Vulkan backend)"
+        "this device cannot inspect pixels: it lacks storage buffers written by fragment shaders, as WebGL2 does \
+         (try the Vulkan backend, or WebGPU in the page)"
     )]
     Unsupported,
     #[error("reading the inspection back failed")]
@@ -217,7 +218,7 @@ impl<'s> Explainer<'s> {
         wgsl: Wgsl,
     ) -> Result<Explainer<'s>, ExplainError> {
         let flags = gpu.adapter.get_downlevel_capabilities().flags;
-        if !flags.contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE) {
+        if !flags.contains(wgpu::DownlevelFlags::FRAGMENT_WRITABLE_STORAGE) || gpu.profile() == Profile::WebGl2 {
             return Err(ExplainError::Unsupported);
         }
         let mut settings = settings.clone();

@@ -96,7 +96,11 @@ impl FaceCopy {
             label: Some("mipmap::face_layout"),
             entries: &[
                 layout::sampler(1, wgpu::SamplerBindingType::NonFiltering),
-                layout::texture(binding, wgpu::TextureSampleType::Float { filterable: false }, dimension),
+                layout::texture(
+                    binding,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    shaders::Profile::of(device).view_dimension(dimension),
+                ),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -197,7 +201,7 @@ impl MipmapGenerator {
         if levels <= 1 || layers.is_empty() {
             return;
         }
-        let face_copy = self.face_copy(texture);
+        let face_copy = self.face_copy(texture, shaders::Profile::of(device));
         let pipeline = self.pipeline(device, texture.format());
         let scratch = scratch_chain(device, texture);
         let face = face_copy.map(|copy| self.face_source(device, texture, copy));
@@ -229,7 +233,7 @@ impl MipmapGenerator {
 
     /// The face copy a cube or cube array's levels start from (`None` for a 2D image), once
     /// `texture` is known to be one the generator handles.
-    fn face_copy(&self, texture: &wgpu::Texture) -> Option<&FaceCopy> {
+    fn face_copy(&self, texture: &wgpu::Texture, profile: shaders::Profile) -> Option<&FaceCopy> {
         assert!(
             texture.dimension() == wgpu::TextureDimension::D2 && texture.sample_count() == 1,
             "mipmaps are generated for single-sample 2D textures"
@@ -238,7 +242,7 @@ impl MipmapGenerator {
             texture.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT),
             "a texture needs TEXTURE_BINDING | RENDER_ATTACHMENT usage to have its mipmaps generated"
         );
-        match Layers::of(texture) {
+        match Layers::of(texture, profile) {
             Layers::Single => None,
             Layers::Cube => Some(&self.face_of_cube),
             Layers::Cubes(_) => Some(&self.face_of_cubes),
@@ -261,7 +265,10 @@ impl MipmapGenerator {
         });
         let cube = texture.create_view(&wgpu::TextureViewDescriptor {
             label: Some("mipmap::face_source"),
-            dimension: Some(Layers::of(texture).view_dimension()),
+            dimension: Some({
+                let profile = shaders::Profile::of(device);
+                Layers::of(texture, profile).view_dimension(profile)
+            }),
             base_mip_level: 0,
             mip_level_count: Some(1),
             ..Default::default()

@@ -9,6 +9,8 @@ pub mod texture;
 pub mod uniform;
 
 use std::sync::Arc;
+
+pub use crate::shaders::Profile;
 use web_time::Instant;
 
 /// A wgpu device and the instance and adapter it came from.
@@ -29,13 +31,7 @@ pub enum GpuError {
     NoAdapter { tried: String },
     #[error("the {adapter} adapter refused to create a device: {source}")]
     Device { adapter: String, source: wgpu::RequestDeviceError },
-    #[error(
-        "the {adapter} adapter cannot sample arrays of cube maps (wgpu's DownlevelFlags::CUBE_ARRAY_TEXTURES; \
-         WebGL2 and OpenGL ES without EXT_texture_cube_map_array lack them), and the dynamic environment \
-         cubes of the rasterizer are one"
-    )]
-    NoCubeArrays { adapter: String },
-    #[error("MIRADOR_LIMITS={0}: unknown value; `downlevel` is the only one")]
+    #[error("MIRADOR_LIMITS={0}: unknown value; `downlevel` and `webgl2` are the ones there are")]
     UnknownLimits(String),
     #[error(
         "a {width}×{height} image does not fit this device ({adapter}): its max_texture_dimension_2d \
@@ -59,11 +55,25 @@ impl Gpu {
         Gpu::first_headless(vec![backends])
     }
 
+    /// [`Gpu::headless_on`] with a device of the WebGL2 profile whatever the adapter offers, as
+    /// `MIRADOR_LIMITS=webgl2` makes: how one process compares the profiles (`tests/gl_backend.rs`).
+    pub fn headless_webgl2_on(backends: wgpu::Backends) -> Result<Gpu, GpuError> {
+        let (instance, adapter) = pollster::block_on(Gpu::first_adapter(
+            vec![backends],
+            wgpu::InstanceDescriptor::new_without_display_handle,
+            |_| Some(()),
+            |instance, adapter| async move { Ok((instance, adapter)) },
+        ))?
+        .0;
+        pollster::block_on(Gpu::with_limits(instance, adapter, Some(Limits::WebGl2)))
+    }
+
     fn first_headless(order: Vec<wgpu::Backends>) -> Result<Gpu, GpuError> {
         let (gpu, ()) = pollster::block_on(Gpu::first_adapter(
             order,
             wgpu::InstanceDescriptor::new_without_display_handle,
             |_| Some(()),
+            Gpu::with_adapter_async,
         ))?;
         Ok(gpu)
     }
@@ -84,6 +94,18 @@ impl Gpu {
     where
         W: wgpu::rwh::HasWindowHandle + wgpu::rwh::HasDisplayHandle + std::fmt::Debug + Send + Sync + 'static,
     {
+        Gpu::for_window_on(window, backend_order()).await
+    }
+
+    /// [`Gpu::for_window_async`] on the backends of `order`, tried in turn (the page's
+    /// `?webgl2` asks for WebGL2 alone).
+    pub async fn for_window_on<W>(
+        window: Arc<W>,
+        order: Vec<wgpu::Backends>,
+    ) -> Result<(Gpu, wgpu::Surface<'static>), GpuError>
+    where
+        W: wgpu::rwh::HasWindowHandle + wgpu::rwh::HasDisplayHandle + std::fmt::Debug + Send + Sync + 'static,
+    {
         let descriptor = || wgpu::InstanceDescriptor::new_with_display_handle(Box::new(window.clone()));
         let attach = |instance: &wgpu::Instance| match instance.create_surface(window.clone()) {
             Ok(surface) => Some(surface),
@@ -92,26 +114,33 @@ impl Gpu {
                 None
             }
         };
-        Gpu::first_adapter(backend_order(), descriptor, attach).await
+        Gpu::first_adapter(order, descriptor, attach, Gpu::with_adapter_async).await
     }
 
     /// Tries the backends of `order` in turn; for each, `attach` may make something the adapter
     /// must be compatible with (a window's surface), and the first adapter found wins.
-    async fn first_adapter<T: SurfaceLike>(
+    async fn first_adapter<T: SurfaceLike, D, F: Future<Output = Result<D, GpuError>>>(
         order: Vec<wgpu::Backends>,
         descriptor: impl Fn() -> wgpu::InstanceDescriptor,
         attach: impl Fn(&wgpu::Instance) -> Option<T>,
-    ) -> Result<(Gpu, T), GpuError> {
+        device: impl Fn(wgpu::Instance, wgpu::Adapter) -> F,
+    ) -> Result<(D, T), GpuError> {
         let mut tried = Vec::new();
         for backends in order {
             let mut d = descriptor().with_env();
             d.backends = backends;
+            // In the browser, WebGPU is offered only where it gives an adapter (Chrome on Linux
+            // has `navigator.gpu` and none), and WebGL2 otherwise: a canvas takes one kind of
+            // context, so the choice is made before its surface is.
+            #[cfg(target_arch = "wasm32")]
+            let instance = wgpu::util::new_instance_with_webgpu_detection(d).await;
+            #[cfg(not(target_arch = "wasm32"))]
             let instance = wgpu::Instance::new(d);
             tried.push(format!("{backends:?}"));
             let Some(attached) = attach(&instance) else { continue };
             let options = wgpu::RequestAdapterOptions { compatible_surface: attached.surface(), ..Default::default() };
             match instance.request_adapter(&options).await {
-                Ok(adapter) => return Ok((Gpu::with_adapter_async(instance, adapter).await?, attached)),
+                Ok(adapter) => return Ok((device(instance, adapter).await?, attached)),
                 Err(e) => log::info!("no {backends:?} adapter: {e}"),
             }
         }
@@ -121,25 +150,42 @@ impl Gpu {
     /// A device for `adapter`, asking only for what every backend Mirador supports can give,
     /// and for the adapter's largest textures. `MIRADOR_LIMITS=downlevel` leaves the texture size
     /// at wgpu's downlevel default (2048 pixels a side), to try Mirador as a small device runs it.
-    /// An adapter without cube-map arrays is refused here, with the reason, rather than by a
-    /// validation error when the first frame binds its environment maps: desktop GL and Vulkan
-    /// have them, WebGL2 does not.
+    ///
+    /// An adapter without cube-map arrays (WebGL2, OpenGL ES 3.0) gets a device of the WebGL2
+    /// profile ([`Profile`]): wgpu's WebGL2 limits, and shaders that do without what it lacks.
+    /// `MIRADOR_LIMITS=webgl2` makes such a device on any adapter, to run those paths natively.
     pub fn with_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, GpuError> {
         pollster::block_on(Gpu::with_adapter_async(instance, adapter))
     }
 
     /// [`Gpu::with_adapter`] as a future.
     pub async fn with_adapter_async(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Gpu, GpuError> {
+        let asked = match std::env::var("MIRADOR_LIMITS") {
+            Ok(value) if value == "downlevel" => Some(Limits::Downlevel),
+            Ok(value) if value == "webgl2" => Some(Limits::WebGl2),
+            Ok(value) => return Err(GpuError::UnknownLimits(value)),
+            Err(_) => None,
+        };
+        Gpu::with_limits(instance, adapter, asked).await
+    }
+
+    /// The device of [`Gpu::with_adapter`], with the limits `asked` for (else the adapter's
+    /// resolution).
+    async fn with_limits(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        asked: Option<Limits>,
+    ) -> Result<Gpu, GpuError> {
         let info = adapter.get_info();
         log::info!("adapter: {} ({:?})", info.name, info.backend);
-        if !adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::CUBE_ARRAY_TEXTURES) {
-            return Err(GpuError::NoCubeArrays { adapter: info.name });
-        }
-        let required_limits = match std::env::var("MIRADOR_LIMITS") {
-            Ok(value) if value == "downlevel" => wgpu::Limits::downlevel_defaults(),
-            Ok(value) => return Err(GpuError::UnknownLimits(value)),
-            Err(_) => wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+        let cube_arrays = adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::CUBE_ARRAY_TEXTURES);
+        let webgl2 = !cube_arrays || asked == Some(Limits::WebGl2);
+        let base = if webgl2 { wgpu::Limits::downlevel_webgl2_defaults() } else { wgpu::Limits::downlevel_defaults() };
+        let required_limits = match asked {
+            Some(Limits::Downlevel) => base,
+            _ => base.using_resolution(adapter.limits()),
         };
+        log::info!("shader profile: {}", if webgl2 { "WebGL2" } else { "standard" });
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("mirador::device"),
@@ -156,14 +202,25 @@ impl Gpu {
         Ok(Gpu { instance, adapter, device, queue })
     }
 
+    /// What this device's shaders may use.
+    pub fn profile(&self) -> Profile {
+        Profile::of(&self.device)
+    }
+
     /// "name (backend)", for logs and `--stats`.
     pub fn describe(&self) -> String {
         let info = self.adapter.get_info();
         format!("{} ({:?})", info.name, info.backend)
     }
 
-    /// Blocks until the queue has finished everything submitted so far.
+    /// Blocks until the queue has finished everything submitted so far. The browser's page
+    /// cannot block: there it only lets finished work report (WebGL2 answers a wait with a
+    /// timeout), and what waits on the GPU is answered a frame or two later
+    /// ([`readback::Pending`]).
     pub fn wait(&self) {
+        #[cfg(target_arch = "wasm32")]
+        let _ = self.device.poll(wgpu::PollType::Poll);
+        #[cfg(not(target_arch = "wasm32"))]
         self.device.poll(wgpu::PollType::wait_indefinitely()).expect("polling the device for completion");
     }
 
@@ -233,10 +290,20 @@ fn seamless_cubes_on_desktop_gl(device: &wgpu::Device) {
     }
 }
 
-/// The backends to try, in order: the ones `WGPU_BACKEND` names, else Vulkan, then GL.
+/// The limits `MIRADOR_LIMITS` asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Limits {
+    /// wgpu's downlevel defaults as they are (textures of 2048 pixels a side).
+    Downlevel,
+    /// A device of the WebGL2 profile, with the adapter's resolution.
+    WebGl2,
+}
+
+/// The backends to try, in order: the ones `WGPU_BACKEND` names, else Vulkan, then GL; in the
+/// browser, WebGPU where it has an adapter, else WebGL2.
 fn backend_order() -> Vec<wgpu::Backends> {
     if cfg!(target_arch = "wasm32") {
-        return vec![wgpu::Backends::BROWSER_WEBGPU];
+        return vec![wgpu::Backends::BROWSER_WEBGPU | wgpu::Backends::GL];
     }
     match wgpu::Backends::from_env() {
         Some(chosen) => vec![chosen],

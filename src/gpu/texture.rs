@@ -1,5 +1,7 @@
 //! Textures: render targets, sampled images, and layered textures ([`Layers`]).
 
+use crate::shaders::Profile;
+
 /// A texture with the default view of all its levels.
 pub struct GpuTexture {
     pub texture: wgpu::Texture,
@@ -120,6 +122,11 @@ impl GpuTexture {
 /// Anything else reads black, with an error in the log. So every layered texture is made by
 /// [`Layers::texture`], which pads the layer count until GL's rule gives the kind asked for,
 /// and sampled through the view it returns.
+///
+/// On a device of the WebGL2 profile ([`Profile`]), which has no cube-map arrays, cubes are
+/// made as a 2D array instead: cube k's face f is layer 6k + f, with one padding layer at the
+/// end so that GL does not make a cube array of it, and the WGSL picks the face
+/// (`shaders/profile/webgl2.wgsl`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Layers {
     /// One image: `D2` views.
@@ -128,8 +135,8 @@ pub enum Layers {
     Array(u32),
     /// One cube: six square faces, sampled through a `Cube` view.
     Cube,
-    /// `n` cubes, sampled through a `CubeArray` view (a device needs
-    /// `DownlevelFlags::CUBE_ARRAY_TEXTURES`, which [`super::Gpu::with_adapter`] checks).
+    /// `n` cubes, sampled through a `CubeArray` view, or a `D2Array` view of `6n + 1` layers on
+    /// the WebGL2 profile.
     Cubes(u32),
 }
 
@@ -139,7 +146,7 @@ impl Layers {
     /// square and a multiple of 6 (six shadow-map layers of one point light would make a cube);
     /// a cube array at least two cubes (one would make a `CUBE_MAP`). The padding layers are
     /// never drawn into nor read.
-    pub fn count(self, (width, height): (u32, u32)) -> u32 {
+    pub fn count(self, (width, height): (u32, u32), profile: Profile) -> u32 {
         match self {
             Layers::Single => 1,
             Layers::Array(n) => {
@@ -147,32 +154,37 @@ impl Layers {
                 if width == height && n.is_multiple_of(6) { n + 1 } else { n }
             }
             Layers::Cube => 6,
+            Layers::Cubes(n) if profile == Profile::WebGl2 => 6 * n.max(1) + 1,
             Layers::Cubes(n) => 6 * n.max(2),
         }
     }
 
     /// The view dimension the texture is sampled through.
-    pub fn view_dimension(self) -> wgpu::TextureViewDimension {
-        match self {
+    pub fn view_dimension(self, profile: Profile) -> wgpu::TextureViewDimension {
+        let declared = match self {
             Layers::Single => wgpu::TextureViewDimension::D2,
             Layers::Array(_) => wgpu::TextureViewDimension::D2Array,
             Layers::Cube => wgpu::TextureViewDimension::Cube,
             Layers::Cubes(_) => wgpu::TextureViewDimension::CubeArray,
-        }
+        };
+        profile.view_dimension(declared)
     }
 
     /// What a 2D texture's layers are, read back from its size by GL's rule: what a texture made
     /// by [`Layers::texture`] was made as (a padded count reads as the padded number).
-    pub fn of(texture: &wgpu::Texture) -> Layers {
-        Layers::by_gl_rule(texture.depth_or_array_layers(), texture.width() == texture.height())
+    /// On the WebGL2 profile, a square texture of `6n + 1` layers reads as `n` cubes, as
+    /// [`Layers::count`] makes them; no array made there has that count and is read back.
+    pub fn of(texture: &wgpu::Texture, profile: Profile) -> Layers {
+        Layers::by_gl_rule(texture.depth_or_array_layers(), texture.width() == texture.height(), profile)
     }
 
     /// wgpu-hal's `get_info_from_desc`: the kind GL makes of `count` layers, square or not.
-    fn by_gl_rule(count: u32, square: bool) -> Layers {
+    fn by_gl_rule(count: u32, square: bool, profile: Profile) -> Layers {
         match count {
             1 => Layers::Single,
             6 if square => Layers::Cube,
             n if square && n.is_multiple_of(6) => Layers::Cubes(n / 6),
+            n if square && profile == Profile::WebGl2 && n > 6 && n % 6 == 1 => Layers::Cubes(n / 6),
             n => Layers::Array(n),
         }
     }
@@ -184,12 +196,17 @@ impl Layers {
         let (width, height) = (descriptor.size.width, descriptor.size.height);
         assert!(descriptor.dimension == wgpu::TextureDimension::D2, "layers are those of a 2D texture");
         assert!(width == height || !matches!(self, Layers::Cube | Layers::Cubes(_)), "a cube's faces are square");
-        let size = wgpu::Extent3d { depth_or_array_layers: self.count((width, height)), ..descriptor.size };
+        let profile = Profile::of(device);
+        let size = wgpu::Extent3d { depth_or_array_layers: self.count((width, height), profile), ..descriptor.size };
         let texture = device.create_texture(&wgpu::TextureDescriptor { size, ..descriptor.clone() });
-        debug_assert_eq!(Layers::of(&texture).view_dimension(), self.view_dimension(), "GL's rule reads it back");
+        debug_assert_eq!(
+            Layers::of(&texture, profile).view_dimension(profile),
+            self.view_dimension(profile),
+            "GL's rule reads it back"
+        );
         let view = texture.create_view(&wgpu::TextureViewDescriptor {
             label: descriptor.label,
-            dimension: Some(self.view_dimension()),
+            dimension: Some(self.view_dimension(profile)),
             ..Default::default()
         });
         GpuTexture { texture, view }
@@ -198,9 +215,10 @@ impl Layers {
 
 #[cfg(test)]
 mod tests {
-    use super::Layers;
+    use super::{Layers, Profile};
 
-    /// Every kind keeps its kind under GL's rule, however many it holds.
+    /// Every kind keeps its kind under GL's rule, however many it holds; on the WebGL2 profile,
+    /// GL makes a 2D array of the cubes, and they read back as cubes.
     #[test]
     fn padded_counts_read_back_as_the_kind_asked_for() {
         let kind = |layers: Layers| std::mem::discriminant(&layers);
@@ -208,16 +226,20 @@ mod tests {
             for (layers, size) in
                 [(Layers::Array(n), (64, 64)), (Layers::Array(n), (64, 32)), (Layers::Cubes(n), (8, 8))]
             {
-                let count = layers.count(size);
+                let count = layers.count(size, Profile::Standard);
                 let held = if matches!(layers, Layers::Cubes(_)) { 6 * n } else { n };
                 assert!(count >= held, "{layers:?}: {count} layers");
-                let read = Layers::by_gl_rule(count, size.0 == size.1);
+                let read = Layers::by_gl_rule(count, size.0 == size.1, Profile::Standard);
                 assert_eq!(kind(read), kind(layers), "{layers:?} of {size:?}: {count} layers");
             }
+            let count = Layers::Cubes(n).count((8, 8), Profile::WebGl2);
+            assert!(count >= 6 * n && !count.is_multiple_of(6), "a 2D array to GL: {count} layers");
+            assert_eq!(Layers::by_gl_rule(count, true, Profile::WebGl2), Layers::Cubes(n));
         }
-        assert_eq!(Layers::Array(6).count((512, 512)), 7, "one point light's six layers");
-        assert_eq!(Layers::Array(1).count((512, 512)), 2);
-        assert_eq!(Layers::Cubes(1).count((16, 16)), 12);
-        assert_eq!(Layers::Cube.count((16, 16)), 6);
+        assert_eq!(Layers::Array(6).count((512, 512), Profile::Standard), 7, "one point light's six layers");
+        assert_eq!(Layers::Array(1).count((512, 512), Profile::Standard), 2);
+        assert_eq!(Layers::Cubes(1).count((16, 16), Profile::Standard), 12);
+        assert_eq!(Layers::Cubes(1).count((16, 16), Profile::WebGl2), 7);
+        assert_eq!(Layers::Cube.count((16, 16), Profile::Standard), 6);
     }
 }

@@ -152,13 +152,21 @@ pub const VIEW_GROUP: &[ViewBinding] = {
 
 /// The view group's layout; `inspect` adds the inspection's bindings.
 pub fn layout(device: &wgpu::Device, inspect: bool) -> wgpu::BindGroupLayout {
+    let profile = crate::shaders::Profile::of(device);
     let entries: Vec<wgpu::BindGroupLayoutEntry> = VIEW_GROUP
         .iter()
         .filter(|b| inspect || !b.resource.inspect_only())
         .map(|b| wgpu::BindGroupLayoutEntry {
             binding: b.binding,
             visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: b.ty,
+            ty: match b.ty {
+                wgpu::BindingType::Texture { sample_type, view_dimension, multisampled } => wgpu::BindingType::Texture {
+                    sample_type,
+                    view_dimension: profile.view_dimension(view_dimension),
+                    multisampled,
+                },
+                ty => ty,
+            },
             count: None,
         })
         .collect();

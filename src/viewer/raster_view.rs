@@ -21,11 +21,12 @@ use std::time::Duration;
 use web_time::Instant;
 
 use super::screen::{Composition, PendingImage, Screen};
+use super::upscale::Reencode;
 use crate::gpu::Gpu;
 use crate::gpu::texture::GpuTexture;
 use crate::raster::{FrameReport, FrameTargets, Renderer, drawn_size};
 use crate::scene::{Camera, Light};
-use crate::shaders::Wgsl;
+use crate::shaders::{Profile, Wgsl};
 use crate::{RenderSettings, Scene};
 
 /// The format egui samples the image from ([`Composition::Textured`]).
@@ -53,6 +54,8 @@ pub struct RasterView {
     pub report: FrameReport,
     /// The image on its way back to the CPU ([`RasterView::read_back`]).
     readback: Option<PendingImage>,
+    /// Draws the image into the one egui shows where a copy cannot (the WebGL2 profile).
+    reencode: Option<Reencode>,
     /// The stride the hybrid's traced terms of the image shown were traced at (1: every pixel):
     /// a new image's are traced coarse, and refined frame by frame while its inputs stay.
     traced_stride: u32,
@@ -115,6 +118,8 @@ impl RasterView {
             readback: None,
             bound: None,
             report: FrameReport::default(),
+            reencode: (screen.composition == Composition::Textured && gpu.profile() == Profile::WebGl2)
+                .then(|| Reencode::new(&gpu.device, DISPLAY_FORMAT)),
             traced_stride: 1,
         }
     }
@@ -174,15 +179,18 @@ impl RasterView {
         self.renderer.profile = profile;
         self.renderer.traced_stride = self.traced_stride;
         self.report = self.renderer.render(gpu, scene, settings, &mut frame.targets, &frame.image.view);
-        if let Some((display, _)) = &frame.display {
+        if let Some((display, display_view)) = &frame.display {
             let mut encoder = gpu
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer::raster::copy") });
-            encoder.copy_texture_to_texture(
-                frame.image.texture.as_image_copy(),
-                display.as_image_copy(),
-                frame.image.texture.size(),
-            );
+            match &self.reencode {
+                Some(reencode) => reencode.record(&gpu.device, &mut encoder, &frame.image.view, display_view),
+                None => encoder.copy_texture_to_texture(
+                    frame.image.texture.as_image_copy(),
+                    display.as_image_copy(),
+                    frame.image.texture.size(),
+                ),
+            }
             gpu.queue.submit([encoder.finish()]);
         }
         gpu.wait();
@@ -269,7 +277,7 @@ fn display_texture(device: &wgpu::Device, size: (u32, u32)) -> wgpu::Texture {
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
         format: DISPLAY_FORMAT,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::RENDER_ATTACHMENT,
         view_formats: &[],
     })
 }

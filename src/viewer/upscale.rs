@@ -26,27 +26,7 @@ impl Upscale {
     /// A pass writing targets of `format`, which must be a plain (not sRGB) format, like the
     /// image views it reads: the bytes move unchanged.
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Upscale {
-        let module = crate::shaders::module(device, "upscale::shader", crate::shaders::UPSCALE);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("upscale::bind_group_layout"),
-            entries: &[
-                layout::texture(0, wgpu::TextureSampleType::Float { filterable: true }, wgpu::TextureViewDimension::D2),
-                layout::sampler(1, wgpu::SamplerBindingType::Filtering),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("upscale::layout"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = layout::fullscreen_pipeline(
-            device,
-            "upscale::pipeline",
-            &pipeline_layout,
-            &module,
-            ("vs_upscale", "fs_upscale"),
-            &[Some(format.into())],
-        );
+        let (pipeline, layout) = image_pipeline(device, "fs_upscale", format);
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("upscale::sampler"),
             mag_filter: wgpu::FilterMode::Linear,
@@ -89,5 +69,79 @@ impl Upscale {
         pass.set_bind_group(0, group, &[]);
         pass.draw(0..3, 0..1);
         pass.pop_debug_group();
+    }
+}
+
+/// The upscale shader's `fragment` writing `format`, and the layout of the image it reads.
+fn image_pipeline(
+    device: &wgpu::Device,
+    fragment: &str,
+    format: wgpu::TextureFormat,
+) -> (wgpu::RenderPipeline, wgpu::BindGroupLayout) {
+    let module = crate::shaders::module(device, "upscale::shader", crate::shaders::UPSCALE);
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("upscale::bind_group_layout"),
+        entries: &[
+            layout::texture(0, wgpu::TextureSampleType::Float { filterable: true }, wgpu::TextureViewDimension::D2),
+            layout::sampler(1, wgpu::SamplerBindingType::Filtering),
+        ],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("upscale::layout"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = layout::fullscreen_pipeline(
+        device,
+        "upscale::pipeline",
+        &pipeline_layout,
+        &module,
+        ("vs_upscale", fragment),
+        &[Some(format.into())],
+    );
+    (pipeline, layout)
+}
+
+/// The 3D view's sRGB image drawn, byte for byte, into the plain texture egui shows, where the
+/// device cannot copy between the two (WebGL2: `glCopyTexSubImage2D` refuses an sRGB source for
+/// a plain target). Elsewhere a copy does it.
+pub struct Reencode {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+}
+
+impl Reencode {
+    /// A pass writing `target_format`, a plain 8-bit format.
+    pub fn new(device: &wgpu::Device, target_format: wgpu::TextureFormat) -> Reencode {
+        let (pipeline, layout) = image_pipeline(device, "fs_reencode", target_format);
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor { label: Some("upscale::reencode"), ..Default::default() });
+        Reencode { pipeline, layout, sampler }
+    }
+
+    /// Draws `image` (an sRGB view) into `target` (a plain view of the same size).
+    pub fn record(
+        &self,
+        device: &wgpu::Device,
+        encoder: &mut wgpu::CommandEncoder,
+        image: &wgpu::TextureView,
+        target: &wgpu::TextureView,
+    ) {
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("upscale::reencode_group"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(image) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+            ],
+        });
+        let mut pass = encoder.begin_render_pass(&layout::pass(
+            "upscale::reencode",
+            &[Some(layout::color_attachment(target, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))],
+            None,
+        ));
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.draw(0..3, 0..1);
     }
 }

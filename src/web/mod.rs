@@ -98,9 +98,8 @@ impl App {
         let (Some(answer), Some(window)) = (answer, self.window.clone()) else { return Ok(()) };
         let (gpu, surface) = answer.map_err(|e| match e {
             GpuError::NoAdapter { .. } => anyhow::anyhow!(
-                "this browser offers no WebGPU adapter. Mirador's page needs WebGPU: Chrome or Edge 113 or newer, \
-                 Firefox 141 or newer on Windows, Safari 26; on Linux, Chrome with \
-                 chrome://flags/#enable-unsafe-webgpu turned on"
+                "this browser offers neither WebGPU nor WebGL2, one of which Mirador's page needs: every \
+                 browser since 2021 has WebGL2 unless it is turned off (chrome://gpu, about:support say)"
             ),
             other => other.into(),
         })?;
@@ -108,7 +107,7 @@ impl App {
         screen.screenshot_sink = Some(Box::new(page::screenshot_taken));
         let scene = self.scene.take().ok_or_else(|| anyhow::anyhow!("the viewer starts once"))?;
         let viewer = Viewer::new(&mut screen, scene, &ViewerConfig::default(), Vec::new(), || {}, None);
-        log::info!("adapter: {}", screen.gpu.describe());
+        log::info!("adapter: {}, {:?} profile", screen.gpu.describe(), screen.gpu.profile());
         screen.window.request_redraw();
         self.running = Some((screen, viewer));
         Ok(())
@@ -161,7 +160,11 @@ impl ApplicationHandler<Wake> for App {
         self.window = Some(window.clone());
         let answer = self.device.clone();
         wasm_bindgen_futures::spawn_local(async move {
-            *answer.borrow_mut() = Some(Gpu::for_window_async(window).await);
+            let device = match page::asks_for_webgl2() {
+                true => Gpu::for_window_on(window, vec![wgpu::Backends::GL]).await,
+                false => Gpu::for_window_async(window).await,
+            };
+            *answer.borrow_mut() = Some(device);
             page::wake(Wake::Device);
         });
     }

@@ -55,6 +55,13 @@ pub fn step(line: &str) -> Result<(), JsError> {
     Ok(())
 }
 
+/// Whether the page's address asks for WebGL2 even where WebGPU is offered (`?webgl2`): how a
+/// teacher sees what students without WebGPU get, and how web/test.sh tries both.
+pub(super) fn asks_for_webgl2() -> bool {
+    let search = web_sys::window().and_then(|w| w.location().search().ok()).unwrap_or_default();
+    search.trim_start_matches('?').split('&').any(|p| p == "webgl2")
+}
+
 /// The built-in scenes' paths, for the page's menu.
 #[wasm_bindgen]
 pub fn builtin_scenes() -> Vec<String> {

@@ -18,6 +18,20 @@ use mirador::gpu::Gpu;
 use mirador::{RenderSettings, Scene};
 
 /// The device every test in this binary shares (device creation dominates small renders).
+/// Every scene under `assets/scenes/` and `assets/scenes/course/`, in order.
+pub fn scene_files() -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for folder in ["scenes", "scenes/course"] {
+        let folder = asset(folder);
+        let entries = std::fs::read_dir(&folder).unwrap_or_else(|e| panic!("{}: {e}", folder.display()));
+        files.extend(
+            entries.map(|e| e.expect("a folder entry").path()).filter(|p| p.extension().is_some_and(|x| x == "toml")),
+        );
+    }
+    files.sort();
+    files
+}
+
 pub fn gpu() -> &'static Gpu {
     static GPU: OnceLock<Gpu> = OnceLock::new();
     GPU.get_or_init(|| {
