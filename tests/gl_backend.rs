@@ -213,8 +213,18 @@ fn screen_refraction_on_gl_matches_vulkan() {
 }
 
 /// What the WebGL2 profile's image may differ from Vulkan's by, on every scene of
-/// `assets/scenes/` (set from the measurements in [`webgl2_profile_matches_vulkan_on_every_scene`]).
-const WEBGL2_TOLERANCE: Tolerance = Tolerance { flip_mean: 0.001, worst_region: 0.03 };
+/// `assets/scenes/` at 320 pixels wide. Measured: the environment stage, whose two objects
+/// reflect their dynamic cubes, differs most, mean FLIP 0.0014 and worst 32×32 region 0.021:
+/// the cube's level of detail is computed by the profile (lavapipe's cube lookups choose theirs
+/// their own way), and over the checkered floor's reflection a level apart shows. Then
+/// environment-ball 0.0005 and 0.018, refraction 0.0004 and 0.012, whitted-depth 0.0003 and
+/// 0.009, the showcase 0.0001 and 0.007; 21 of the 26 scenes 0.0000 and at most 0.006. A cube
+/// read through the wrong face or not at all measured 0.37 and 0.97 on the environment stage
+/// (issue 30's GL bug); ±X directions read from the ±Z layers (tried) measured 0.0096 and 0.20
+/// here and 0.014 and 0.52 on environment-ball: the bound catches both. (Swapping the +X and
+/// −X layers alone changes nothing visible: the mip chains are made through the same table, so
+/// every level past 0 is swapped back, and these objects read their sides past level 0.)
+const WEBGL2_TOLERANCE: Tolerance = Tolerance { flip_mean: 0.003, worst_region: 0.05 };
 
 /// The WebGL2 profile (`shaders/profile/webgl2.wgsl`, issue 36) draws every scene as Vulkan does,
 /// within the two places it may differ: its dynamic cubes are six 2D layers whose lookups do not
