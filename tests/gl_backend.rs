@@ -9,7 +9,11 @@
 //! and logs `GL_INVALID_FRAMEBUFFER_OPERATION`): the torus was missing and the glass showed
 //! nothing behind it, until the copies were drawn instead (`src/gpu/depth_copy.rs`).
 //!
-//! Both devices are made here whatever `WGPU_BACKEND` says ([`Gpu::headless_on`]). A machine
+//! The same GL device with WebGL2's limits draws with the WebGL2 shader profile
+//! (`shaders/profile/webgl2.wgsl`, issue 36): what the page draws with in a browser without
+//! WebGPU. Every scene is compared with Vulkan's image.
+//!
+//! The devices are made here whatever `WGPU_BACKEND` says ([`Gpu::headless_on`]). A machine
 //! without either backend fails these tests with the reason, as every image test of the project
 //! fails without an adapter (`tests/README.md`).
 

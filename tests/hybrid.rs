@@ -6,7 +6,6 @@
 
 mod common;
 
-
 use mirador::Scene;
 use mirador::settings::RenderSettings;
 

@@ -33,13 +33,15 @@ const LATER_BUILTINS: &[&str] = &[
 fn write_as_webgl2(profile: Profile) -> (Vec<String>, Vec<String>) {
     let (mut written, mut failed) = (Vec::new(), Vec::new());
     for (pass, source) in Wgsl::builtin().for_profile(profile).passes() {
-        let module = naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{pass}: {}", e.emit_to_string(&source)));
+        let module =
+            naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{pass}: {}", e.emit_to_string(&source)));
         let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
             .validate(&module)
             .unwrap_or_else(|e| panic!("{pass}: {e:?}"));
         for (index, entry) in module.entry_points.iter().enumerate() {
             let uses_storage = module.global_variables.iter().any(|(handle, var)| {
-                matches!(var.space, naga::AddressSpace::Storage { .. }) && !info.get_entry_point(index)[handle].is_empty()
+                matches!(var.space, naga::AddressSpace::Storage { .. })
+                    && !info.get_entry_point(index)[handle].is_empty()
             });
             if uses_storage {
                 continue;
@@ -57,7 +59,11 @@ fn write_as_webgl2(profile: Profile) -> (Vec<String>, Vec<String>) {
     (written, failed)
 }
 
-fn glsl_es_300(module: &naga::Module, info: &naga::valid::ModuleInfo, entry: &naga::EntryPoint) -> Result<String, String> {
+fn glsl_es_300(
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+    entry: &naga::EntryPoint,
+) -> Result<String, String> {
     let constants = naga::back::PipelineConstants::default();
     let (module, info) =
         naga::back::pipeline_constants::process_overrides(module, info, Some((entry.stage, &entry.name)), &constants)

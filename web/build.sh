@@ -18,7 +18,7 @@ if [ "$(wasm-bindgen --version 2>/dev/null)" != "wasm-bindgen $version" ]; then
     cargo install wasm-bindgen-cli --version "$version"
 fi
 
-cargo rustc --lib --release --locked --target wasm32-unknown-unknown --crate-type cdylib
+cargo rustc --lib --profile web --locked --target wasm32-unknown-unknown --crate-type cdylib
 target_dir=$(cargo metadata --format-version 1 --no-deps | sed 's/.*"target_directory":"\([^"]*\)".*/\1/')
 
 # Built beside the output and moved in at the end: a failed build leaves no half-written page.
@@ -27,7 +27,7 @@ trap 'rm -rf "$staging"' EXIT
 # Without the function names (1 MB; a panic's stack then shows numbers) and the producers section.
 wasm-bindgen --target web --no-typescript --out-name mirador --out-dir "$staging" \
     --remove-name-section --remove-producers-section \
-    "$target_dir/wasm32-unknown-unknown/release/mirador.wasm"
+    "$target_dir/wasm32-unknown-unknown/web/mirador.wasm"
 cp web/index.html web/test.js web/tracer.js "$staging/"
 rm -rf "$out"
 mv "$staging" "$out"

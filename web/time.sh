@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Times the page: `bash web/time.sh [DIST] [RUNS]` loads DIST/index.html?test (default web/dist,
-# built by web/build.sh) RUNS times (default 3) in Chromium with WebGPU on SwiftShader under Xvfb,
+# Times the page: `bash web/time.sh [DIST] [RUNS] [webgl2]` loads DIST/index.html?test (default
+# web/dist, built by web/build.sh) RUNS times (default 3) in Chromium with WebGPU on SwiftShader
+# under Xvfb (with `webgl2`: without WebGPU, so the page draws with WebGL2),
 # each time with a new browser profile (a cold visit: nothing cached), served from localhost
 # under a sub-path. It prints, per run, what the page logs to its console: the first frame's time
 # from the start of the page's load, and the traced showcase's time. Compare two builds by
@@ -9,6 +10,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 dist=${1:-web/dist}
 runs=${2:-3}
+api=${3:-webgpu}
 port=${MIRADOR_WEB_PORT:-8766}
 if [ ! -f "$dist/index.html" ]; then
     echo "$dist/ is not a built page: run bash web/build.sh first" >&2
@@ -22,7 +24,7 @@ command -v chromium >/dev/null && command -v xvfb-run >/dev/null || {
 for run in $(seq "$runs"); do
     work=$(mktemp -d)
     serve_page "$dist" "$work" "$port"
-    open_page "$work" "$port"
+    open_page "$work" "$port" "$api"
     kill "$server" 2>/dev/null || true
     wait "$server" 2>/dev/null || true
     first=$(grep -ao "first frame [0-9]* ms" "$work/browser.log" | head -1 || true)

@@ -6,7 +6,7 @@
 // cube_direction inverts (src/scene/environment.rs, cube_face_uv). What the hardware does for a
 // cube and this does not: filter across a face's edge. Each face is clamped half a texel inside
 // its edge at every level, so a lookup there reads its own face's edge texels where a cube blends
-// the two faces' (docs/course/08-environment-maps.md says where that shows).
+// the two faces' (docs/course/08-environment-maps.md).
 //
 // No textureGather (GLSL ES 3.00 has none): the four comparisons are four lookups, each at a
 // texel's centre, where the comparison sampler's bilinear weights are 1 for that texel alone.

@@ -21,8 +21,8 @@ pub mod text;
 use glam::{Vec2, Vec3};
 use serde::Serialize;
 
-use crate::gpu::{Gpu, Profile};
 use crate::gpu::texture::GpuTexture;
+use crate::gpu::{Gpu, Profile};
 pub use crate::raster::environment::EnvironmentLookup;
 use crate::raster::frame::{FrameFacts, record_kinds};
 use crate::raster::inspect::{GpuInspectFragment, INSPECT_MIRROR, INSPECT_REFRACTION, Part, RasterPixel, RecordKind};

@@ -178,7 +178,8 @@ impl Gpu {
     ) -> Result<Gpu, GpuError> {
         let info = adapter.get_info();
         log::info!("adapter: {} ({:?})", info.name, info.backend);
-        let cube_arrays = adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::CUBE_ARRAY_TEXTURES);
+        let cube_arrays =
+            adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::CUBE_ARRAY_TEXTURES);
         let webgl2 = !cube_arrays || asked == Some(Limits::WebGl2);
         let base = if webgl2 { wgpu::Limits::downlevel_webgl2_defaults() } else { wgpu::Limits::downlevel_defaults() };
         let required_limits = match asked {

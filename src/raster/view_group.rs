@@ -160,11 +160,13 @@ pub fn layout(device: &wgpu::Device, inspect: bool) -> wgpu::BindGroupLayout {
             binding: b.binding,
             visibility: wgpu::ShaderStages::FRAGMENT,
             ty: match b.ty {
-                wgpu::BindingType::Texture { sample_type, view_dimension, multisampled } => wgpu::BindingType::Texture {
-                    sample_type,
-                    view_dimension: profile.view_dimension(view_dimension),
-                    multisampled,
-                },
+                wgpu::BindingType::Texture { sample_type, view_dimension, multisampled } => {
+                    wgpu::BindingType::Texture {
+                        sample_type,
+                        view_dimension: profile.view_dimension(view_dimension),
+                        multisampled,
+                    }
+                }
                 ty => ty,
             },
             count: None,

@@ -121,6 +121,12 @@ pub struct FrameEnd {
     pub next: Option<Instant>,
 }
 
+/// What the viewer says when its device is of the WebGL2 profile (`shaders/profile/webgl2.wgsl`):
+/// what is drawn otherwise, and what cannot run, with why.
+const WEBGL2_NOTICE: &str = "drawn with WebGL2 (no WebGPU here): every technique runs; the dynamic environment \
+     cubes are six 2D layers each, so their lookups do not filter across a face's edge; clicking a pixel \
+     to inspect it needs storage buffers, which WebGL2 lacks (WebGPU or Vulkan have them)";
+
 impl Viewer {
     pub fn new(
         screen: &mut Screen,
@@ -140,6 +146,10 @@ impl Viewer {
             lab.wgsl()
         });
         let raster = RasterView::new(screen, &scene.scene, scene.revision, wgsl);
+        let mut warnings = warnings;
+        if screen.gpu.profile() == crate::shaders::Profile::WebGl2 {
+            warnings.push(WEBGL2_NOTICE.into());
+        }
         Viewer {
             scene,
             settings,

@@ -115,7 +115,8 @@ impl Reencode {
     /// A pass writing `target_format`, a plain 8-bit format.
     pub fn new(device: &wgpu::Device, target_format: wgpu::TextureFormat) -> Reencode {
         let (pipeline, layout) = image_pipeline(device, "fs_reencode", target_format);
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor { label: Some("upscale::reencode"), ..Default::default() });
+        let sampler =
+            device.create_sampler(&wgpu::SamplerDescriptor { label: Some("upscale::reencode"), ..Default::default() });
         Reencode { pipeline, layout, sampler }
     }
 

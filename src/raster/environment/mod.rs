@@ -190,7 +190,11 @@ impl Converter {
                 layout::sampler(1, wgpu::SamplerBindingType::Filtering),
                 layout::texture(2, filterable, wgpu::TextureViewDimension::D2),
                 layout::texture(3, filterable, wgpu::TextureViewDimension::Cube),
-                layout::texture(4, filterable, shaders::Profile::of(device).view_dimension(wgpu::TextureViewDimension::CubeArray)),
+                layout::texture(
+                    4,
+                    filterable,
+                    shaders::Profile::of(device).view_dimension(wgpu::TextureViewDimension::CubeArray),
+                ),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
