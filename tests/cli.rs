@@ -444,3 +444,28 @@ fn budget_writes_its_json_and_its_sheet_even_for_a_tiny_image() {
     let output = mirador(&["budget", &scene, "--sheet", wrong.to_str().unwrap()]);
     assert!(!output.status.success() && !wrong.exists(), "{}", stderr(&output));
 }
+
+/// `mirador` on a device of the WebGL2 profile (`MIRADOR_LIMITS=webgl2` on GL): what the page
+/// draws with in a browser without WebGPU.
+fn mirador_as_webgl2(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_mirador"))
+        .args(args)
+        .env("MIRADOR_LIMITS", "webgl2")
+        .env("WGPU_BACKEND", "gl")
+        .output()
+        .expect("running the mirador binary")
+}
+
+/// The WebGL2 profile draws (`tests/gl_backend.rs` compares its images), and what it cannot run
+/// says why: pixel inspection needs storage buffers, the lab's checks compute shaders.
+#[test]
+fn the_webgl2_profile_draws_and_names_what_it_cannot_run() {
+    let dir = scratch("webgl2");
+    let out = dir.join("showcase.png");
+    let output = mirador_as_webgl2(&["render", "-o", out.to_str().unwrap(), "--width", "160", "--height", "90"]);
+    assert!(output.status.success(), "render on the WebGL2 profile: {}", stderr(&output));
+    assert_eq!(image::image_dimensions(&out).expect("a PNG"), (160, 90));
+    std::fs::remove_file(&out).unwrap();
+    let output = mirador_as_webgl2(&["explain", "--pixel", "80,45", "--width", "160", "--height", "90"]);
+    assert_fails_cleanly(&output, &["cannot inspect pixels", "storage buffers", "WebGL2"], &dir);
+}
