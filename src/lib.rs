@@ -28,7 +28,6 @@ pub mod compare;
 pub mod explain;
 pub mod files;
 pub mod gpu;
-#[cfg(not(target_arch = "wasm32"))]
 pub mod lab;
 pub mod linear_output;
 pub mod output;

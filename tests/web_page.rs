@@ -147,4 +147,50 @@ fn the_page_draws_what_the_native_renderers_draw() {
         against_acne >= MIN_TOGGLE_RATIO * error,
         "the page's hybrid is as close to the acne ({against_acne}) as to the traced shadows ({error})"
     );
+
+    // The lab in the page: the planar-mirrors lab's scene drawn with the stub's functions and with
+    // Mirador's, each against the native renderer compiled from the same WGSL (the editor beside
+    // the view leaves the view narrower).
+    let lab = mirador::lab::find("planar-mirrors").expect("a built-in lab");
+    let mut scene = mirador::lab::images::scene(&lab.images[0], None).expect("the lab's scene");
+    let (stub, lab_view) = shot(&dir, "lab-stub.png");
+    (scene.camera.width, scene.camera.height) = (lab_view[2], lab_view[3]);
+    let gpu = common::gpu();
+    let native = |wgsl| mirador::lab::images::raster(gpu, &scene, &wgsl).expect("the lab's scene draws");
+    let native_stub = native(mirador::lab::source::student(&lab, &lab.stub()));
+    let native_reference = native(mirador::lab::source::reference(&lab));
+    let (reference, reference_view) = shot(&dir, "lab-reference.png");
+    assert_eq!(reference_view, lab_view);
+    let error = flip(&native_stub, &crop(&stub, lab_view), "lab-stub", &dir);
+    assert!(error <= MAX_CROSS_GPU_FLIP, "the lab's stub in the page differs from the native stub: {error}");
+    let error = flip(&native_reference, &crop(&reference, lab_view), "lab-reference", &dir);
+    assert!(error <= MAX_CROSS_GPU_FLIP, "the lab's reference in the page differs from the native: {error}");
+    let apart = flip(&native_reference, &crop(&stub, lab_view), "lab-stub-against-reference", &dir);
+    assert!(
+        apart >= MIN_TOGGLE_RATIO * error,
+        "the page's stub is as near the reference ({apart}) as the page's reference is ({error})"
+    );
+
+    // The student's reflection typed into the editor draws the reference's image; a typo then
+    // keeps it drawn (the last version that compiled), with the problem over the view's top left.
+    let (solved, solved_view) = shot(&dir, "lab-solved.png");
+    assert_eq!(solved_view, lab_view);
+    let solved_error = flip(&native_reference, &crop(&solved, lab_view), "lab-solved", &dir);
+    assert!(
+        solved_error <= MAX_CROSS_GPU_FLIP,
+        "the student's reflection in the page differs from the reference: {solved_error}"
+    );
+    let error = flip(&native_stub, &crop(&solved, lab_view), "lab-solved-against-stub", &dir);
+    assert!(
+        error >= MIN_TOGGLE_RATIO * solved_error,
+        "the page did not draw the student's edit: {error} from the stub"
+    );
+    let (typo, typo_view) = shot(&dir, "lab-typo.png");
+    assert_eq!(typo_view, lab_view);
+    let lower = [lab_view[0], lab_view[1] + lab_view[3] / 2, lab_view[2], lab_view[3] / 2];
+    let in_view = |[x, y, w, h]: [u32; 4]| [x - lab_view[0], y - lab_view[1], w, h];
+    let error = flip(&crop(&native_reference, in_view(lower)), &crop(&typo, lower), "lab-typo", &dir);
+    assert!(error <= MAX_CROSS_GPU_FLIP, "a typo did not keep the last version drawn: {error}");
+    let boxed = flip(&crop(&solved, lab_view), &crop(&typo, lab_view), "lab-typo-box", &dir);
+    assert!(boxed > 0.001, "the typo's problem is not shown over the view: {boxed}");
 }

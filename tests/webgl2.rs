@@ -28,11 +28,11 @@ const LATER_BUILTINS: &[&str] = &[
     "imageStore",
 ];
 
-/// Each entry point of each pass composed for `profile`, written as WebGL2's GLSL: the entry
+/// Each entry point of each pass of `wgsl` composed for `profile`, written as WebGL2's GLSL: the entry
 /// points written, and the failures with their reasons.
-fn write_as_webgl2(profile: Profile) -> (Vec<String>, Vec<String>) {
+fn write_as_webgl2(wgsl: &Wgsl, profile: Profile) -> (Vec<String>, Vec<String>) {
     let (mut written, mut failed) = (Vec::new(), Vec::new());
-    for (pass, source) in Wgsl::builtin().for_profile(profile).passes() {
+    for (pass, source) in wgsl.for_profile(profile).passes() {
         let module =
             naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{pass}: {}", e.emit_to_string(&source)));
         let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
@@ -93,7 +93,7 @@ fn glsl_es_300(
 
 #[test]
 fn every_pass_is_written_as_webgl2_glsl_on_the_webgl2_profile() {
-    let (written, failed) = write_as_webgl2(Profile::WebGl2);
+    let (written, failed) = write_as_webgl2(&Wgsl::builtin(), Profile::WebGl2);
     assert!(failed.is_empty(), "entry points WebGL2 cannot compile:\n{}", failed.join("\n"));
     // Every pass has entry points a WebGL2 device draws with.
     for pass in ["scene", "transparency", "refraction", "volume", "mipmap", "environment", "shadow", "present"] {
@@ -103,8 +103,26 @@ fn every_pass_is_written_as_webgl2_glsl_on_the_webgl2_profile() {
 
 #[test]
 fn the_standard_profile_is_not_webgl2_glsl() {
-    let (_, failed) = write_as_webgl2(Profile::Standard);
+    let (_, failed) = write_as_webgl2(&Wgsl::builtin(), Profile::Standard);
     // The cube arrays (every surface pass reads the dynamic cubes), and the shadow filters' gather.
     assert!(failed.iter().any(|f| f.starts_with("scene::")), "{failed:?}");
     assert!(failed.iter().any(|f| f.starts_with("mipmap::")), "{failed:?}");
+}
+
+/// Every lab's routes compile for WebGL2, or the lab says why not (`webgl2` in its lab.toml), and
+/// only then: the page offers a lab on WebGL2 exactly when it runs there.
+#[test]
+fn every_lab_runs_on_webgl2_or_says_why_not() {
+    for lab in mirador::lab::catalog() {
+        let (_, failures) = write_as_webgl2(&mirador::lab::source::reference(&lab), Profile::WebGl2);
+        eprintln!("{}: {} entry points WebGL2 cannot compile {:?}", lab.name, failures.len(), failures.first());
+        match &lab.webgl2 {
+            Some(reason) => {
+                assert!(!failures.is_empty(), "{} says it cannot run on WebGL2 ({reason}), yet compiles", lab.name)
+            }
+            None => {
+                assert!(failures.is_empty(), "{} cannot run on WebGL2 and does not say why: {failures:?}", lab.name)
+            }
+        }
+    }
 }

@@ -1,7 +1,8 @@
 // The browser test's page side (web/test.sh loads `index.html?test`). Everything goes through the
 // page's own interface, `mirador.step(...)`, which the scene menu and the file picker use too:
 // the showcase as it opens, the shadows toggled off, the split view once the tracer has finished
-// in the page, the difference view, and the hybrid's traced shadows over acned shadow maps. Each screenshot (the whole canvas, PNG) is posted to the
+// in the page, the difference view, the hybrid's traced shadows over acned shadow maps, and a lab's
+// stub and reference. Each screenshot (the whole canvas, PNG) is posted to the
 // test server with the 3D view's rectangle; `done` ends the run, `failed` says why it stopped.
 const post = (path, body, view) =>
   fetch(path, { method: "POST", body, headers: view ? { "X-View": view.join(" ") } : {} });
@@ -11,6 +12,7 @@ export function run(mirador) {
   let posted = 0;
   window.miradorScreenshot = async (name, png, view) => {
     await post(`/capture/${name}`, png, view);
+    if (name === "lab-reference.png") editTheLab(mirador);
     if (++posted === expected) await post("/capture/done", "done");
   };
   window.miradorError = (text) => post("/capture/failed", text);
@@ -39,7 +41,51 @@ export function run(mirador) {
     "set hybrid.shadows=true",
     "wait 10s",
     "screenshot hybrid.png",
+    // (the screenshot is posted with the view's rectangle a frame or two later: the lab's editor
+    // must not have narrowed the view by then)
+    "wait 2s",
+    // The lab in the page: the planar-mirrors lab's stub (its neutral reflection: the mirror
+    // shows the room unreflected), then the reference; the editor narrows the view.
+    "set hybrid.shadows=false",
+    "lab open planar-mirrors",
+    "wait 4s",
+    "screenshot lab-stub.png",
+    "lab reference",
+    "wait 4s",
+    "screenshot lab-reference.png",
   ];
-  expected = steps.filter((s) => s.startsWith("screenshot")).length;
+  expected = [...steps, ...LAB_EDITS, ...LAB_TYPO].filter((s) => s.startsWith("screenshot")).length;
   for (const step of steps) mirador.step(step);
+}
+
+// What a student does next, once the reference is shown: writes the reflection (this text, as
+// if typed into the editor), sees it drawn, then saves a version with a typo: the view keeps the
+// last version that compiled and shows the problem.
+const REFLECTION = `fn mirror_reflection(plane: vec4f) -> mat4x4f {
+    let n = plane.xyz;
+    let d = plane.w;
+    return mat4x4f(
+        vec4f(1.0 - 2.0 * n.x * n.x, -2.0 * n.x * n.y, -2.0 * n.x * n.z, 0.0),
+        vec4f(-2.0 * n.y * n.x, 1.0 - 2.0 * n.y * n.y, -2.0 * n.y * n.z, 0.0),
+        vec4f(-2.0 * n.z * n.x, -2.0 * n.z * n.y, 1.0 - 2.0 * n.z * n.z, 0.0),
+        vec4f(-2.0 * d * n.x, -2.0 * d * n.y, -2.0 * d * n.z, 1.0),
+    );
+}
+`;
+const LAB_EDITS = ["lab student", "wait 4s", "screenshot lab-solved.png", "wait 1s"];
+const LAB_TYPO = ["wait 4s", "screenshot lab-typo.png"];
+
+function editTheLab(mirador) {
+  mirador.set_lab_text(REFLECTION);
+  for (const step of LAB_EDITS) mirador.step(step);
+  // The typo once the solved screenshot's steps have run (steps run one a frame, in order).
+  const typo = () => {
+    mirador.set_lab_text(REFLECTION.replace("let d = plane.w;", "let d = plane.w"));
+    for (const step of LAB_TYPO) mirador.step(step);
+  };
+  const previous = window.miradorScreenshot;
+  window.miradorScreenshot = async (name, png, view) => {
+    await previous(name, png, view);
+    if (name === "lab-solved.png") typo();
+  };
 }

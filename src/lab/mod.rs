@@ -25,11 +25,17 @@
 //! limit ([`run`]): a software GPU cannot be interrupted, and a shader that never returns is a
 //! failed test, not a hung grader.
 
+// What runs the checks: processes and folders, which the page has not. The
+// page's lab mode (src/viewer/lab.rs) uses the lab, its scenes and its source checks.
+#[cfg(not(target_arch = "wasm32"))]
 pub mod check;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod folder;
 pub mod harness;
 pub mod images;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod report;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod run;
 pub mod source;
 
@@ -66,6 +72,11 @@ pub struct Lab {
     pub images: Vec<ImageTest>,
     #[serde(default)]
     pub mistakes: Vec<Mistake>,
+    /// Why the lab cannot run on a device of the WebGL2 profile (the page where the browser has
+    /// no WebGPU), when its routes need what WebGL2's shading language lacks. Kept true by
+    /// `tests/webgl2.rs`, which compiles every lab for WebGL2.
+    #[serde(default)]
+    pub webgl2: Option<String>,
 }
 
 /// A function the student writes: one of Mirador's, by name, and the body the stub gives it.

@@ -94,6 +94,9 @@ pub struct Viewer {
     budget_next: bool,
     /// Lab mode (`mirador view --lab DIR`): the student's functions drawn, reloaded when saved.
     pub lab: Option<LabMode>,
+    /// What the device's shaders may use (the page's labs need it).
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    profile: crate::shaders::Profile,
     /// The settings changed in each scene opened before (`super::config`), by scene key.
     remembered: BTreeMap<String, toml::Table>,
     /// The settings and the scene's own the panel's list of changed settings was made from, and
@@ -147,7 +150,8 @@ impl Viewer {
         });
         let raster = RasterView::new(screen, &scene.scene, scene.revision, wgsl);
         let mut warnings = warnings;
-        if screen.gpu.profile() == crate::shaders::Profile::WebGl2 {
+        let profile = screen.gpu.profile();
+        if profile == crate::shaders::Profile::WebGl2 {
             warnings.push(WEBGL2_NOTICE.into());
         }
         Viewer {
@@ -185,6 +189,7 @@ impl Viewer {
             error_budget: None,
             budget_next: false,
             lab,
+            profile,
             remembered,
             changed: Default::default(),
         }
@@ -281,6 +286,39 @@ impl Viewer {
         } else {
             self.scene.overrides = overrides;
         }
+    }
+
+    /// Opens the built-in lab `name` (the page's lab menu): its scene, with the settings its
+    /// first image test sets, drawn with the stub's functions until the student's text compiles.
+    #[cfg(target_arch = "wasm32")]
+    pub fn open_lab(&mut self, name: &str) {
+        match LabMode::open(name, self.profile) {
+            Ok((lab, scene)) => {
+                self.settings = scene.settings.clone();
+                self.scene.replace(scene, &self.settings.clone());
+                self.notice(format!("lab {name}: {}; write its functions in the editor", lab.lab.title));
+                self.lab = Some(lab);
+            }
+            Err(e) => self.notice(format!("lab {name}: {e:#}")),
+        }
+    }
+
+    /// The page's lab: the editor's text replaced (a file the student opened), checked at once.
+    #[cfg(target_arch = "wasm32")]
+    pub fn set_lab_text(&mut self, text: String) {
+        match self.lab.as_mut() {
+            Some(lab) => {
+                lab.text = text;
+                lab.edited();
+            }
+            None => self.notice("no lab is open: choose one first".into()),
+        }
+    }
+
+    /// The page's lab: its file's name and the editor's text, for the page's download.
+    #[cfg(target_arch = "wasm32")]
+    pub fn lab_file(&self) -> Option<(String, String)> {
+        self.lab.as_ref().map(|lab| (lab.lab.file.clone(), lab.text.clone()))
     }
 
     /// Every setting back to the scene file's own.
@@ -380,6 +418,10 @@ impl Viewer {
             self.changed = (self.settings.clone(), self.scene.seed_settings.clone(), list);
         }
         let mut output = UiOutput::default();
+        // The page's lab editor edits the text out of the lab while the panel reads the rest.
+        #[cfg(target_arch = "wasm32")]
+        let mut editing =
+            self.lab.as_mut().map(|lab| (lab.lab.file.clone(), std::mem::take(&mut lab.text), lab.problems.clone()));
         let mut model = UiModel {
             settings: &self.settings,
             scene: &mut self.scene,
@@ -398,8 +440,19 @@ impl Viewer {
             lab: self.lab.as_ref().map(LabMode::panel),
             changed_settings: &self.changed.2,
             error_budget: self.error_budget.as_deref(),
+            #[cfg(target_arch = "wasm32")]
+            lab_editor: editing.as_mut().map(|(file, text, problems)| super::lab::LabEditor { file, text, problems }),
+            #[cfg(not(target_arch = "wasm32"))]
+            lab_editor: None,
         };
         let full = screen.egui.run_ui(raw, |ui| output = ui::draw(ui, &mut model));
+        #[cfg(target_arch = "wasm32")]
+        if let (Some((_, text, _)), Some(lab)) = (editing, self.lab.as_mut()) {
+            lab.text = text;
+            if output.lab_edited {
+                lab.edited();
+            }
+        }
         (output, full)
     }
 
@@ -808,6 +861,14 @@ impl Viewer {
                 Some(lab) => lab.show(shown),
                 None => bail!("`lab {}`: the viewer is not in lab mode (mirador view --lab DIR)", shown.label()),
             },
+            #[cfg(target_arch = "wasm32")]
+            Step::LabOpen(name) => self.open_lab(&name),
+            #[cfg(not(target_arch = "wasm32"))]
+            Step::LabOpen(name) => {
+                bail!(
+                    "`lab open {name}` is the page's; natively: mirador lab new {name} DIR, then mirador view --lab DIR"
+                )
+            }
         }
         Ok(())
     }

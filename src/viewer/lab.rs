@@ -14,7 +14,11 @@
 //! - The lab starts from its scene and the settings its first image test sets, never from what
 //!   the viewer remembered of another scene, and remembers nothing when it closes.
 //!
-//! The page has no lab mode yet: there [`LabMode`] has no value.
+//!
+//! In the page (`index.html`'s lab menu) the student's file is the text of an editor beside the
+//! view, taken in a moment after the last keystroke, checked the same way (naga's messages, at
+//! the same `line:column`), and downloaded with the page's button. The page draws the student's
+//! functions and the reference; the difference view and the checks run natively for now.
 
 /// What the view shows in lab mode.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -65,6 +69,10 @@ pub struct LabPanel<'a> {
     pub fallback: &'static str,
     /// The difference view's error map and its mean, once made for the current view.
     pub difference: Option<(egui::TextureId, f32)>,
+    /// What the view can show: the page has no difference view yet.
+    pub choices: &'static [LabShown],
+    /// When the student's text is taken in, and where the checks run.
+    pub how: &'static str,
 }
 
 #[cfg(not(target_arch = "wasm32"))]
@@ -243,6 +251,8 @@ mod native {
                 problems: &self.problems,
                 fallback: self.fallback(),
                 difference: self.difference.as_ref().map(|d| (d.texture.id(), d.flip_mean)),
+                choices: &LabShown::ALL,
+                how: "redrawn when saved; `mirador lab check DIR` runs the tests",
             }
         }
 
@@ -315,37 +325,161 @@ mod native {
     }
 }
 
-/// The page has no lab mode yet (issue 36): no value of this type exists there.
 #[cfg(target_arch = "wasm32")]
-pub enum LabMode {}
+pub use page::LabMode;
 
 #[cfg(target_arch = "wasm32")]
-impl LabMode {
-    pub fn poll(&mut self) -> bool {
-        match *self {}
+mod page {
+    use std::time::Duration;
+
+    use web_time::Instant;
+
+    use super::LabShown;
+    use crate::lab::{Lab, source};
+    use crate::shaders::Wgsl;
+
+    /// How long after the last keystroke the editor's text is checked and drawn.
+    const PAUSE: Duration = Duration::from_millis(300);
+
+    pub struct LabMode {
+        pub lab: Lab,
+        /// The student's file, as the editor holds it.
+        pub text: String,
+        /// The last keystroke not yet checked.
+        edited: Option<Instant>,
+        /// The student's functions as last compiled (the stub's until a version does).
+        student: Wgsl,
+        generation: u64,
+        /// Why the text is not the one drawn, each problem at its place.
+        pub problems: Vec<String>,
+        pub shown: LabShown,
+        changed: bool,
     }
 
-    pub fn next_poll(&self) -> web_time::Instant {
-        match *self {}
-    }
+    impl LabMode {
+        /// The built-in lab `name`, its text the stub, and the scene its first image test draws.
+        /// A lab whose routes WebGL2 cannot compile is refused there with its reason.
+        pub fn open(name: &str, profile: crate::shaders::Profile) -> anyhow::Result<(LabMode, crate::Scene)> {
+            let lab = crate::lab::find(name).map_err(anyhow::Error::msg)?;
+            if let (crate::shaders::Profile::WebGl2, Some(reason)) = (profile, &lab.webgl2) {
+                anyhow::bail!("this page draws with WebGL2 here, and the lab cannot run there: {reason}");
+            }
+            let test = lab.images.first().ok_or_else(|| anyhow::anyhow!("lab {} has no scene", lab.name))?;
+            let scene = crate::lab::images::scene(test, None).map_err(anyhow::Error::msg)?;
+            let text = lab.stub();
+            let mut mode = LabMode {
+                student: source::student(&lab, &text),
+                lab,
+                text,
+                edited: None,
+                generation: 0,
+                problems: Vec::new(),
+                shown: LabShown::Student,
+                changed: true,
+            };
+            mode.check();
+            Ok((mode, scene))
+        }
 
-    pub fn wgsl(&self) -> crate::shaders::Wgsl {
-        match *self {}
-    }
+        /// The editor changed the text: it is checked after a pause.
+        pub fn edited(&mut self) {
+            self.edited = Some(Instant::now());
+        }
 
-    pub fn show(&mut self, _: LabShown) {
-        match *self {}
-    }
+        /// Checks the text as `lab check` checks a file: adopted when it compiles.
+        fn check(&mut self) {
+            let problems = source::problems(&self.lab, &self.text);
+            if problems.is_empty() {
+                self.student = source::student(&self.lab, &self.text);
+                self.generation += 1;
+                self.problems.clear();
+                self.changed = true;
+            } else {
+                self.problems = problems.iter().map(|p| p.display(&self.lab.file)).collect();
+            }
+        }
 
-    pub fn panel(&self) -> LabPanel<'_> {
-        match *self {}
-    }
+        /// Checks the text once the student paused; returns whether the window must be drawn.
+        pub fn poll(&mut self) -> bool {
+            match self.edited {
+                Some(at) if at.elapsed() >= PAUSE => {
+                    self.edited = None;
+                    self.check();
+                    true
+                }
+                _ => false,
+            }
+        }
 
-    pub fn take_changed(&mut self) -> bool {
-        match *self {}
-    }
+        pub fn next_poll(&self) -> Instant {
+            self.edited.map_or_else(|| Instant::now() + Duration::from_secs(3600), |at| at + PAUSE)
+        }
 
-    pub fn update_difference(&mut self, _: &crate::gpu::Gpu, _: &egui::Context, _: &crate::Scene, _: u64) {
-        match *self {}
+        fn fallback(&self) -> &'static str {
+            if self.generation <= 1 { "the stub's neutral functions" } else { "the last version that compiled" }
+        }
+
+        pub fn take_changed(&mut self) -> bool {
+            std::mem::take(&mut self.changed)
+        }
+
+        pub fn wgsl(&self) -> Wgsl {
+            match self.shown {
+                LabShown::Reference => source::reference(&self.lab),
+                LabShown::Student | LabShown::Difference => self.student.clone(),
+            }
+        }
+
+        pub fn panel(&self) -> super::LabPanel<'_> {
+            super::LabPanel {
+                name: &self.lab.name,
+                title: &self.lab.title,
+                file: std::path::Path::new(&self.lab.file),
+                shown: self.shown,
+                problems: &self.problems,
+                fallback: self.fallback(),
+                difference: None,
+                choices: &[LabShown::Student, LabShown::Reference],
+                how: "redrawn as you type; the checks run natively: `mirador lab check DIR` on the downloaded file",
+            }
+        }
+
+        /// Shows `shown`; the page has no difference view, so the L key goes back to the student's.
+        pub fn show(&mut self, shown: LabShown) {
+            let shown = if shown == LabShown::Difference { LabShown::Student } else { shown };
+            if shown != self.shown {
+                self.shown = shown;
+                self.changed = true;
+            }
+        }
+
+        pub fn update_difference(&mut self, _: &crate::gpu::Gpu, _: &egui::Context, _: &crate::Scene, _: u64) {}
+    }
+}
+
+/// The student's file in an editor beside the view, on the window's right (the page's lab mode),
+/// with the file's problems under it at their `line:column`.
+pub struct LabEditor<'a> {
+    pub file: &'a str,
+    pub text: &'a mut String,
+    pub problems: &'a [String],
+}
+
+impl LabEditor<'_> {
+    /// Lays the editor out as the window's right panel; returns whether the text changed.
+    pub fn show(&mut self, ui: &mut egui::Ui) -> bool {
+        let mut changed = false;
+        egui::Panel::right("lab_editor").resizable(true).default_size(480.0).show(ui, |ui| {
+            ui.label(egui::RichText::new(self.file).monospace().strong());
+            for problem in self.problems {
+                ui.colored_label(ui.visuals().error_fg_color, egui::RichText::new(problem).monospace().small());
+            }
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                let edit =
+                    egui::TextEdit::multiline(self.text).code_editor().desired_width(f32::INFINITY).desired_rows(40);
+                changed = ui.add(edit).changed();
+            });
+        });
+        changed
     }
 }

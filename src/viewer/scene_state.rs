@@ -96,7 +96,8 @@ impl SceneState {
         }
     }
 
-    fn replace(&mut self, scene: Scene, settings: &RenderSettings) {
+    /// Replaces the scene with `scene` at the window's image size, drawn with `settings`.
+    pub fn replace(&mut self, scene: Scene, settings: &RenderSettings) {
         let (width, height) = (self.scene.camera.width, self.scene.camera.height);
         let revision = self.revision + 1;
         let overrides = std::mem::take(&mut self.overrides);

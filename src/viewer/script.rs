@@ -77,6 +77,8 @@ pub enum Step {
     Budget,
     Screenshot(PathBuf),
     Lab(LabShown),
+    /// Open a built-in lab with an editor for its file (the page's lab menu).
+    LabOpen(String),
     ResetSettings,
 }
 
@@ -115,9 +117,13 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
     Ok(match verb {
         "set" => Step::Set(assignment("set")?),
         "material" => Step::Material(assignment("material")?),
-        "lab" => {
-            Step::Lab(LabShown::parse(args).ok_or_else(|| fail("the lab view is student, reference or difference"))?)
-        }
+        "lab" => match args.trim().strip_prefix("open ") {
+            Some(name) => Step::LabOpen(name.trim().to_owned()),
+            None => Step::Lab(
+                LabShown::parse(args)
+                    .ok_or_else(|| fail("the lab view is student, reference or difference, or `open NAME`"))?,
+            ),
+        },
         "view" => {
             Step::View(ViewMode::parse(args).ok_or_else(|| fail("the view is raster, traced, split or difference"))?)
         }

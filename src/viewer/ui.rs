@@ -50,6 +50,8 @@ pub struct UiModel<'a> {
     pub changed_settings: &'a [String],
     /// The last error budget measured (`crate::budget`), as its report.
     pub error_budget: Option<&'a str>,
+    /// The page's lab: the student's file in an editor beside the view.
+    pub lab_editor: Option<super::lab::LabEditor<'a>>,
 }
 
 /// Requests the UI makes of the frame.
@@ -89,6 +91,8 @@ pub struct UiOutput {
     pub cursor: Option<Vec2>,
     /// Lab mode: show the student's image, the reference or their difference.
     pub lab_shown: Option<LabShown>,
+    /// The page's lab editor changed the student's text.
+    pub lab_edited: bool,
 }
 
 /// Draws the whole window.
@@ -99,6 +103,9 @@ pub fn draw(ui: &mut egui::Ui, model: &mut UiModel) -> UiOutput {
         egui::Panel::left("side_panel").resizable(true).default_size(330.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| side_panel(ui, model, &mut output));
         });
+    }
+    if let Some(editor) = &mut model.lab_editor {
+        output.lab_edited = editor.show(ui);
     }
     egui::CentralPanel::no_frame().show(ui, |ui| view(ui, model, &mut output));
     hud::help_window(ui.ctx(), &mut model.view.help_open);
@@ -268,9 +275,9 @@ fn error_budget(ui: &mut egui::Ui, report: Option<&str>, output: &mut UiOutput) 
 /// Lab mode's section: the lab, the student's file, what the view shows, the file's problems.
 fn lab_section(ui: &mut egui::Ui, lab: &LabPanel, output: &mut UiOutput) {
     ui.label(egui::RichText::new(format!("lab `{}`", lab.name)).strong()).on_hover_text(lab.title);
-    ui.small(format!("{} (redrawn when saved)", lab.file.display()));
+    ui.small(format!("{}: {}", lab.file.display(), lab.how));
     ui.horizontal(|ui| {
-        for shown in LabShown::ALL {
+        for &shown in lab.choices {
             let hint = match shown {
                 LabShown::Student => "Your functions (the last version that compiled). L switches.",
                 LabShown::Reference => "Mirador's own functions: the answer key. L switches.",
@@ -284,7 +291,7 @@ fn lab_section(ui: &mut egui::Ui, lab: &LabPanel, output: &mut UiOutput) {
         }
     });
     if lab.problems.is_empty() {
-        ui.small("Compiles. `mirador lab check DIR` runs the tests.");
+        ui.small("Compiles.");
     } else {
         ui.colored_label(ui.visuals().error_fg_color, format!("Does not compile: {} drawn.", lab.fallback));
     }

@@ -119,6 +119,12 @@ impl App {
             return;
         }
         viewer.push_steps(page::take_steps());
+        if let Some(name) = page::take_lab_asked() {
+            viewer.open_lab(&name);
+        }
+        if let Some(text) = page::take_lab_text() {
+            viewer.set_lab_text(text);
+        }
         match viewer.frame(screen) {
             Ok(end) => {
                 self.next_frame = end.next;
@@ -135,6 +141,7 @@ impl App {
             }
         }
         page::remember_view(viewer.view_pixels);
+        page::remember_lab_file(viewer.lab_file());
         // Steps run one a frame, as a scripted native run does.
         if !viewer.script_done() {
             screen.window.request_redraw();

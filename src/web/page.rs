@@ -20,6 +20,12 @@ thread_local! {
     static STEPS: RefCell<VecDeque<Step>> = const { RefCell::new(VecDeque::new()) };
     /// The 3D view's rectangle in the canvas at the last frame: `x, y, width, height` pixels.
     static VIEW: RefCell<Option<[u32; 4]>> = const { RefCell::new(None) };
+    /// The lab the page's menu asked for, until the next frame opens it.
+    static LAB_ASKED: RefCell<Option<String>> = const { RefCell::new(None) };
+    /// A text for the open lab's editor, from the page, until the next frame takes it.
+    static LAB_TEXT: RefCell<Option<String>> = const { RefCell::new(None) };
+    /// The open lab's file name and text at the last frame, for the download.
+    static LAB_FILE: RefCell<Option<(String, String)>> = const { RefCell::new(None) };
 }
 
 pub(super) fn set_proxy(proxy: EventLoopProxy<Wake>) {
@@ -60,6 +66,46 @@ pub fn step(line: &str) -> Result<(), JsError> {
 pub(super) fn asks_for_webgl2() -> bool {
     let search = web_sys::window().and_then(|w| w.location().search().ok()).unwrap_or_default();
     search.trim_start_matches('?').split('&').any(|p| p == "webgl2")
+}
+
+/// The built-in labs' names, for the page's lab menu.
+#[wasm_bindgen]
+pub fn labs() -> Vec<String> {
+    crate::lab::catalog().into_iter().map(|lab| lab.name).collect()
+}
+
+/// Opens the built-in lab `name` at the next frame: its scene, and an editor with its stub.
+#[wasm_bindgen]
+pub fn open_lab(name: &str) {
+    LAB_ASKED.with(|l| *l.borrow_mut() = Some(name.to_owned()));
+    wake(Wake::Steps);
+}
+
+/// The open lab's file as the editor holds it, `[name, text]`, for the page's download button;
+/// empty when no lab is open.
+#[wasm_bindgen]
+pub fn lab_file() -> Vec<String> {
+    LAB_FILE.with(|f| f.borrow().clone().map(|(name, text)| vec![name, text]).unwrap_or_default())
+}
+
+/// Replaces the open lab's text (the page's "open my file": a file saved from an earlier
+/// visit), checked and drawn as an edit is.
+#[wasm_bindgen]
+pub fn set_lab_text(text: String) {
+    LAB_TEXT.with(|t| *t.borrow_mut() = Some(text));
+    wake(Wake::Steps);
+}
+
+pub(super) fn take_lab_text() -> Option<String> {
+    LAB_TEXT.with(|t| t.borrow_mut().take())
+}
+
+pub(super) fn take_lab_asked() -> Option<String> {
+    LAB_ASKED.with(|l| l.borrow_mut().take())
+}
+
+pub(super) fn remember_lab_file(file: Option<(String, String)>) {
+    LAB_FILE.with(|f| *f.borrow_mut() = file);
 }
 
 /// The built-in scenes' paths, for the page's menu.
