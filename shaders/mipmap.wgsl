@@ -92,6 +92,5 @@ fn fs_mipmap_face_cube(in: FaceOut) -> @location(0) vec4f {
 
 @fragment
 fn fs_mipmap_face_cubes(in: FaceOut) -> @location(0) vec4f {
-    let d = face_texel_direction(in.position, in.layer % 6u, textureDimensions(face_cubes).x);
-    return cube_array_sample_level(face_cubes, face_sampler, d, i32(in.layer / 6u), 0.0);
+    return cube_array_face_texel(face_cubes, face_sampler, in.position.xy, in.layer);
 }

@@ -1,7 +1,7 @@
 //! The browser build's page, checked against the native renderers: `web/test.sh` builds the page,
-//! loads it in headless Chromium (WebGPU on SwiftShader), lets the page's test (`web/test.js`)
-//! take four screenshots through the page's own interface, and then runs this file with
-//! `MIRADOR_WEB_CAPTURE` naming the folder they were posted to. It needs a browser and the web
+//! loads it in Chromium under Xvfb twice (WebGPU on SwiftShader, then WebGL2 where WebGPU is
+//! missing), lets the page's test (`web/test.js`) take its screenshots through the page's own
+//! interface, and then runs this file on each run's folder (`MIRADOR_WEB_CAPTURE`). It needs a browser and the web
 //! build, more than CI's time allows, so it is `#[ignore]`d in `cargo test`; `tests/web.rs` keeps
 //! the web build compiling there.
 //!
@@ -9,7 +9,9 @@
 //! (another GPU draws it: SwiftShader, not lavapipe, so within that GPU difference), toggling
 //! shadows in the page gives the headless image without shadows, the split view's halves are the raster and the traced
 //! images (the tracer ran in the page, in slices: exactly the native image), and the difference view is the page's
-//! FLIP map of those two images, as `compare` makes it.
+//! FLIP map of those two images, as `compare` makes it; the hybrid's traced shadows are `render`'s;
+//! and a lab's stub, reference, a student's solution typed into the editor and then a typo are
+//! drawn as the native renderer compiled from the same WGSL draws them.
 
 mod common;
 

@@ -1,99 +1,23 @@
 //! The WebGL2 profile (issue 36): every pass Mirador draws with compiles to what WebGL2 runs.
 //!
 //! WebGL2 is OpenGL ES 3.0, whose shading language (GLSL ES 3.00) has no cube-map arrays, no
-//! `textureGather`, no storage buffers and no compute shaders. wgpu's GL backend in the page
-//! writes each entry point as GLSL ES 3.00 with naga's GLSL writer; this test does the same for
-//! every pass composed for the WebGL2 profile (`shaders/profile/webgl2.wgsl`), and checks that
-//! the standard profile's text would not compile there (its cube arrays), so the test can fail.
+//! `textureGather`, no `textureNumLevels`, no storage buffers and no compute shaders. wgpu's GL
+//! backend in the page writes each entry point as GLSL ES 3.00 with naga's GLSL writer;
+//! `mirador::lab::source::webgl2_written` does the same for every pass composed for a profile,
+//! and these tests run it on the WebGL2 profile (`shaders/profile/webgl2.wgsl`), on the standard
+//! profile (whose cube arrays must fail, so the check can), and on every lab. The page's lab
+//! uses the same function to check a student's file on a WebGL2 device.
 //!
 //! Entry points a WebGL2 device never draws with are left out by rule, not by name: those that
 //! write the inspection's storage buffer (`explain`, which the WebGL2 profile refuses with its
 //! reason). The images this profile draws are compared with Vulkan's in `tests/gl_backend.rs`.
 
+use mirador::lab::source::{webgl2_failures, webgl2_written};
 use mirador::shaders::{Profile, Wgsl};
-
-/// Built-in functions GLSL ES 3.10 added, which naga's writer emits for ES 3.00 all the same
-/// (it checks types and qualifiers against the version, not every function).
-const LATER_BUILTINS: &[&str] = &[
-    "textureGather",
-    "textureGatherOffset",
-    "textureQueryLevels",
-    "findMSB",
-    "findLSB",
-    "bitCount",
-    "bitfieldExtract",
-    "bitfieldInsert",
-    "bitfieldReverse",
-    "imageLoad",
-    "imageStore",
-];
-
-/// Each entry point of each pass of `wgsl` composed for `profile`, written as WebGL2's GLSL: the entry
-/// points written, and the failures with their reasons.
-fn write_as_webgl2(wgsl: &Wgsl, profile: Profile) -> (Vec<String>, Vec<String>) {
-    let (mut written, mut failed) = (Vec::new(), Vec::new());
-    for (pass, source) in wgsl.for_profile(profile).passes() {
-        let module =
-            naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{pass}: {}", e.emit_to_string(&source)));
-        let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
-            .validate(&module)
-            .unwrap_or_else(|e| panic!("{pass}: {e:?}"));
-        for (index, entry) in module.entry_points.iter().enumerate() {
-            let uses_storage = module.global_variables.iter().any(|(handle, var)| {
-                matches!(var.space, naga::AddressSpace::Storage { .. })
-                    && !info.get_entry_point(index)[handle].is_empty()
-            });
-            if uses_storage {
-                continue;
-            }
-            let name = format!("{pass}::{}", entry.name);
-            match glsl_es_300(&module, &info, entry) {
-                Ok(glsl) => match LATER_BUILTINS.iter().find(|f| glsl.contains(&format!("{f}("))) {
-                    Some(builtin) => failed.push(format!("{name}: {builtin}, which GLSL ES 3.00 lacks")),
-                    None => written.push(name),
-                },
-                Err(e) => failed.push(format!("{name}: {e}")),
-            }
-        }
-    }
-    (written, failed)
-}
-
-fn glsl_es_300(
-    module: &naga::Module,
-    info: &naga::valid::ModuleInfo,
-    entry: &naga::EntryPoint,
-) -> Result<String, String> {
-    let constants = naga::back::PipelineConstants::default();
-    let (module, info) =
-        naga::back::pipeline_constants::process_overrides(module, info, Some((entry.stage, &entry.name)), &constants)
-            .map_err(|e| e.to_string())?;
-    let options = naga::back::glsl::Options {
-        version: naga::back::glsl::Version::Embedded { version: 300, is_webgl: true },
-        ..Default::default()
-    };
-    let pipeline = naga::back::glsl::PipelineOptions {
-        shader_stage: entry.stage,
-        entry_point: entry.name.clone(),
-        multiview: None,
-    };
-    let mut glsl = String::new();
-    let mut writer = naga::back::glsl::Writer::new(
-        &mut glsl,
-        &module,
-        &info,
-        &options,
-        &pipeline,
-        naga::proc::BoundsCheckPolicies::default(),
-    )
-    .map_err(|e| e.to_string())?;
-    writer.write().map_err(|e| e.to_string())?;
-    Ok(glsl)
-}
 
 #[test]
 fn every_pass_is_written_as_webgl2_glsl_on_the_webgl2_profile() {
-    let (written, failed) = write_as_webgl2(&Wgsl::builtin(), Profile::WebGl2);
+    let (written, failed) = webgl2_written(&Wgsl::builtin(), Profile::WebGl2);
     assert!(failed.is_empty(), "entry points WebGL2 cannot compile:\n{}", failed.join("\n"));
     // Every pass has entry points a WebGL2 device draws with.
     for pass in ["scene", "transparency", "refraction", "volume", "mipmap", "environment", "shadow", "present"] {
@@ -103,8 +27,8 @@ fn every_pass_is_written_as_webgl2_glsl_on_the_webgl2_profile() {
 
 #[test]
 fn the_standard_profile_is_not_webgl2_glsl() {
-    let (_, failed) = write_as_webgl2(&Wgsl::builtin(), Profile::Standard);
-    // The cube arrays (every surface pass reads the dynamic cubes), and the shadow filters' gather.
+    let (_, failed) = webgl2_written(&Wgsl::builtin(), Profile::Standard);
+    // The cube arrays (every surface pass reads the dynamic cubes, the mip chain copies them).
     assert!(failed.iter().any(|f| f.starts_with("scene::")), "{failed:?}");
     assert!(failed.iter().any(|f| f.starts_with("mipmap::")), "{failed:?}");
 }
@@ -114,7 +38,7 @@ fn the_standard_profile_is_not_webgl2_glsl() {
 #[test]
 fn every_lab_runs_on_webgl2_or_says_why_not() {
     for lab in mirador::lab::catalog() {
-        let (_, failures) = write_as_webgl2(&mirador::lab::source::reference(&lab), Profile::WebGl2);
+        let failures = webgl2_failures(&mirador::lab::source::reference(&lab));
         eprintln!("{}: {} entry points WebGL2 cannot compile {:?}", lab.name, failures.len(), failures.first());
         match &lab.webgl2 {
             Some(reason) => {
@@ -125,4 +49,20 @@ fn every_lab_runs_on_webgl2_or_says_why_not() {
             }
         }
     }
+}
+
+/// A student's file that WGSL accepts but WebGL2 cannot compile is a problem on a WebGL2 device
+/// (the page without WebGPU), placed in the function that causes it, and none on the standard one.
+#[test]
+fn a_student_function_webgl2_lacks_is_a_problem_there() {
+    let lab = mirador::lab::find("mipmaps").expect("a built-in lab");
+    let solution = lab.solution();
+    let lacking = solution.replacen("let last = ", "let last = f32(textureNumLevels(t) - 1u) + 0.0 * ", 1);
+    assert_ne!(lacking, solution, "the solution clamps to its last level");
+    assert!(mirador::lab::source::problems_on(&lab, &solution, Profile::WebGl2).is_empty());
+    assert!(mirador::lab::source::problems_on(&lab, &lacking, Profile::Standard).is_empty());
+    let problems = mirador::lab::source::problems_on(&lab, &lacking, Profile::WebGl2);
+    let problem = problems.first().expect("WebGL2 has no textureNumLevels").display(&lab.file);
+    eprintln!("{problem}");
+    assert!(problem.contains("WebGL2") && problem.contains("trilinear_sample"), "{problem}");
 }

@@ -18,8 +18,8 @@
 // Trilinear; u repeats (the lat–long map's wrap), v clamps. Cube lookups ignore both.
 @group(2) @binding(6) var env_sampler: sampler;
 @group(2) @binding(7) var env_cube: texture_cube<f32>;
-// A cube array, or six layers of a 2D array a cube where the device has no cube arrays
-// (shaders/profile/).
+// A cube array; where the device has none (WebGL2), a 2D array whose layers 6k..6k+5 are cube k's
+// faces (shaders/profile/).
 @group(2) @binding(8) var env_cubes: CubeArray;
 @group(2) @binding(9) var env_sphere: texture_2d<f32>;
 @group(2) @binding(10) var env_latlong: texture_2d<f32>;

@@ -26,3 +26,12 @@ fn gather_compare(map: texture_depth_2d_array, cmp: sampler_comparison, corner: 
 fn texture_level_count(t: texture_2d<f32>) -> u32 {
     return textureNumLevels(t);
 }
+
+// Texel `position` of layer `layer` (cube layer / 6's face layer % 6) at level 0, for the mip
+// chain's face copy: looked up along that texel's centre direction (GL samples a cube only
+// through a view of the whole cube, and textureLoad has no cube form), where a nearest lookup
+// reads exactly that texel.
+fn cube_array_face_texel(cubes: CubeArray, s: sampler, position: vec2f, layer: u32) -> vec4f {
+    let d = cube_direction(layer % 6u, position / f32(textureDimensions(cubes).x));
+    return textureSampleLevel(cubes, s, d, i32(layer / 6u), 0.0);
+}

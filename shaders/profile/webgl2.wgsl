@@ -57,7 +57,8 @@ fn cube_face_duv(f: CubeFace, d: vec3f, dd: vec3f) -> vec2f {
 
 // One mip level of one face, bilinear, uv kept half a texel inside the face's edge.
 fn cube_face_sample(cubes: CubeArray, s: sampler, uv: vec2f, layer: i32, level: f32) -> vec4f {
-    let texels = max(f32(textureDimensions(cubes).x) / exp2(level), 1.0);
+    // A level's size is rounded down (a 300-texel face has 2 texels at level 7, not 2.34).
+    let texels = max(floor(f32(textureDimensions(cubes).x) / exp2(level)), 1.0);
     let margin = 0.5 / texels;
     return textureSampleLevel(cubes, s, clamp(uv, vec2f(margin), vec2f(1.0 - margin)), layer, level);
 }
@@ -101,4 +102,12 @@ fn texture_level_count(t: texture_2d<f32>) -> u32 {
     // log2 of half a texel more: a power of two is not rounded down by an inexact log2.
     let size = textureDimensions(t);
     return u32(floor(log2(f32(max(size.x, size.y)) + 0.5))) + 1u;
+}
+
+// Texel `position` of layer `layer` (cube layer / 6's face layer % 6) at level 0, for the mip
+// chain's face copy: the layer read directly, not through the face table above, so that a
+// mistake in the table shows at every level rather than being undone by the chain.
+fn cube_array_face_texel(cubes: CubeArray, s: sampler, position: vec2f, layer: u32) -> vec4f {
+    let uv = position / vec2f(textureDimensions(cubes));
+    return textureSampleLevel(cubes, s, uv, i32(layer), 0.0);
 }

@@ -173,7 +173,9 @@ impl Layers {
     /// What a 2D texture's layers are, read back from its size by GL's rule: what a texture made
     /// by [`Layers::texture`] was made as (a padded count reads as the padded number).
     /// On the WebGL2 profile, a square texture of `6n + 1` layers reads as `n` cubes, as
-    /// [`Layers::count`] makes them; no array made there has that count and is read back.
+    /// [`Layers::count`] makes them. A square array can have that count too (one point light's
+    /// six shadow layers are padded to seven): only the mip generator reads kinds back, and it is
+    /// given images and cubes, never arrays. Both are sampled through a 2D-array view there.
     pub fn of(texture: &wgpu::Texture, profile: Profile) -> Layers {
         Layers::by_gl_rule(texture.depth_or_array_layers(), texture.width() == texture.height(), profile)
     }

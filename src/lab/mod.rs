@@ -214,6 +214,14 @@ pub fn find(name: &str) -> Result<Lab, String> {
 impl Lab {
     /// The names of Mirador's declarations the lab routes (`const TRILINEAR_BY_HAND = true;` →
     /// `TRILINEAR_BY_HAND`).
+    /// Why the lab cannot run on a device of `profile`, if it cannot (its `webgl2` reason).
+    pub fn refusal(&self, profile: crate::shaders::Profile) -> Option<&str> {
+        match profile {
+            crate::shaders::Profile::WebGl2 => self.webgl2.as_deref(),
+            crate::shaders::Profile::Standard => None,
+        }
+    }
+
     pub fn route_names(&self) -> Vec<String> {
         self.routes.iter().filter_map(|route| source::declared_name(route)).collect()
     }

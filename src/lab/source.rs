@@ -5,7 +5,7 @@
 //! `file:line:column`.
 
 use super::Lab;
-use crate::shaders::{self, Wgsl};
+use crate::shaders::{self, Profile, Wgsl};
 
 /// A problem with the student's file, where it is.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -78,11 +78,29 @@ pub fn student(lab: &Lab, student: &str) -> Wgsl {
 
 /// Everything wrong with the student's file, empty when every surface module compiles with it.
 pub fn problems(lab: &Lab, text: &str) -> Vec<Problem> {
+    problems_on(lab, text, Profile::Standard)
+}
+
+/// [`problems`] for a device of `profile`: on WebGL2, the modules must also be written as GLSL
+/// ES 3.00 (naga checks WGSL, not what WebGL2's shading language lacks: `textureNumLevels`, a
+/// depth texel read, `firstLeadingBit`).
+pub fn problems_on(lab: &Lab, text: &str, profile: Profile) -> Vec<Problem> {
     let signatures = signature_problems(lab, text);
     if !signatures.is_empty() {
         return signatures;
     }
-    let Some(mut problem) = compile_problem(lab, text) else {
+    let compile = |text: &str| {
+        compile_problem(lab, text).or_else(|| match profile {
+            Profile::WebGl2 => webgl2_failures(&student(lab, text)).into_iter().next().map(|failure| Problem {
+                line: None,
+                column: None,
+                text: None,
+                message: format!("WebGL2 cannot compile it: {failure}"),
+            }),
+            Profile::Standard => None,
+        })
+    };
+    let Some(mut problem) = compile(text) else {
         return Vec::new();
     };
     if problem.line.is_none() {
@@ -92,7 +110,7 @@ pub fn problems(lab: &Lab, text: &str) -> Vec<Problem> {
             let (_, builtin) = builtin_declaration(&slot.name).expect("a lab's slots are Mirador's functions");
             let mut cured = text.to_owned();
             cured.replace_range(range.clone(), &builtin);
-            if compile_problem(lab, &cured).is_none() {
+            if compile(&cured).is_none() {
                 let line = text[..range.start].matches('\n').count() as u32 + 1;
                 problem.line = Some(line);
                 problem.column = Some(1);
@@ -250,6 +268,106 @@ fn naga_problem(composed: &str, start: usize, text: &str) -> Option<Problem> {
         }
         None => Some(Problem { line: None, column: None, text: None, message }),
     }
+}
+
+/// Built-in functions GLSL ES 3.10 added, which naga's writer emits for ES 3.00 all the same
+/// (it checks types and qualifiers against the version, not every function).
+const LATER_BUILTINS: &[&str] = &[
+    "textureGather",
+    "textureGatherOffset",
+    "textureQueryLevels",
+    "findMSB",
+    "findLSB",
+    "bitCount",
+    "bitfieldExtract",
+    "bitfieldInsert",
+    "bitfieldReverse",
+    "imageLoad",
+    "imageStore",
+];
+
+/// Every entry point of every pass of `wgsl`, composed for the WebGL2 profile, that WebGL2
+/// cannot compile, as `pass::entry: why`: each written as GLSL ES 3.00 by naga, as wgpu's GL
+/// backend writes it in the page. Entry points that write a storage buffer (`explain`'s) are
+/// left out: a WebGL2 device never draws with them.
+pub fn webgl2_failures(wgsl: &Wgsl) -> Vec<String> {
+    webgl2_written(wgsl, Profile::WebGl2).1
+}
+
+/// The entry points of `wgsl`'s passes composed for `profile` that GLSL ES 3.00 takes, and those
+/// it does not, with why (`tests/webgl2.rs` checks the standard profile fails, so this can).
+pub fn webgl2_written(wgsl: &Wgsl, profile: Profile) -> (Vec<String>, Vec<String>) {
+    let (mut written, mut failed) = (Vec::new(), Vec::new());
+    for (pass, source) in wgsl.for_profile(profile).passes() {
+        let module = match naga::front::wgsl::parse_str(&source) {
+            Ok(module) => module,
+            Err(e) => {
+                failed.push(format!("{pass}: {}", e.message()));
+                continue;
+            }
+        };
+        let validated =
+            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
+                .validate(&module);
+        let info = match validated {
+            Ok(info) => info,
+            Err(e) => {
+                failed.push(format!("{pass}: {}", e.as_inner()));
+                continue;
+            }
+        };
+        for (index, entry) in module.entry_points.iter().enumerate() {
+            let uses_storage = module.global_variables.iter().any(|(handle, var)| {
+                matches!(var.space, naga::AddressSpace::Storage { .. })
+                    && !info.get_entry_point(index)[handle].is_empty()
+            });
+            if uses_storage {
+                continue;
+            }
+            let name = format!("{pass}::{}", entry.name);
+            match glsl_es_300(&module, &info, entry) {
+                Ok(glsl) => match LATER_BUILTINS.iter().find(|f| glsl.contains(&format!("{f}("))) {
+                    Some(builtin) => failed.push(format!("{name}: {builtin}, which GLSL ES 3.00 lacks")),
+                    None => written.push(name),
+                },
+                Err(e) => failed.push(format!("{name}: {e}")),
+            }
+        }
+    }
+    (written, failed)
+}
+
+/// `entry` of `module` as GLSL ES 3.00 for WebGL, its overrides at their defaults.
+fn glsl_es_300(
+    module: &naga::Module,
+    info: &naga::valid::ModuleInfo,
+    entry: &naga::EntryPoint,
+) -> Result<String, String> {
+    let constants = naga::back::PipelineConstants::default();
+    let (module, info) =
+        naga::back::pipeline_constants::process_overrides(module, info, Some((entry.stage, &entry.name)), &constants)
+            .map_err(|e| e.to_string())?;
+    let options = naga::back::glsl::Options {
+        version: naga::back::glsl::Version::Embedded { version: 300, is_webgl: true },
+        ..Default::default()
+    };
+    let pipeline = naga::back::glsl::PipelineOptions {
+        shader_stage: entry.stage,
+        entry_point: entry.name.clone(),
+        multiview: None,
+    };
+    let mut glsl = String::new();
+    let mut writer = naga::back::glsl::Writer::new(
+        &mut glsl,
+        &module,
+        &info,
+        &options,
+        &pipeline,
+        naga::proc::BoundsCheckPolicies::default(),
+    )
+    .map_err(|e| e.to_string())?;
+    writer.write().map_err(|e| e.to_string())?;
+    Ok(glsl)
 }
 
 #[cfg(test)]

@@ -294,8 +294,11 @@ impl Viewer {
     pub fn open_lab(&mut self, name: &str) {
         match LabMode::open(name, self.profile) {
             Ok((lab, scene)) => {
-                self.settings = scene.settings.clone();
-                self.scene.replace(scene, &self.settings.clone());
+                let settings = scene.settings.clone();
+                // The lab's scene is its own: no overrides of the scene it replaces.
+                self.scene.overrides.clear();
+                self.scene.replace(scene, &settings);
+                self.settings = settings;
                 self.notice(format!("lab {name}: {}; write its functions in the editor", lab.lab.title));
                 self.lab = Some(lab);
             }
@@ -307,10 +310,7 @@ impl Viewer {
     #[cfg(target_arch = "wasm32")]
     pub fn set_lab_text(&mut self, text: String) {
         match self.lab.as_mut() {
-            Some(lab) => {
-                lab.text = text;
-                lab.edited();
-            }
+            Some(lab) => lab.replace_text(text),
             None => self.notice("no lab is open: choose one first".into()),
         }
     }

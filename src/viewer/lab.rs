@@ -14,11 +14,11 @@
 //! - The lab starts from its scene and the settings its first image test sets, never from what
 //!   the viewer remembered of another scene, and remembers nothing when it closes.
 //!
-//!
 //! In the page (`index.html`'s lab menu) the student's file is the text of an editor beside the
 //! view, taken in a moment after the last keystroke, checked the same way (naga's messages, at
-//! the same `line:column`), and downloaded with the page's button. The page draws the student's
-//! functions and the reference; the difference view and the checks run natively for now.
+//! the same `line:column`; on WebGL2 also as WebGL2 compiles it), and downloaded with the page's
+//! button. The page draws the student's functions and the reference; the difference view and the
+//! checks run natively for now.
 
 /// What the view shows in lab mode.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -336,7 +336,7 @@ mod page {
 
     use super::LabShown;
     use crate::lab::{Lab, source};
-    use crate::shaders::Wgsl;
+    use crate::shaders::{Profile, Wgsl};
 
     /// How long after the last keystroke the editor's text is checked and drawn.
     const PAUSE: Duration = Duration::from_millis(300);
@@ -354,14 +354,16 @@ mod page {
         pub problems: Vec<String>,
         pub shown: LabShown,
         changed: bool,
+        /// The device's profile: on WebGL2 the text must also compile to its shading language.
+        profile: Profile,
     }
 
     impl LabMode {
         /// The built-in lab `name`, its text the stub, and the scene its first image test draws.
         /// A lab whose routes WebGL2 cannot compile is refused there with its reason.
-        pub fn open(name: &str, profile: crate::shaders::Profile) -> anyhow::Result<(LabMode, crate::Scene)> {
+        pub fn open(name: &str, profile: Profile) -> anyhow::Result<(LabMode, crate::Scene)> {
             let lab = crate::lab::find(name).map_err(anyhow::Error::msg)?;
-            if let (crate::shaders::Profile::WebGl2, Some(reason)) = (profile, &lab.webgl2) {
+            if let Some(reason) = lab.refusal(profile) {
                 anyhow::bail!("this page draws with WebGL2 here, and the lab cannot run there: {reason}");
             }
             let test = lab.images.first().ok_or_else(|| anyhow::anyhow!("lab {} has no scene", lab.name))?;
@@ -376,6 +378,7 @@ mod page {
                 problems: Vec::new(),
                 shown: LabShown::Student,
                 changed: true,
+                profile,
             };
             mode.check();
             Ok((mode, scene))
@@ -386,9 +389,17 @@ mod page {
             self.edited = Some(Instant::now());
         }
 
-        /// Checks the text as `lab check` checks a file: adopted when it compiles.
+        /// A whole new text (a file the student opened): checked at once.
+        pub fn replace_text(&mut self, text: String) {
+            self.text = text;
+            self.edited = None;
+            self.check();
+        }
+
+        /// Checks the text as `lab check` checks a file (and, on WebGL2, as WebGL2 compiles it):
+        /// adopted when it compiles.
         fn check(&mut self) {
-            let problems = source::problems(&self.lab, &self.text);
+            let problems = source::problems_on(&self.lab, &self.text, self.profile);
             if problems.is_empty() {
                 self.student = source::student(&self.lab, &self.text);
                 self.generation += 1;
@@ -411,6 +422,8 @@ mod page {
             }
         }
 
+        /// When the text is next due a look: a pause after the last keystroke; none pending, an
+        /// hour away.
         pub fn next_poll(&self) -> Instant {
             self.edited.map_or_else(|| Instant::now() + Duration::from_secs(3600), |at| at + PAUSE)
         }

@@ -198,6 +198,12 @@ impl App {
         let size = self.options.size.unwrap_or(config.window);
         let vsync = !self.options.scripted();
         let mut screen = Screen::open(event_loop, "Mirador", size, vsync)?;
+        if let Some(reason) = self.lab.as_ref().and_then(|lab| lab.lab.refusal(screen.gpu.profile())) {
+            anyhow::bail!(
+                "{} draws with the WebGL2 profile, and this lab cannot run there: {reason}",
+                screen.gpu.describe()
+            );
+        }
         let scene = self.scene.take().context("the window opens once")?;
         let proxy = self.proxy.clone();
         let wake = move || {

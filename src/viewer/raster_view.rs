@@ -118,7 +118,9 @@ impl RasterView {
             readback: None,
             bound: None,
             report: FrameReport::default(),
-            reencode: (screen.composition == Composition::Textured && gpu.profile() == Profile::WebGl2)
+            // GL copies an sRGB texture into a plain one only with glCopyImageSubData, which
+            // WebGL2 and OpenGL ES 3.0 lack; a draw does it everywhere.
+            reencode: (screen.composition == Composition::Textured && gl_without_image_copies(gpu))
                 .then(|| Reencode::new(&gpu.device, DISPLAY_FORMAT)),
             traced_stride: 1,
         }
@@ -266,6 +268,14 @@ impl RasterView {
     pub fn reading_back(&self) -> bool {
         self.readback.is_some()
     }
+}
+
+/// Whether `gpu` is GL without copies between textures of formats that differ in sRGB-ness:
+/// WebGL2 and OpenGL ES 3.0 (the WebGL2 profile's devices), or GL in the browser whatever its
+/// profile.
+fn gl_without_image_copies(gpu: &Gpu) -> bool {
+    gpu.adapter.get_info().backend == wgpu::Backend::Gl
+        && (gpu.profile() == Profile::WebGl2 || cfg!(target_arch = "wasm32"))
 }
 
 /// The texture egui samples: the raster image's bytes, not decoded.

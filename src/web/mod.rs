@@ -127,7 +127,10 @@ impl App {
         }
         match viewer.frame(screen) {
             Ok(end) => {
-                self.next_frame = end.next;
+                // The next frame asked for, or the look at the lab's text after a pause in the
+                // typing, whichever first (the page watches no scene file).
+                let lab = viewer.lab.as_ref().map(crate::viewer::lab::LabMode::next_poll);
+                self.next_frame = [end.next, lab].into_iter().flatten().min();
                 if !self.first_frame_shown {
                     self.first_frame_shown = true;
                     // From the start of the page's load: what a cold visit waits (web/README.md).

@@ -17,7 +17,6 @@ use std::sync::OnceLock;
 use mirador::gpu::Gpu;
 use mirador::{RenderSettings, Scene};
 
-/// The device every test in this binary shares (device creation dominates small renders).
 /// Every scene under `assets/scenes/` and `assets/scenes/course/`, in order.
 pub fn scene_files() -> Vec<PathBuf> {
     let mut files = Vec::new();
@@ -32,6 +31,7 @@ pub fn scene_files() -> Vec<PathBuf> {
     files
 }
 
+/// The device every test in this binary shares (device creation dominates small renders).
 pub fn gpu() -> &'static Gpu {
     static GPU: OnceLock<Gpu> = OnceLock::new();
     GPU.get_or_init(|| {

@@ -398,8 +398,9 @@ pub struct EnvironmentMaps {
     pub cube: MapTexture,
     pub sphere: MapTexture,
     pub latlong: MapTexture,
-    /// Six layers per object of `SceneGpu::env_objects`, in a cube array of at least two cubes
-    /// ([`Layers::count`]; 1×1 texels for none, unused).
+    /// Six layers per object of `SceneGpu::env_objects`, in a cube array of at least two cubes,
+    /// or a 2D array of `6n + 1` layers on the WebGL2 profile ([`Layers::count`]; 1×1 texels for
+    /// none, unused).
     pub dynamic: MapTexture,
     /// How many of the cube array's cubes belong to objects.
     dynamic_cubes: u32,
