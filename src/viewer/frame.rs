@@ -306,6 +306,28 @@ impl Viewer {
         }
     }
 
+    /// The step `lab student|reference|difference`.
+    fn lab_step(&mut self, shown: super::lab::LabShown) -> anyhow::Result<()> {
+        match &mut self.lab {
+            Some(lab) => lab.show(shown),
+            None => bail!("`lab {}`: the viewer is not in lab mode (mirador view --lab DIR)", shown.label()),
+        }
+        Ok(())
+    }
+
+    /// The step `lab open NAME`: the page's lab menu.
+    #[cfg(target_arch = "wasm32")]
+    fn lab_open_step(&mut self, name: &str) -> anyhow::Result<()> {
+        self.open_lab(name);
+        Ok(())
+    }
+
+    /// The step `lab open NAME`, which natively has no lab to open without a folder.
+    #[cfg(not(target_arch = "wasm32"))]
+    fn lab_open_step(&mut self, name: &str) -> anyhow::Result<()> {
+        bail!("`lab open {name}` is the page's; natively: mirador lab new {name} DIR, then mirador view --lab DIR")
+    }
+
     /// The page's lab: the editor's text replaced (a file the student opened), checked at once.
     #[cfg(target_arch = "wasm32")]
     pub fn set_lab_text(&mut self, text: String) {
@@ -421,7 +443,7 @@ impl Viewer {
         // The page's lab editor edits the text out of the lab while the panel reads the rest.
         #[cfg(target_arch = "wasm32")]
         let mut editing =
-            self.lab.as_mut().map(|lab| (lab.lab.file.clone(), std::mem::take(&mut lab.text), lab.problems.clone()));
+            self.lab.as_mut().map(|lab| (lab.lab.file.clone(), std::mem::take(&mut lab.text), lab.problems().to_vec()));
         let mut model = UiModel {
             settings: &self.settings,
             scene: &mut self.scene,
@@ -857,18 +879,8 @@ impl Viewer {
             Step::WaitFor(time) => self.script.wait_until = Some(Instant::now() + time),
             Step::WaitTraced => self.script.wait_traced_since = Some(Instant::now()),
             Step::Screenshot(path) => self.screenshot = Some(path),
-            Step::Lab(shown) => match &mut self.lab {
-                Some(lab) => lab.show(shown),
-                None => bail!("`lab {}`: the viewer is not in lab mode (mirador view --lab DIR)", shown.label()),
-            },
-            #[cfg(target_arch = "wasm32")]
-            Step::LabOpen(name) => self.open_lab(&name),
-            #[cfg(not(target_arch = "wasm32"))]
-            Step::LabOpen(name) => {
-                bail!(
-                    "`lab open {name}` is the page's; natively: mirador lab new {name} DIR, then mirador view --lab DIR"
-                )
-            }
+            Step::Lab(shown) => self.lab_step(shown)?,
+            Step::LabOpen(name) => self.lab_open_step(&name)?,
         }
         Ok(())
     }

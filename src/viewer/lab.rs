@@ -75,6 +75,54 @@ pub struct LabPanel<'a> {
     pub how: &'static str,
 }
 
+/// What a lab mode draws, natively and in the page alike: the student's functions as last
+/// compiled (the stub's until a version does), and why the text is not the one drawn.
+struct Compiled {
+    student: crate::shaders::Wgsl,
+    /// How many versions of the student's text compiled so far.
+    generation: u64,
+    /// Each problem at its place, as `lab check` prints it; empty when the text is the one drawn.
+    problems: Vec<String>,
+    /// The shader the view draws with changed: the frame rebuilds its renderer.
+    changed: bool,
+}
+
+impl Compiled {
+    fn stub(lab: &crate::lab::Lab) -> Compiled {
+        let student = crate::lab::source::student(lab, &lab.stub());
+        Compiled { student, generation: 0, problems: Vec::new(), changed: true }
+    }
+
+    /// Takes in the student's `text` (the file `file`) with its `problems`: adopted when it has
+    /// none. Returns whether it was.
+    fn take_in(&mut self, lab: &crate::lab::Lab, text: &str, problems: &[crate::lab::source::Problem]) -> bool {
+        if problems.is_empty() {
+            self.student = crate::lab::source::student(lab, text);
+            self.generation += 1;
+            self.problems.clear();
+            self.changed = true;
+            true
+        } else {
+            self.problems = problems.iter().map(|p| p.display(&lab.file)).collect();
+            false
+        }
+    }
+
+    /// What the view draws while the text does not compile.
+    fn fallback(&self) -> &'static str {
+        if self.generation == 0 { "the stub's neutral functions" } else { "the last version that compiled" }
+    }
+
+    /// What the view draws with: the student's functions, or in the reference view Mirador's
+    /// (the difference view draws the student's under its error map).
+    fn wgsl(&self, lab: &crate::lab::Lab, shown: LabShown) -> crate::shaders::Wgsl {
+        match shown {
+            LabShown::Reference => crate::lab::source::reference(lab),
+            LabShown::Student | LabShown::Difference => self.student.clone(),
+        }
+    }
+}
+
 #[cfg(not(target_arch = "wasm32"))]
 pub use native::LabMode;
 
@@ -103,20 +151,13 @@ mod native {
         /// writes within one tick of the clock still changes the length.
         modified: Option<(SystemTime, u64)>,
         checked: Instant,
-        /// The student's functions as last compiled (the stub's neutral bodies until a version
-        /// does), and how many versions compiled so far.
-        student: Wgsl,
-        generation: u64,
-        /// Why the saved file is not the one drawn: each problem at its place, as `lab check`
-        /// prints it. Empty when the file drawn is the file saved.
-        pub problems: Vec<String>,
+        /// What the view draws of the student's file.
+        compiled: super::Compiled,
         pub shown: LabShown,
         /// The difference view's image and mean, and what it was made from.
         pub difference: Option<ShownDifference>,
         /// The renderers that draw it, kept from one view to the next.
         renderers: Option<DifferenceRenderers>,
-        /// The shader the view draws with changed: the frame rebuilds its renderer.
-        changed: bool,
     }
 
     /// The two renderers the difference view draws with, kept while the student's functions, the
@@ -162,17 +203,14 @@ mod native {
             let scene = crate::lab::images::scene(&test, Some(dir)).map_err(anyhow::Error::msg)?;
             let file = dir.join(&lab.file);
             let mut mode = LabMode {
-                student: source::student(&lab, &lab.stub()),
+                compiled: super::Compiled::stub(&lab),
                 lab,
                 modified: None,
                 checked: Instant::now(),
                 file,
-                generation: 0,
-                problems: Vec::new(),
                 shown: LabShown::Student,
                 difference: None,
                 renderers: None,
-                changed: true,
             };
             mode.read();
             Ok((mode, scene))
@@ -186,20 +224,16 @@ mod native {
             let text = match std::fs::read_to_string(&self.file) {
                 Ok(text) => text,
                 Err(e) => {
-                    self.problems = vec![format!("{}: {e}", self.file.display())];
+                    self.compiled.problems = vec![format!("{}: {e}", self.file.display())];
                     return true;
                 }
             };
             let problems = source::problems(&self.lab, &text);
-            if problems.is_empty() {
-                self.student = source::student(&self.lab, &text);
-                self.generation += 1;
-                self.problems.clear();
-                self.changed = true;
+            if self.compiled.take_in(&self.lab, &text, &problems) {
                 println!("lab: {name} compiles; the view draws it");
             } else {
-                self.problems = problems.iter().map(|p| p.display(&name)).collect();
-                println!("lab: {name} does not compile; the view draws {}\n{}", self.fallback(), self.problems[0]);
+                let (fallback, first) = (self.compiled.fallback(), &self.compiled.problems[0]);
+                println!("lab: {name} does not compile; the view draws {fallback}\n{first}");
             }
             true
         }
@@ -217,14 +251,9 @@ mod native {
             self.read()
         }
 
-        /// What the view draws while the saved file does not compile.
-        fn fallback(&self) -> &'static str {
-            if self.generation == 0 { "the stub's neutral functions" } else { "the last version that compiled" }
-        }
-
         /// Whether the shader the view draws with changed since the last call.
         pub fn take_changed(&mut self) -> bool {
-            std::mem::take(&mut self.changed)
+            std::mem::take(&mut self.compiled.changed)
         }
 
         /// When the file is next due a look.
@@ -232,13 +261,9 @@ mod native {
             self.checked + WATCH_PERIOD
         }
 
-        /// What the view draws with: the student's functions, or in the reference view
-        /// Mirador's (the difference view draws the student's under its error map).
+        /// What the view draws with ([`super::Compiled::wgsl`]).
         pub fn wgsl(&self) -> Wgsl {
-            match self.shown {
-                LabShown::Reference => source::reference(&self.lab),
-                LabShown::Student | LabShown::Difference => self.student.clone(),
-            }
+            self.compiled.wgsl(&self.lab, self.shown)
         }
 
         /// What the window shows of the lab.
@@ -248,8 +273,8 @@ mod native {
                 title: &self.lab.title,
                 file: &self.file,
                 shown: self.shown,
-                problems: &self.problems,
-                fallback: self.fallback(),
+                problems: &self.compiled.problems,
+                fallback: self.compiled.fallback(),
                 difference: self.difference.as_ref().map(|d| (d.texture.id(), d.flip_mean)),
                 choices: &LabShown::ALL,
                 how: "redrawn when saved; `mirador lab check DIR` runs the tests",
@@ -260,7 +285,7 @@ mod native {
         pub fn show(&mut self, shown: LabShown) {
             if shown != self.shown {
                 self.shown = shown;
-                self.changed = true;
+                self.compiled.changed = true;
             }
         }
 
@@ -275,13 +300,13 @@ mod native {
                 lights: scene.lights.clone(),
                 settings: scene.settings.clone(),
                 revision,
-                generation: self.generation,
+                generation: self.compiled.generation,
             };
             if self.difference.as_ref().is_some_and(|d| d.inputs == inputs) {
                 return;
             }
-            let made_for = (self.generation, revision, (scene.camera.width, scene.camera.height));
-            let (lab, student, kept) = (&self.lab, &self.student, &mut self.renderers);
+            let made_for = (self.compiled.generation, revision, (scene.camera.width, scene.camera.height));
+            let (lab, student, kept) = (&self.lab, &self.compiled.student, &mut self.renderers);
             let drawn = gpu.checked(|| {
                 let renderers = match kept.take() {
                     Some(renderers) if renderers.made_for == made_for => renderers,
@@ -347,13 +372,9 @@ mod page {
         pub text: String,
         /// The last keystroke not yet checked.
         edited: Option<Instant>,
-        /// The student's functions as last compiled (the stub's until a version does).
-        student: Wgsl,
-        generation: u64,
-        /// Why the text is not the one drawn, each problem at its place.
-        pub problems: Vec<String>,
+        /// What the view draws of the student's text.
+        compiled: super::Compiled,
         pub shown: LabShown,
-        changed: bool,
         /// The device's profile: on WebGL2 the text must also compile to its shading language.
         profile: Profile,
     }
@@ -368,19 +389,14 @@ mod page {
             }
             let test = lab.images.first().ok_or_else(|| anyhow::anyhow!("lab {} has no scene", lab.name))?;
             let scene = crate::lab::images::scene(test, None).map_err(anyhow::Error::msg)?;
-            let text = lab.stub();
-            let mut mode = LabMode {
-                student: source::student(&lab, &text),
+            let mode = LabMode {
+                compiled: super::Compiled::stub(&lab),
+                text: lab.stub(),
                 lab,
-                text,
                 edited: None,
-                generation: 0,
-                problems: Vec::new(),
                 shown: LabShown::Student,
-                changed: true,
                 profile,
             };
-            mode.check();
             Ok((mode, scene))
         }
 
@@ -400,14 +416,12 @@ mod page {
         /// adopted when it compiles.
         fn check(&mut self) {
             let problems = source::problems_on(&self.lab, &self.text, self.profile);
-            if problems.is_empty() {
-                self.student = source::student(&self.lab, &self.text);
-                self.generation += 1;
-                self.problems.clear();
-                self.changed = true;
-            } else {
-                self.problems = problems.iter().map(|p| p.display(&self.lab.file)).collect();
-            }
+            self.compiled.take_in(&self.lab, &self.text, &problems);
+        }
+
+        /// Why the text is not the one drawn, each problem at its place.
+        pub fn problems(&self) -> &[String] {
+            &self.compiled.problems
         }
 
         /// Checks the text once the student paused; returns whether the window must be drawn.
@@ -428,19 +442,12 @@ mod page {
             self.edited.map_or_else(|| Instant::now() + Duration::from_secs(3600), |at| at + PAUSE)
         }
 
-        fn fallback(&self) -> &'static str {
-            if self.generation <= 1 { "the stub's neutral functions" } else { "the last version that compiled" }
-        }
-
         pub fn take_changed(&mut self) -> bool {
-            std::mem::take(&mut self.changed)
+            std::mem::take(&mut self.compiled.changed)
         }
 
         pub fn wgsl(&self) -> Wgsl {
-            match self.shown {
-                LabShown::Reference => source::reference(&self.lab),
-                LabShown::Student | LabShown::Difference => self.student.clone(),
-            }
+            self.compiled.wgsl(&self.lab, self.shown)
         }
 
         pub fn panel(&self) -> super::LabPanel<'_> {
@@ -449,8 +456,8 @@ mod page {
                 title: &self.lab.title,
                 file: std::path::Path::new(&self.lab.file),
                 shown: self.shown,
-                problems: &self.problems,
-                fallback: self.fallback(),
+                problems: &self.compiled.problems,
+                fallback: self.compiled.fallback(),
                 difference: None,
                 choices: &[LabShown::Student, LabShown::Reference],
                 how: "redrawn as you type; the checks run natively: `mirador lab check DIR` on the downloaded file",
@@ -462,7 +469,7 @@ mod page {
             let shown = if shown == LabShown::Difference { LabShown::Student } else { shown };
             if shown != self.shown {
                 self.shown = shown;
-                self.changed = true;
+                self.compiled.changed = true;
             }
         }
 
