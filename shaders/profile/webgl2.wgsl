@@ -64,7 +64,11 @@ fn cube_face_sample(cubes: CubeArray, s: sampler, uv: vec2f, layer: i32, level: 
 }
 
 fn cube_array_sample_level(cubes: CubeArray, s: sampler, d: vec3f, cube: i32, level: f32) -> vec4f {
-    let f = cube_face_of(d);
+    return cube_face_trilinear(cubes, s, cube_face_of(d), d, cube, level);
+}
+
+// Direction d on face f of cube `cube`, at mip level `level`: the two levels around it, blended.
+fn cube_face_trilinear(cubes: CubeArray, s: sampler, f: CubeFace, d: vec3f, cube: i32, level: f32) -> vec4f {
     let uv = cube_face_uv_of(f, d);
     let layer = 6 * cube + f.face;
     let below = floor(level);
@@ -82,7 +86,7 @@ fn cube_array_sample_grad(cubes: CubeArray, s: sampler, d: vec3f, cube: i32, dx:
     let size = f32(textureDimensions(cubes).x);
     let step = max(length(cube_face_duv(f, d, dx)), length(cube_face_duv(f, d, dy))) * size;
     let level = max(log2(max(step, 1e-8)), 0.0);
-    return cube_array_sample_level(cubes, s, d, cube, level);
+    return cube_face_trilinear(cubes, s, f, d, cube, level);
 }
 
 fn gather_compare(map: texture_depth_2d_array, cmp: sampler_comparison, corner: vec2f, layer: u32, depth: f32) -> vec4f {

@@ -201,10 +201,11 @@ impl MipmapGenerator {
         if levels <= 1 || layers.is_empty() {
             return;
         }
-        let face_copy = self.face_copy(texture, shaders::Profile::of(device));
+        let profile = shaders::Profile::of(device);
+        let face_copy = self.face_copy(texture, profile);
         let pipeline = self.pipeline(device, texture.format());
         let scratch = scratch_chain(device, texture);
-        let face = face_copy.map(|copy| self.face_source(device, texture, copy));
+        let face = face_copy.map(|copy| self.face_source(device, texture, copy, profile));
         encoder.push_debug_group("mipmap");
         for layer in layers {
             if let Some(face) = &face {
@@ -252,7 +253,13 @@ impl MipmapGenerator {
 
     /// A cube's level 0, one face at a time, as the 2D image level 1 reads; and the group that
     /// reads the whole cube (its level 0) to draw it.
-    fn face_source<'a>(&self, device: &wgpu::Device, texture: &wgpu::Texture, copy: &'a FaceCopy) -> FaceSource<'a> {
+    fn face_source<'a>(
+        &self,
+        device: &wgpu::Device,
+        texture: &wgpu::Texture,
+        copy: &'a FaceCopy,
+        profile: shaders::Profile,
+    ) -> FaceSource<'a> {
         let image = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("mipmap::face"),
             size: wgpu::Extent3d { depth_or_array_layers: 1, ..texture.size() },
@@ -265,10 +272,7 @@ impl MipmapGenerator {
         });
         let cube = texture.create_view(&wgpu::TextureViewDescriptor {
             label: Some("mipmap::face_source"),
-            dimension: Some({
-                let profile = shaders::Profile::of(device);
-                Layers::of(texture, profile).view_dimension(profile)
-            }),
+            dimension: Some(Layers::of(texture, profile).view_dimension(profile)),
             base_mip_level: 0,
             mip_level_count: Some(1),
             ..Default::default()

@@ -185,7 +185,7 @@ impl RasterView {
             let mut encoder = gpu
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("viewer::raster::copy") });
-            match &self.reencode {
+            match &mut self.reencode {
                 Some(reencode) => reencode.record(&gpu.device, &mut encoder, &frame.image.view, display_view),
                 None => encoder.copy_texture_to_texture(
                     frame.image.texture.as_image_copy(),

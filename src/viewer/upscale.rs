@@ -109,6 +109,8 @@ pub struct Reencode {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
+    /// The group reading the last image drawn, kept while that image is.
+    input: Option<(wgpu::TextureView, wgpu::BindGroup)>,
 }
 
 impl Reencode {
@@ -117,32 +119,36 @@ impl Reencode {
         let (pipeline, layout) = image_pipeline(device, "fs_reencode", target_format);
         let sampler =
             device.create_sampler(&wgpu::SamplerDescriptor { label: Some("upscale::reencode"), ..Default::default() });
-        Reencode { pipeline, layout, sampler }
+        Reencode { pipeline, layout, sampler, input: None }
     }
 
     /// Draws `image` (an sRGB view) into `target` (a plain view of the same size).
     pub fn record(
-        &self,
+        &mut self,
         device: &wgpu::Device,
         encoder: &mut wgpu::CommandEncoder,
         image: &wgpu::TextureView,
         target: &wgpu::TextureView,
     ) {
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("upscale::reencode_group"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(image) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
-            ],
-        });
+        if self.input.as_ref().is_none_or(|(view, _)| view != image) {
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("upscale::reencode_group"),
+                layout: &self.layout,
+                entries: &[
+                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(image) },
+                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                ],
+            });
+            self.input = Some((image.clone(), group));
+        }
+        let (_, group) = self.input.as_ref().expect("made just above");
         let mut pass = encoder.begin_render_pass(&layout::pass(
             "upscale::reencode",
             &[Some(layout::color_attachment(target, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))],
             None,
         ));
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &group, &[]);
+        pass.set_bind_group(0, group, &[]);
         pass.draw(0..3, 0..1);
     }
 }
