@@ -369,8 +369,9 @@ fn lab(command: LabCommand) -> ExitCode {
         LabCommand::Check { dir, tests, points, time_limit } => {
             let time_limit =
                 std::time::Duration::try_from_secs_f64(time_limit).unwrap_or(std::time::Duration::from_secs(30));
-            check::check(&check::Options { dir, hidden: tests, points, time_limit }).map(|report| {
+            check::check(&check::Options { dir: dir.clone(), hidden: tests, points, time_limit }).map(|report| {
                 print!("{}", report::text(&report));
+                println!("(written: {} and {})", dir.join("results.json").display(), dir.join("report.md").display());
                 report.passed()
             })
         }

@@ -480,3 +480,54 @@ fn explain_reads_the_students_blend() {
     assert!(raster.radiance.min_element() > 0.45, "the student's blend drew {}", raster.radiance);
     assert!((sum - raster.radiance).abs().max_element() <= 2e-3, "terms {sum} against {}", raster.radiance);
 }
+
+/// The checks the viewer's lab panel runs, a step at a time as the page must (`Progress`), find
+/// what `lab check` finds for the same file: the same tests pass, with the same scores and the
+/// same mistakes named, for the answer key, the stub and a mistake. On the standard profile
+/// (Vulkan) and on the WebGL2 one (GL), where the page runs without WebGPU: the known answers
+/// are one-pixel draws, which WebGL2 can do.
+#[test]
+fn the_panels_checks_find_what_lab_check_finds() {
+    use mirador::gpu::Gpu;
+    use mirador::lab::checks::Progress;
+    let lab = lab::find("planar-mirrors").expect("a built-in lab");
+    let devices = [
+        ("standard", Gpu::headless_on(wgpu::Backends::VULKAN).expect("a Vulkan device")),
+        ("webgl2", Gpu::headless_webgl2_on(wgpu::Backends::GL).expect("a GL device")),
+    ];
+    let cases = [("key", lab.solution()), ("stub", lab.stub()), ("mistake", lab.mistaken(&lab.mistakes[0]))];
+    for (case, text) in cases {
+        let dir = folder(&lab.name, &format!("panel-{case}"), false);
+        std::fs::write(dir.join(&lab.file), &text).expect("writing the student's file");
+        let (_, cli) = check(&dir, &[]);
+        for (profile, gpu) in &devices {
+            let mut progress = Progress::start(gpu, &lab, &text);
+            let mut polls = 0;
+            while !progress.done() {
+                if !progress.advance() {
+                    gpu.wait();
+                }
+                polls += 1;
+                assert!(polls < 100_000, "{case} on {profile}: the check never ends");
+            }
+            let report: serde_json::Value =
+                serde_json::from_str(&mirador::lab::report::results_json(&progress.report())).expect("JSON");
+            let (theirs, mine) = (tests_of(&cli), tests_of(&report));
+            assert_eq!(mine.len(), theirs.len());
+            for (index, (mine, theirs)) in mine.iter().zip(theirs).enumerate() {
+                let what = format!(
+                    "{case} on {profile}, {}:\n{}\nlab check: {}",
+                    mine["name"], mine["output"], theirs["output"]
+                );
+                assert_eq!(mine["name"], theirs["name"], "{what}");
+                assert_eq!(mine["score"], theirs["score"], "{what}");
+                assert_eq!(mine["mistake"], theirs["mistake"], "{what}");
+                let pictured = progress.pictures()[index].is_some();
+                assert_eq!(pictured, index >= lab.known_answers.len(), "{what}: pictures for image tests only");
+            }
+            assert_eq!(report["score"], cli["score"], "{case} on {profile}");
+            eprintln!("{case} on {profile}: {} / {} points, {polls} polls", report["score"], report["max_score"]);
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

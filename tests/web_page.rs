@@ -195,4 +195,50 @@ fn the_page_draws_what_the_native_renderers_draw() {
     assert!(error <= MAX_CROSS_GPU_FLIP, "a typo did not keep the last version drawn: {error}");
     let boxed = flip(&crop(&solved, lab_view), &crop(&typo, lab_view), "lab-typo-box", &dir);
     assert!(boxed > 0.001, "the typo's problem is not shown over the view: {boxed}");
+
+    lab_checks_in_the_page(&dir, &lab, gpu);
+}
+
+/// The lab's checks run in the page (the panel's Check button) on a wrong solution and a right
+/// one: the wrong fails, naming the known mistake it makes, the right passes every test, and
+/// each test scores as the native checker scores the same text on the same kind of device (the
+/// standard profile natively for the page's WebGPU, the WebGL2 profile on GL for its WebGL2).
+fn lab_checks_in_the_page(dir: &Path, lab: &mirador::lab::Lab, gpu: &mirador::gpu::Gpu) {
+    let read = |name: &str| std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+    // web/test.sh names each run's folder after the API the page drew with.
+    let webgl2 = dir.file_name().is_some_and(|name| name == "webgl2");
+    let gl;
+    let device = if webgl2 {
+        gl = mirador::gpu::Gpu::headless_webgl2_on(wgpu::Backends::GL).expect("a GL device");
+        &gl
+    } else {
+        gpu
+    };
+    for (case, passes) in [("lab-wrong", false), ("lab-right", true)] {
+        let text = read(&format!("{case}.wgsl"));
+        let page: serde_json::Value = serde_json::from_str(&read(&format!("{case}.json"))).expect("results.json");
+        let mut native = mirador::lab::checks::Progress::start(device, lab, &text);
+        while !native.done() {
+            if !native.advance() {
+                device.wait();
+            }
+        }
+        let tests = page["tests"].as_array().expect("results.json lists its tests");
+        assert_eq!(tests.len(), native.results().len(), "{case}");
+        for (theirs, ours) in tests.iter().zip(native.results()) {
+            let what = format!("{case}, {}:\npage: {}\nnative: {}", ours.name, theirs["output"], ours.output);
+            assert_eq!(theirs["name"], ours.name.as_str(), "{what}");
+            assert_eq!(theirs["score"].as_f64(), Some(f64::from(ours.score)), "{what}");
+            assert_eq!(theirs["mistake"].as_str(), ours.mistake.as_deref(), "{what}");
+        }
+        let (score, max) = (page["score"].as_f64().unwrap(), page["max_score"].as_f64().unwrap());
+        eprintln!("{case}: {score} / {max} points in the page ({} s)", page["execution_time"]);
+        if passes {
+            assert_eq!(score, max, "the right solution does not pass in the page:\n{page:#}");
+        } else {
+            assert!(score < max, "the wrong solution passes in the page:\n{page:#}");
+            let named = tests.iter().any(|t| t["mistake"] == "d not doubled");
+            assert!(named, "no failing test names the mistake the wrong solution makes:\n{page:#}");
+        }
+    }
 }

@@ -1,21 +1,42 @@
 // The browser test's page side (web/test.sh loads `index.html?test`). Everything goes through the
 // page's own interface, `mirador.step(...)`, which the scene menu and the file picker use too:
 // the showcase as it opens, the shadows toggled off, the split view once the tracer has finished
-// in the page, the difference view, the hybrid's traced shadows over acned shadow maps, and a lab's
-// stub and reference. Each screenshot (the whole canvas, PNG) is posted to the
+// in the page, the difference view, the hybrid's traced shadows over acned shadow maps, a lab's
+// stub and reference, a student's edits, and the lab's checks run in the page on a wrong solution
+// and a right one (their results.json posted as `lab-wrong.json`, `lab-right.json`, with the
+// texts checked). Each screenshot (the whole canvas, PNG) is posted to the
 // test server with the 3D view's rectangle; `done` ends the run, `failed` says why it stopped.
 const post = (path, body, view) =>
   fetch(path, { method: "POST", body, headers: view ? { "X-View": view.join(" ") } : {} });
 
+// Every screenshot, check text and results.json the run posts, counted: `done` follows the last.
+let expected = 0;
+let posted = 0;
+const count = async () => {
+  if (++posted === expected) await post("/capture/done", "done");
+};
+
 export function run(mirador) {
-  let expected = 0;
-  let posted = 0;
+  // What the page does next once a screenshot is posted: the lab's steps follow one another.
+  const after = {
+    "lab-reference.png": () => editTheLab(mirador),
+    "lab-solved.png": () => typo(mirador),
+    "lab-typo.png": () => check(mirador, "lab-wrong", WRONG),
+    "lab-checked.png": () => check(mirador, "lab-right", REFLECTION),
+  };
   window.miradorScreenshot = async (name, png, view) => {
     await post(`/capture/${name}`, png, view);
-    if (name === "lab-reference.png") editTheLab(mirador);
-    if (++posted === expected) await post("/capture/done", "done");
+    after[name]?.();
+    await count();
   };
   window.miradorError = (text) => post("/capture/failed", text);
+  // The page's own handler (it enables the results' download) keeps running.
+  const page = window.miradorLabChecked;
+  window.miradorLabChecked = async (json) => {
+    page?.(json);
+    await post(`/capture/${checking}.json`, json);
+    await count();
+  };
   const steps = [
     "overlay off",
     "wait 2s",
@@ -54,7 +75,9 @@ export function run(mirador) {
     "wait 4s",
     "screenshot lab-reference.png",
   ];
-  expected = [...steps, ...LAB_EDITS, ...LAB_TYPO].filter((s) => s.startsWith("screenshot")).length;
+  const screenshots = [...steps, ...LAB_EDITS, ...LAB_TYPO, ...CHECK].filter((s) => s.startsWith("screenshot"));
+  // And each check's text and results.json.
+  expected = screenshots.length + 4;
   for (const step of steps) mirador.step(step);
 }
 
@@ -78,14 +101,26 @@ const LAB_TYPO = ["wait 4s", "screenshot lab-typo.png"];
 function editTheLab(mirador) {
   mirador.set_lab_text(REFLECTION);
   for (const step of LAB_EDITS) mirador.step(step);
-  // The typo once the solved screenshot's steps have run (steps run one a frame, in order).
-  const typo = () => {
-    mirador.set_lab_text(REFLECTION.replace("let d = plane.w;", "let d = plane.w"));
-    for (const step of LAB_TYPO) mirador.step(step);
-  };
-  const previous = window.miradorScreenshot;
-  window.miradorScreenshot = async (name, png, view) => {
-    await previous(name, png, view);
-    if (name === "lab-solved.png") typo();
-  };
+}
+
+// The typo once the solved screenshot is posted.
+function typo(mirador) {
+  mirador.set_lab_text(REFLECTION.replace("let d = plane.w;", "let d = plane.w"));
+  for (const step of LAB_TYPO) mirador.step(step);
+}
+
+// The lab's checks in the page, as a student runs them with the panel's Check button: first on a
+// wrong solution (the mirror's offset not doubled: the lab's known mistake "d not doubled"),
+// whose panel is screenshot, then on the right one. Each check's text and results.json go to the
+// test server, which holds them against the native checker's (tests/web_page.rs).
+const WRONG = REFLECTION.replaceAll("-2.0 * d * n.", "-d * n.");
+const CHECK = ["lab check", "wait checked", "wait 1s", "screenshot lab-checked.png"];
+let checking = "";
+
+async function check(mirador, name, text) {
+  checking = name;
+  await post(`/capture/${name}.wgsl`, text);
+  mirador.set_lab_text(text);
+  for (const step of name === "lab-wrong" ? CHECK : CHECK.slice(0, 2)) mirador.step(step);
+  await count();
 }

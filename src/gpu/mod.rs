@@ -13,7 +13,9 @@ use std::sync::Arc;
 pub use crate::shaders::Profile;
 use web_time::Instant;
 
-/// A wgpu device and the instance and adapter it came from.
+/// A wgpu device and the instance and adapter it came from. A clone shares the same device (wgpu's
+/// handles are counted references), for work that outlives a borrow: the page's lab checks.
+#[derive(Clone)]
 pub struct Gpu {
     pub instance: wgpu::Instance,
     pub adapter: wgpu::Adapter,
@@ -242,6 +244,25 @@ impl Gpu {
     #[cfg(target_arch = "wasm32")]
     pub fn checked<T>(&self, work: impl FnOnce() -> T) -> Result<T, GpuError> {
         Ok(work())
+    }
+
+    /// [`Gpu::checked`] as a future, which the page can wait for too: the error scopes are pushed
+    /// and popped around `work` at once, and their answers awaited (in the browser they come after
+    /// the page returns to its event loop). The lab's checks draw this way, so that a student's
+    /// function the device rejects is a failed test with the device's reason in the page as
+    /// natively, not an image of zeros.
+    pub async fn checked_later<T>(&self, work: impl FnOnce() -> T) -> Result<T, GpuError> {
+        let out_of_memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let internal = self.device.push_error_scope(wgpu::ErrorFilter::Internal);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let value = work();
+        // Popped innermost first, as scopes must be; answered later.
+        let (validation, internal, out_of_memory) = (validation.pop(), internal.pop(), out_of_memory.pop());
+        let (validation, internal, out_of_memory) = (validation.await, internal.await, out_of_memory.await);
+        match out_of_memory.or(internal).or(validation) {
+            None => Ok(value),
+            Some(error) => Err(reported(&error)),
+        }
     }
 
     /// Runs `work` with its GPU errors captured: an out-of-memory, internal or validation error

@@ -105,6 +105,39 @@ impl Pending {
     pub fn size(&self) -> (u32, u32) {
         (self.width, self.height)
     }
+
+    /// The texels, once the GPU has copied them: a future that is ready when [`Pending::take`]
+    /// is. Its driver polls it again after the device made progress ([`block_on`], or the
+    /// page's next frame); it registers no waker.
+    pub async fn texels(self, device: &wgpu::Device) -> Result<Vec<u8>, ReadbackError> {
+        std::future::poll_fn(|_| match self.take(device) {
+            Some(result) => std::task::Poll::Ready(result),
+            None => std::task::Poll::Pending,
+        })
+        .await
+    }
+}
+
+/// Runs `future` (whose only waits are GPU readbacks) to its end, waiting for the device whenever
+/// it is not ready: how the native side drives code the page drives a frame at a time.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn block_on<T>(device: &wgpu::Device, future: impl std::future::Future<Output = T>) -> T {
+    let mut future = std::pin::pin!(future);
+    loop {
+        if let Some(value) = poll_once(future.as_mut()) {
+            return value;
+        }
+        // An error here is a lost device, which the readback then reports as a failed mapping.
+        let _ = device.poll(wgpu::PollType::wait_indefinitely());
+    }
+}
+
+/// Polls `future` once: its value when it is done, `None` while a readback is under way.
+pub fn poll_once<F: std::future::Future + ?Sized>(future: std::pin::Pin<&mut F>) -> Option<F::Output> {
+    match future.poll(&mut std::task::Context::from_waker(std::task::Waker::noop())) {
+        std::task::Poll::Ready(value) => Some(value),
+        std::task::Poll::Pending => None,
+    }
 }
 
 /// Records the copy of rows `rows` of mip level 0 into `buffer`, `padded_row` bytes a row.

@@ -1,9 +1,10 @@
 //! `mirador lab check DIR`: the student's file validated, then the tests run in a child process
 //! under a time limit each, scored from the points a teacher can edit, and reported.
 
+use super::checks::Finding;
 use super::find;
-use super::report::{Report, TestResult};
-use super::run::{Finding, Test, tests};
+use super::report::Report;
+use super::run::tests;
 use super::source;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -63,33 +64,12 @@ pub fn check(options: &Options) -> Result<Report, String> {
         run_in_child(options, tests.len())
     } else {
         let why = format!("not run: {} does not compile (see the first problem above)", lab.file);
-        (0..tests.len()).map(|index| unfinished(index, &why)).collect()
+        (0..tests.len()).map(|index| Finding::unfinished(index, &why)).collect()
     };
-    let results = tests.iter().zip(findings).map(|(test, finding)| result(test, finding, &points)).collect();
+    let results = tests.iter().zip(findings).map(|(test, finding)| test.result(finding, &points)).collect();
     let report = Report { lab, problems, results, seconds: start.elapsed().as_secs_f64() };
     super::report::write(&report, &options.dir)?;
     Ok(report)
-}
-
-fn result(test: &Test, finding: Finding, points: &BTreeMap<String, f32>) -> TestResult {
-    let max_score = points.get(test.name()).copied().unwrap_or(test.points());
-    let mut output = finding.output;
-    if let Some((name, sentence)) = &finding.mistake {
-        output.push_str(&format!("\nThis looks like a known mistake, {name}: {sentence}"));
-    }
-    TestResult {
-        name: test.name().to_owned(),
-        score: if finding.passed { max_score } else { 0.0 },
-        max_score,
-        output,
-        mistake: finding.mistake.map(|(name, _)| name),
-        passed: finding.passed,
-        images: finding.images,
-    }
-}
-
-fn unfinished(index: usize, why: &str) -> Finding {
-    Finding { index, passed: false, output: why.to_owned(), mistake: None, images: None }
 }
 
 /// Runs the tests in `mirador lab run` children: a test that takes longer than the limit stops
@@ -132,8 +112,10 @@ fn run_in_child(options: &Options, count: usize) -> Vec<Finding> {
                     let _ = child.wait();
                     let limit = options.time_limit.as_secs_f64();
                     let index = findings.len();
-                    findings
-                        .push(unfinished(index, &format!("did not finish within {limit} s: a loop that never ends?")));
+                    findings.push(Finding::unfinished(
+                        index,
+                        &format!("did not finish within {limit} s: a loop that never ends?"),
+                    ));
                     return fill(findings, count, &format!("not run: an earlier test did not finish within {limit} s"));
                 }
                 Err(mpsc::RecvTimeoutError::Disconnected) => {
@@ -144,7 +126,7 @@ fn run_in_child(options: &Options, count: usize) -> Vec<Finding> {
                         let tail: Vec<&str> = stderr.lines().rev().take(3).collect();
                         let tail: Vec<&str> = tail.into_iter().rev().collect();
                         let index = findings.len();
-                        findings.push(unfinished(
+                        findings.push(Finding::unfinished(
                             index,
                             &format!("the checker stopped during this test: {}", tail.join(" / ")),
                         ));
@@ -160,7 +142,7 @@ fn run_in_child(options: &Options, count: usize) -> Vec<Finding> {
 fn fill(mut findings: Vec<Finding>, count: usize, why: &str) -> Vec<Finding> {
     while findings.len() < count {
         let index = findings.len();
-        findings.push(unfinished(index, why));
+        findings.push(Finding::unfinished(index, why));
     }
     findings
 }

@@ -1,7 +1,9 @@
-//! Known-answer tests: one call of a student's function on tiny inputs, run in a compute shader
-//! with the shared WGSL (and the student's functions in place of Mirador's), its value read
-//! back. Inputs a texture function needs are two tiny textures made here, whose every texel is
-//! known (the values a test expects are worked out by hand from these):
+//! Known-answer tests: one call of a student's function on tiny inputs, run in a fragment shader
+//! with the shared WGSL (and the student's functions in place of Mirador's), its value written
+//! bit for bit into a 1×1 `Rgba32Uint` target and read back. A fragment shader rather than a
+//! compute one: WebGL2 has none, and the page's lab runs its checks there too. Inputs a texture
+//! function needs are two tiny textures made here, whose every texel is known (the values a
+//! test expects are worked out by hand from these):
 //!
 //! - `lab_texture`: `texture_2d<f32>`, 4×4 with a full chain of 3 levels. Level 0 holds
 //!   (x, y, (x + y) mod 2, 1) at texel (x, y); level 1 holds (10 + x, 10 + y, 0.5, 1); level 2
@@ -10,86 +12,57 @@
 //!   (x, y): 0.05 in the top-left corner to 0.8 in the bottom-right.
 
 use crate::gpu::Gpu;
+use crate::gpu::readback::Pending;
 use wgpu::util::DeviceExt;
 
-/// The harness's bindings, declared before the entry point.
+/// The harness's bindings, declared before the entry points.
 pub const BINDINGS: &str = "
-@group(0) @binding(0) var<storage, read_write> lab_out: array<vec4f>;
-@group(0) @binding(1) var lab_texture: texture_2d<f32>;
-@group(0) @binding(2) var lab_depth: texture_depth_2d_array;
+@group(0) @binding(0) var lab_texture: texture_2d<f32>;
+@group(0) @binding(1) var lab_depth: texture_depth_2d_array;
 ";
 
 const SIDE: u32 = 4;
+
+/// The format of the target a call's value is written to: four `u32`, the value's bits, which no
+/// blending or conversion can touch (and which WebGL2 can render to, as it cannot to floats
+/// without an extension).
+const TARGET: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Uint;
 
 /// The harness's textures and layout, made once for every call.
 pub struct Harness {
     layout: wgpu::BindGroupLayout,
     group: wgpu::BindGroup,
-    output: wgpu::Buffer,
-    staging: wgpu::Buffer,
+    target: wgpu::Texture,
 }
 
 impl Harness {
     pub fn new(gpu: &Gpu) -> Harness {
         let device = &gpu.device;
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+        let entry = |binding, sample_type, view_dimension| wgpu::BindGroupLayoutEntry {
             binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture { sample_type, view_dimension, multisampled: false },
             count: None,
         };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lab::harness"),
             entries: &[
-                entry(
-                    0,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                ),
-                entry(
-                    1,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                ),
-                entry(
-                    2,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
-                ),
+                entry(0, wgpu::TextureSampleType::Float { filterable: false }, wgpu::TextureViewDimension::D2),
+                entry(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
             ],
         });
         let texture = colour_texture(gpu);
         let depth = depth_texture(gpu);
-        let buffer = |usage| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("lab::harness"),
-                size: 16,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
-        let output = buffer(wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC);
-        let staging = buffer(wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ);
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("lab::harness"),
             layout: &layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: output.as_entire_binding() },
                 wgpu::BindGroupEntry {
-                    binding: 1,
+                    binding: 0,
                     resource: wgpu::BindingResource::TextureView(&texture.create_view(&Default::default())),
                 },
                 wgpu::BindGroupEntry {
-                    binding: 2,
+                    binding: 1,
                     resource: wgpu::BindingResource::TextureView(&depth.create_view(&wgpu::TextureViewDescriptor {
                         dimension: Some(wgpu::TextureViewDimension::D2Array),
                         ..Default::default()
@@ -97,57 +70,111 @@ impl Harness {
                 },
             ],
         });
-        Harness { layout, group, output, staging }
+        let target = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("lab::harness::target"),
+            size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: TARGET,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        Harness { layout, group, target }
+    }
+
+    /// The module that computes `call` (a `vec4f` expression) in the shared WGSL as `wgsl`
+    /// composes it, for `wgsl`'s profile: `lab_main` writes the value's bits.
+    pub fn module(wgsl: &crate::shaders::Wgsl, call: &str) -> String {
+        let entry = format!(
+            "{BINDINGS}
+@vertex
+fn lab_vertex(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {{
+    return vec4f(f32(i / 2u) * 4.0 - 1.0, f32(i % 2u) * 4.0 - 1.0, 0.0, 1.0);
+}}
+
+@fragment
+fn lab_main() -> @location(0) vec4u {{
+    let lab_value: vec4f = {call};
+    return bitcast<vec4u>(lab_value);
+}}
+"
+        );
+        wgsl.compose_common(&entry)
     }
 
     /// The value of `call` (a `vec4f` expression) in a module of the shared WGSL as `wgsl`
     /// composes it; a GPU error is the error's text.
-    pub fn call(&self, gpu: &Gpu, wgsl: &crate::shaders::Wgsl, call: &str) -> Result<[f32; 4], String> {
-        let entry =
-            format!("{BINDINGS}\n@compute @workgroup_size(1)\nfn lab_main() {{\n    lab_out[0] = {call};\n}}\n");
-        let source = wgsl.compose_common(&entry);
+    pub async fn call(&self, gpu: &Gpu, wgsl: &crate::shaders::Wgsl, call: &str) -> Result<[f32; 4], String> {
+        // Composed for the device's profile, as the passes are: WebGL2 has no cube arrays.
+        let source = Harness::module(&wgsl.for_profile(gpu.profile()), call);
         if let Err(error) = naga::front::wgsl::parse_str(&source) {
             return Err(format!("the test's call `{call}` does not compile: {}", error.message()));
         }
+        let readback = gpu.checked_later(|| self.draw(gpu, source)).await.map_err(|e| e.to_string())?;
+        let bytes = readback.map_err(|e| e.to_string())?.texels(&gpu.device).await.map_err(|e| e.to_string())?;
+        let word = |i: usize| f32::from_bits(u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]));
+        Ok([word(0), word(4), word(8), word(12)])
+    }
+
+    /// Draws the one pixel of `source`'s `lab_main` and starts reading it back.
+    fn draw(&self, gpu: &Gpu, source: String) -> Result<Pending, crate::gpu::readback::ReadbackError> {
         let device = &gpu.device;
-        let run = || {
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("lab::call"),
-                source: wgpu::ShaderSource::Wgsl(source.into()),
-            });
-            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("lab::call"),
-                bind_group_layouts: &[Some(&self.layout)],
-                immediate_size: 0,
-            });
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("lab::call"),
-                layout: Some(&layout),
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("lab::call"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("lab::call"),
+            bind_group_layouts: &[Some(&self.layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("lab::call"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("lab_vertex"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
                 module: &module,
                 entry_point: Some("lab_main"),
                 compilation_options: Default::default(),
-                cache: None,
+                targets: &[Some(TARGET.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let view = self.target.create_view(&Default::default());
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("lab::call"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
             });
-            let mut encoder = device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                pass.set_pipeline(&pipeline);
-                pass.set_bind_group(0, &self.group, &[]);
-                pass.dispatch_workgroups(1, 1, 1);
-            }
-            encoder.copy_buffer_to_buffer(&self.output, 0, &self.staging, 0, 16);
-            gpu.queue.submit([encoder.finish()]);
-        };
-        gpu.checked(run).map_err(|e| e.to_string())?;
-        self.staging.slice(..).map_async(wgpu::MapMode::Read, |_| ());
-        gpu.wait();
-        let value = {
-            let view = self.staging.slice(..).get_mapped_range().map_err(|e| e.to_string())?;
-            let floats: &[f32] = bytemuck::cast_slice(&view);
-            [floats[0], floats[1], floats[2], floats[3]]
-        };
-        self.staging.unmap();
-        Ok(value)
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &self.group, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        Pending::start(device, &gpu.queue, &self.target, 16)
     }
 }
 

@@ -33,10 +33,21 @@ pub fn scene(test: &ImageTest, folder: Option<&Path>) -> Result<Scene, String> {
     Ok(scene)
 }
 
-/// `scene` drawn by the rasterizer compiled from `wgsl`; a GPU error is its text.
+/// `scene` drawn by the rasterizer compiled from `wgsl`; a GPU error is its text. Natively, it
+/// waits for the image.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn raster(gpu: &Gpu, scene: &Scene, wgsl: &Wgsl) -> Result<RgbaImage, String> {
-    gpu.checked(|| Headless::with_wgsl(gpu, scene, wgsl.clone()).render(gpu, scene, &scene.settings))
-        .map_err(|e| e.to_string())
+    crate::gpu::readback::block_on(&gpu.device, drawn(gpu, scene, wgsl))
+}
+
+/// [`raster`] as a future, which the page polls a frame at a time.
+pub async fn drawn(gpu: &Gpu, scene: &Scene, wgsl: &Wgsl) -> Result<RgbaImage, String> {
+    let draw = || Headless::with_wgsl(gpu, scene, wgsl.clone()).render_later(gpu, scene, &scene.settings);
+    let started = gpu.checked_later(draw).await;
+    let readback = started.map_err(|e| e.to_string())?.map_err(|e| e.to_string())?;
+    let (width, height) = readback.size();
+    let pixels = readback.texels(&gpu.device).await.map_err(|e| e.to_string())?;
+    RgbaImage::from_raw(width, height, pixels).ok_or_else(|| "the readback has the wrong size".to_owned())
 }
 
 /// `scene` traced.

@@ -13,7 +13,7 @@
 //! What a lab checks, in order ([`check`]):
 //! 1. the file itself: each slot's signature, then naga's parse and validation of every surface
 //!    module, errors given at the student's `file:line:column` ([`source`]);
-//! 2. known-answer tests: each function called on tiny inputs in a compute shader, with a value
+//! 2. known-answer tests: each function called on tiny inputs in a one-pixel draw, with a value
 //!    and a tolerance or a range where several answers are right ([`harness`]);
 //! 3. image tests: a scene drawn with the student's functions against the same scene drawn with
 //!    Mirador's (tight), or against the ray tracer where theory says the two agree (no worse than
@@ -21,19 +21,19 @@
 //!    ([`images`]).
 //!
 //! A test that fails is matched against the lab's known mistakes (the solution with one typical
-//! slip made), and the report names the one it matches. Tests run in a child process with a time
-//! limit ([`run`]): a software GPU cannot be interrupted, and a shader that never returns is a
-//! failed test, not a hung grader.
+//! slip made), and the report names the one it matches ([`checks`]). `mirador lab check` runs the
+//! tests in a child process with a time limit ([`run`]): a software GPU cannot be interrupted,
+//! and a shader that never returns is a failed test, not a hung grader. The page runs the same
+//! tests a frame at a time (src/viewer/lab.rs), and gives the same `results.json` ([`report`]).
 
-// What runs the checks: processes and folders, which the page has not. The
-// page's lab mode (src/viewer/lab.rs) uses the lab, its scenes and its source checks.
+// What runs the checks natively: processes and folders, which the page has not.
 #[cfg(not(target_arch = "wasm32"))]
 pub mod check;
+pub mod checks;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod folder;
 pub mod harness;
 pub mod images;
-#[cfg(not(target_arch = "wasm32"))]
 pub mod report;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod run;

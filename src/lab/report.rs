@@ -4,8 +4,10 @@
 
 use super::Lab;
 use super::source::Problem;
+#[cfg(not(target_arch = "wasm32"))]
 use crate::output::write_atomically;
 use std::fmt::Write;
+#[cfg(not(target_arch = "wasm32"))]
 use std::path::Path;
 
 /// One test's result, as Gradescope reads it (`name`, `score`, `max_score`, `output`).
@@ -62,7 +64,7 @@ pub fn text(report: &Report) -> String {
     }
     let _ = writeln!(
         out,
-        "\nlab {}: {} / {} points, {} of {} tests passed, in {:.1} s (results.json, report.md)",
+        "\nlab {}: {} / {} points, {} of {} tests passed, in {:.1} s",
         report.lab.name,
         points(report.score()),
         points(report.max_score()),
@@ -73,13 +75,13 @@ pub fn text(report: &Report) -> String {
     out
 }
 
-fn points(value: f32) -> String {
+/// A score as the reports write it: `3`, `2.5`.
+pub fn points(value: f32) -> String {
     if value.fract() == 0.0 { format!("{value:.0}") } else { format!("{value:.1}") }
 }
 
-/// Writes `results.json` and `report.md` (with the pictures the run left in `report/`) into
-/// `dir`.
-pub fn write(report: &Report, dir: &Path) -> Result<(), String> {
+/// `results.json`'s text: the report in Gradescope's format.
+pub fn results_json(report: &Report) -> String {
     let problems: Vec<String> = report.problems.iter().map(|p| p.display(&report.lab.file)).collect();
     let json = serde_json::json!({
         "score": report.score(),
@@ -88,13 +90,21 @@ pub fn write(report: &Report, dir: &Path) -> Result<(), String> {
         "output": if problems.is_empty() { format!("lab {}", report.lab.name) } else { problems.join("\n") },
         "tests": report.results,
     });
-    let json = serde_json::to_string_pretty(&json).expect("a report serialises");
+    serde_json::to_string_pretty(&json).expect("a report serialises")
+}
+
+/// Writes `results.json` and `report.md` (with the pictures the run left in `report/`) into
+/// `dir`.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn write(report: &Report, dir: &Path) -> Result<(), String> {
+    let json = results_json(report);
     let path = dir.join("results.json");
     write_atomically(json.as_bytes(), &path).map_err(|e| format!("{}: {e}", path.display()))?;
     let path = dir.join("report.md");
     write_atomically(markdown(report).as_bytes(), &path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 fn markdown(report: &Report) -> String {
     let lab = &report.lab;
     let mut out = format!(

@@ -286,8 +286,8 @@ const LATER_BUILTINS: &[&str] = &[
     "imageStore",
 ];
 
-/// Every entry point of every pass of `wgsl`, composed for the WebGL2 profile, that WebGL2
-/// cannot compile, as `pass::entry: why`: each written as GLSL ES 3.00 by naga, as wgpu's GL
+/// Every entry point of every pass of `wgsl` (and of the known-answer tests' harness), composed
+/// for the WebGL2 profile, that WebGL2 cannot compile, as `pass::entry: why`: each written as GLSL ES 3.00 by naga, as wgpu's GL
 /// backend writes it in the page. Entry points that write a storage buffer (`explain`'s) are
 /// left out: a WebGL2 device never draws with them.
 pub fn webgl2_failures(wgsl: &Wgsl) -> Vec<String> {
@@ -298,7 +298,10 @@ pub fn webgl2_failures(wgsl: &Wgsl) -> Vec<String> {
 /// it does not, with why (`tests/webgl2.rs` checks the standard profile fails, so this can).
 pub fn webgl2_written(wgsl: &Wgsl, profile: Profile) -> (Vec<String>, Vec<String>) {
     let (mut written, mut failed) = (Vec::new(), Vec::new());
-    for (pass, source) in wgsl.for_profile(profile).passes() {
+    let wgsl = wgsl.for_profile(profile);
+    // And the known-answer tests' one-pixel draw, which the page runs on WebGL2 too.
+    let harness = ("lab", super::harness::Harness::module(&wgsl, "vec4f(0.0)"));
+    for (pass, source) in wgsl.passes().into_iter().chain([harness]) {
         let module = match naga::front::wgsl::parse_str(&source) {
             Ok(module) => module,
             Err(e) => {
@@ -306,9 +309,10 @@ pub fn webgl2_written(wgsl: &Wgsl, profile: Profile) -> (Vec<String>, Vec<String
                 continue;
             }
         };
+        // As wgpu validates a module for a WebGL2 device: without cube-map arrays, even declared.
+        let capabilities = naga::valid::Capabilities::all().difference(naga::valid::Capabilities::CUBE_ARRAY_TEXTURES);
         let validated =
-            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::all())
-                .validate(&module);
+            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities).validate(&module);
         let info = match validated {
             Ok(info) => info,
             Err(e) => {

@@ -76,6 +76,19 @@ impl Headless {
             readback::read_rgba8(&gpu.device, &gpu.queue, &self.output.texture).expect("reading the frame back");
         image::RgbaImage::from_raw(width, height, pixels).expect("readback returns width × height RGBA8 pixels")
     }
+
+    /// [`Headless::render`] without blocking: the frame is submitted and its readback started
+    /// here; the image comes when the returned readback is awaited ([`readback::Pending::texels`]).
+    /// The page's lab checks draw this way.
+    pub fn render_later(
+        &mut self,
+        gpu: &Gpu,
+        scene: &Scene,
+        settings: &RenderSettings,
+    ) -> Result<readback::Pending, readback::ReadbackError> {
+        self.report = self.renderer.render(gpu, scene, settings, &mut self.targets, &self.output.view);
+        readback::Pending::start(&gpu.device, &gpu.queue, &self.output.texture, 4)
+    }
 }
 
 /// Renders `scene` once, headless, with `settings`.

@@ -94,6 +94,10 @@ pub struct Viewer {
     budget_next: bool,
     /// Lab mode (`mirador view --lab DIR`): the student's functions drawn, reloaded when saved.
     pub lab: Option<LabMode>,
+    /// A check of the lab asked for (the step `lab check`), started where the frame has the GPU.
+    lab_check_next: bool,
+    /// The last finished check's `results.json`, until the page takes it.
+    pub lab_results: Option<String>,
     /// What the device's shaders may use (the page's labs need it).
     #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
     profile: crate::shaders::Profile,
@@ -112,6 +116,8 @@ struct Script {
     /// A `wait 2s` step's end.
     wait_until: Option<Instant>,
     wait_traced_since: Option<Instant>,
+    /// A `wait checked` step's start.
+    wait_checked_since: Option<Instant>,
     /// A `measure` step ran: the stats start where it said, not after the last step.
     measured: bool,
     /// Start the stats again after this frame.
@@ -189,6 +195,8 @@ impl Viewer {
             error_budget: None,
             budget_next: false,
             lab,
+            lab_check_next: false,
+            lab_results: None,
             profile,
             remembered,
             changed: Default::default(),
@@ -201,6 +209,7 @@ impl Viewer {
             && self.script.wait_frames == 0
             && self.script.wait_until.is_none()
             && self.script.wait_traced_since.is_none()
+            && self.script.wait_checked_since.is_none()
             && self.screenshot.is_none()
     }
 
@@ -315,6 +324,31 @@ impl Viewer {
         Ok(())
     }
 
+    /// One step of the lab's check under way, started first when the panel's Check button or the
+    /// step `lab check` asked for one. A finished check's summary is printed, and its
+    /// `results.json` kept for the page's download.
+    fn advance_lab_check(&mut self, screen: &Screen) {
+        if let Some(lab) = self.lab.as_mut().filter(|_| std::mem::take(&mut self.lab_check_next)) {
+            lab.start_check(&screen.gpu);
+            let name = lab.lab.name.clone();
+            self.notice(format!("lab {name}: checking"));
+        }
+        let ctx = &screen.egui;
+        let Some(checking) = self.lab.as_mut().and_then(|lab| lab.checking.as_mut()) else { return };
+        checking.advance(ctx);
+        if let Some(report) = checking.take_finished() {
+            print!("{}", crate::lab::report::text(&report));
+            self.lab_results = Some(crate::lab::report::results_json(&report));
+            let summary = format!(
+                "lab {}: {} / {} points",
+                report.lab.name,
+                crate::lab::report::points(report.score()),
+                crate::lab::report::points(report.max_score())
+            );
+            self.notice(summary);
+        }
+    }
+
     /// The step `lab open NAME`: the page's lab menu.
     #[cfg(target_arch = "wasm32")]
     fn lab_open_step(&mut self, name: &str) -> anyhow::Result<()> {
@@ -376,6 +410,7 @@ impl Viewer {
         screen.write_screenshots()?;
         self.run_script(&mut input)?;
         self.poll_file();
+        self.advance_lab_check(screen);
         self.traced.poll(&screen.egui);
         // The volume ray and the environment's direction under the cursor, made here so that the
         // layout only draws them.
@@ -577,6 +612,7 @@ impl Viewer {
         // frame or two after they are asked for, and the hybrid's traced terms are refined frame
         // by frame while the camera rests.
         let busy = self.traced.worker.busy()
+            || self.lab.as_ref().is_some_and(LabMode::checking)
             || self.raster.reading_back()
             || self.raster.refining()
             || screen.screenshots_pending();
@@ -657,6 +693,7 @@ impl Viewer {
         if let (Some(shown), Some(lab)) = (output.lab_shown, &mut self.lab) {
             lab.show(shown);
         }
+        self.lab_check_next |= output.lab_check;
         if self.scene.scene.camera != before || output.camera_edited {
             self.moving_until = Some(now + SETTLE);
         }
@@ -805,6 +842,15 @@ impl Viewer {
             }
             self.script.wait_until = None;
         }
+        if let Some(since) = self.script.wait_checked_since {
+            if !self.lab.as_ref().is_some_and(LabMode::checking) {
+                self.script.wait_checked_since = None;
+            } else if since.elapsed() > TRACE_TIMEOUT {
+                bail!("`wait checked`: the lab's check had not finished after {} s", TRACE_TIMEOUT.as_secs());
+            } else {
+                return Ok(());
+            }
+        }
         if let Some(since) = self.script.wait_traced_since {
             let difference = self.view.mode == ViewMode::Difference;
             if self.request.is_some() && self.traced.complete(self.key, difference) {
@@ -881,6 +927,9 @@ impl Viewer {
             Step::Screenshot(path) => self.screenshot = Some(path),
             Step::Lab(shown) => self.lab_step(shown)?,
             Step::LabOpen(name) => self.lab_open_step(&name)?,
+            Step::LabCheck if self.lab.is_none() => bail!("`lab check`: the viewer is not in lab mode"),
+            Step::LabCheck => self.lab_check_next = true,
+            Step::WaitChecked => self.script.wait_checked_since = Some(Instant::now()),
         }
         Ok(())
     }

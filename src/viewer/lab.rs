@@ -14,11 +14,15 @@
 //! - The lab starts from its scene and the settings its first image test sets, never from what
 //!   the viewer remembered of another scene, and remembers nothing when it closes.
 //!
+//! - The panel's Check button (or the step `lab check`) runs the lab's tests on the view's device,
+//!   one step a frame ([`Checking`]), and lists what each found, with an image test's correct,
+//!   yours and difference pictures: what `mirador lab check` finds, without leaving the viewer.
+//!
 //! In the page (`index.html`'s lab menu) the student's file is the text of an editor beside the
 //! view, taken in a moment after the last keystroke, checked the same way (naga's messages, at
 //! the same `line:column`; on WebGL2 also as WebGL2 compiles it), and downloaded with the page's
-//! button. The page draws the student's functions and the reference; the difference view and the
-//! checks run natively for now.
+//! button, as is the last check's `results.json`. The page draws the student's functions and the
+//! reference and runs the checks; its difference view is the check's pictures.
 
 /// What the view shows in lab mode.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -69,10 +73,116 @@ pub struct LabPanel<'a> {
     pub fallback: &'static str,
     /// The difference view's error map and its mean, once made for the current view.
     pub difference: Option<(egui::TextureId, f32)>,
-    /// What the view can show: the page has no difference view yet.
+    /// What the view can show: the page's difference view is the check's pictures.
     pub choices: &'static [LabShown],
-    /// When the student's text is taken in, and where the checks run.
+    /// When the student's text is taken in.
     pub how: &'static str,
+    /// The last check, running or done.
+    pub checking: Option<&'a Checking>,
+}
+
+/// The lab's tests run from the panel's Check button (or the step `lab check`) on the view's
+/// device, a step a frame ([`crate::lab::checks::Progress`]): in the page nothing may wait for
+/// the GPU. What each test found is listed in the panel, an image test with its pictures.
+pub struct Checking {
+    progress: crate::lab::checks::Progress,
+    /// Each finished image test's correct, yours and difference pictures, as egui textures.
+    textures: Vec<Option<[egui::TextureHandle; 3]>>,
+    /// Whether the finished report was handed on (to the page's script, to the terminal).
+    handed_on: bool,
+}
+
+impl Checking {
+    /// Starts checking `text`, the student's file.
+    pub fn start(gpu: &crate::gpu::Gpu, lab: &crate::lab::Lab, text: &str) -> Checking {
+        let progress = crate::lab::checks::Progress::start(gpu, lab, text);
+        Checking { progress, textures: Vec::new(), handed_on: false }
+    }
+
+    /// One step of the test under way; returns whether a test finished (the panel changes).
+    pub fn advance(&mut self, ctx: &egui::Context) -> bool {
+        let advanced = self.progress.advance();
+        let pictures = self.progress.pictures();
+        for (index, images) in pictures.iter().enumerate().skip(self.textures.len()) {
+            let textures = images.as_ref().map(|images| {
+                images.each_ref().map(|image| {
+                    let size = [image.width() as usize, image.height() as usize];
+                    let image = egui::ColorImage::from_rgba_unmultiplied(size, image.as_raw());
+                    ctx.load_texture(format!("lab::check::{index}"), image, egui::TextureOptions::NEAREST)
+                })
+            });
+            self.textures.push(textures);
+        }
+        advanced
+    }
+
+    pub fn running(&self) -> bool {
+        !self.progress.done()
+    }
+
+    pub fn progress(&self) -> &crate::lab::checks::Progress {
+        &self.progress
+    }
+
+    /// Test `index`'s pictures, correct, yours and difference, once it ran (an image test).
+    pub fn pictures(&self, index: usize) -> Option<[egui::TextureId; 3]> {
+        self.textures.get(index)?.as_ref().map(|textures| textures.each_ref().map(|t| t.id()))
+    }
+
+    /// What the check found so far, as the panel lists it: the score, each test passed or failed
+    /// with what it found, an image test's pictures under it.
+    pub fn show(&self, ui: &mut egui::Ui) {
+        use crate::lab::report::points;
+        let (progress, error) = (&self.progress, ui.visuals().error_fg_color);
+        let report = progress.report();
+        let passed = report.results.iter().filter(|r| r.passed).count();
+        let summary = if progress.done() {
+            format!(
+                "{} / {} points: {passed} of {} tests passed ({:.1} s).",
+                points(report.score()),
+                points(report.max_score()),
+                progress.len(),
+                report.seconds
+            )
+        } else {
+            format!("Checking: {} of {} tests run…", report.results.len(), progress.len())
+        };
+        ui.label(egui::RichText::new(summary).strong());
+        if let Some(problem) = progress.problems().first() {
+            ui.colored_label(error, egui::RichText::new(problem.display(&report.lab.file)).monospace().small());
+        }
+        let pass = egui::Color32::from_rgb(90, 190, 110);
+        for (index, result) in report.results.iter().enumerate() {
+            let (mark, colour) = if result.passed { ("pass", pass) } else { ("FAIL", error) };
+            ui.horizontal_wrapped(|ui| {
+                let score = format!("{mark} {}/{}", points(result.score), points(result.max_score));
+                ui.label(egui::RichText::new(score).monospace().color(colour));
+                ui.label(egui::RichText::new(&result.name).small());
+            });
+            if !result.passed {
+                ui.label(egui::RichText::new(&result.output).small());
+            }
+            if let Some(pictures) = self.pictures(index) {
+                let spacing = ui.spacing().item_spacing.x;
+                let width = ((ui.available_width() - 2.0 * spacing) / 3.0).clamp(40.0, 160.0);
+                let size = self.textures[index].as_ref().map_or([16, 9], |t| t[0].size());
+                let size = egui::vec2(width, width * size[1] as f32 / size[0].max(1) as f32);
+                ui.horizontal(|ui| {
+                    for (id, what) in pictures.into_iter().zip(["correct", "yours", "difference"]) {
+                        ui.add(egui::Image::new((id, size))).on_hover_text(what);
+                    }
+                });
+            }
+        }
+    }
+
+    /// The finished check's report, once: for the page's script and the terminal.
+    pub fn take_finished(&mut self) -> Option<crate::lab::report::Report> {
+        (self.progress.done() && !self.handed_on).then(|| {
+            self.handed_on = true;
+            self.progress.report()
+        })
+    }
 }
 
 /// What a lab mode draws, natively and in the page alike: the student's functions as last
@@ -158,6 +268,8 @@ mod native {
         pub difference: Option<ShownDifference>,
         /// The renderers that draw it, kept from one view to the next.
         renderers: Option<DifferenceRenderers>,
+        /// The last check run from the panel.
+        pub checking: Option<super::Checking>,
     }
 
     /// The two renderers the difference view draws with, kept while the student's functions, the
@@ -211,6 +323,7 @@ mod native {
                 shown: LabShown::Student,
                 difference: None,
                 renderers: None,
+                checking: None,
             };
             mode.read();
             Ok((mode, scene))
@@ -277,7 +390,21 @@ mod native {
                 fallback: self.compiled.fallback(),
                 difference: self.difference.as_ref().map(|d| (d.texture.id(), d.flip_mean)),
                 choices: &LabShown::ALL,
-                how: "redrawn when saved; `mirador lab check DIR` runs the tests",
+                how: "redrawn when saved",
+                checking: self.checking.as_ref(),
+            }
+        }
+
+        /// Whether a check is under way.
+        pub fn checking(&self) -> bool {
+            self.checking.as_ref().is_some_and(super::Checking::running)
+        }
+
+        /// Runs the lab's tests on the file as saved now (the panel's Check button).
+        pub fn start_check(&mut self, gpu: &Gpu) {
+            match std::fs::read_to_string(&self.file) {
+                Ok(text) => self.checking = Some(super::Checking::start(gpu, &self.lab, &text)),
+                Err(e) => self.compiled.problems = vec![format!("{}: {e}", self.file.display())],
             }
         }
 
@@ -377,6 +504,8 @@ mod page {
         pub shown: LabShown,
         /// The device's profile: on WebGL2 the text must also compile to its shading language.
         profile: Profile,
+        /// The last check run from the panel.
+        pub checking: Option<super::Checking>,
     }
 
     impl LabMode {
@@ -396,6 +525,7 @@ mod page {
                 edited: None,
                 shown: LabShown::Student,
                 profile,
+                checking: None,
             };
             Ok((mode, scene))
         }
@@ -460,11 +590,23 @@ mod page {
                 fallback: self.compiled.fallback(),
                 difference: None,
                 choices: &[LabShown::Student, LabShown::Reference],
-                how: "redrawn as you type; the checks run natively: `mirador lab check DIR` on the downloaded file",
+                how: "redrawn as you type",
+                checking: self.checking.as_ref(),
             }
         }
 
-        /// Shows `shown`; the page has no difference view, so the L key goes back to the student's.
+        /// Whether a check is under way.
+        pub fn checking(&self) -> bool {
+            self.checking.as_ref().is_some_and(super::Checking::running)
+        }
+
+        /// Runs the lab's tests on the editor's text (the panel's Check button).
+        pub fn start_check(&mut self, gpu: &crate::gpu::Gpu) {
+            self.checking = Some(super::Checking::start(gpu, &self.lab, &self.text));
+        }
+
+        /// Shows `shown`; the page's difference view is the check's pictures, so the L key goes
+        /// back to the student's.
         pub fn show(&mut self, shown: LabShown) {
             let shown = if shown == LabShown::Difference { LabShown::Student } else { shown };
             if shown != self.shown {

@@ -592,8 +592,8 @@ pub fn course_fonts() -> egui::FontDefinitions {
 
 #[cfg(test)]
 mod tests {
-    /// Every character the panel's tooltips (the settings' documentation) and the help window
-    /// show has a glyph in the proportional face or its fallbacks.
+    /// Every character the panel's tooltips (the settings' documentation), the help window and
+    /// the lab panel show has a glyph in the proportional face or its fallbacks.
     #[test]
     fn the_course_notation_has_glyphs() {
         let definitions = super::course_fonts();
@@ -604,6 +604,14 @@ mod tests {
             text.push_str(what);
         }
         text.push_str("⊗‖");
+        // What the lab panel shows: the labs' titles, their tests' names and their mistakes'
+        // sentences (a check's results).
+        for lab in crate::lab::catalog() {
+            text.push_str(&lab.title);
+            let names = lab.known_answers.iter().map(|t| &t.name).chain(lab.images.iter().map(|t| &t.name));
+            text.extend(names.map(String::as_str));
+            text.extend(lab.mistakes.iter().flat_map(|m| [m.name.as_str(), m.sentence.as_str()]));
+        }
         let font = egui::FontId::proportional(13.0);
         let missing: String = text.chars().filter(|c| !c.is_control() && !fonts.has_glyph(&font, *c)).collect();
         assert!(missing.is_empty(), "no glyph for {missing:?}");

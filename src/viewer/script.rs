@@ -32,6 +32,8 @@
 //!                               after the last step)
 //! screenshot FILE.png           the whole window, written atomically
 //! lab student                   in lab mode: the student's image | reference | difference (L)
+//! lab check                     in lab mode: run the lab's tests (the panel's Check button)
+//! wait checked                  until the lab's check has run every test
 //! ```
 //!
 //! Blank lines and lines starting with `#` are skipped in script files.
@@ -79,6 +81,9 @@ pub enum Step {
     Lab(LabShown),
     /// Open a built-in lab with an editor for its file (the page's lab menu).
     LabOpen(String),
+    /// Run the lab's tests (the panel's Check button).
+    LabCheck,
+    WaitChecked,
     ResetSettings,
 }
 
@@ -117,11 +122,12 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
     Ok(match verb {
         "set" => Step::Set(assignment("set")?),
         "material" => Step::Material(assignment("material")?),
+        "lab" if args.trim() == "check" => Step::LabCheck,
         "lab" => match args.trim().strip_prefix("open ") {
             Some(name) => Step::LabOpen(name.trim().to_owned()),
             None => Step::Lab(
                 LabShown::parse(args)
-                    .ok_or_else(|| fail("the lab view is student, reference or difference, or `open NAME`"))?,
+                    .ok_or_else(|| fail("the lab view is student, reference or difference, `open NAME` or `check`"))?,
             ),
         },
         "view" => {
@@ -178,12 +184,13 @@ pub fn parse(text: &str) -> Result<Step, ScriptError> {
         "panel" => Step::Panel(switch(args).ok_or_else(|| fail("panel on or panel off"))?),
         "overlay" => Step::Overlay(switch(args).ok_or_else(|| fail("overlay on or overlay off"))?),
         "wait" if args == "traced" => Step::WaitTraced,
+        "wait" if args == "checked" => Step::WaitChecked,
         "wait" if args.ends_with('s') => {
             let seconds = args[..args.len() - 1].parse::<f32>().ok().filter(|s| s.is_finite() && *s >= 0.0);
             let seconds = seconds.filter(|s| *s <= 3600.0).ok_or_else(|| fail("wait 2s: seconds, up to an hour"))?;
             Step::WaitFor(std::time::Duration::from_secs_f32(seconds))
         }
-        "wait" => Step::Wait(args.parse().map_err(|_| fail("wait N (frames), wait 2s or wait traced"))?),
+        "wait" => Step::Wait(args.parse().map_err(|_| fail("wait N (frames), wait 2s, wait traced or wait checked"))?),
         "screenshot" if args.to_ascii_lowercase().ends_with(".png") => Step::Screenshot(PathBuf::from(args)),
         "screenshot" => return Err(fail("the screenshot must be a .png file")),
         _ => return Err(fail("unknown step (see `mirador view --help`)")),
@@ -212,6 +219,8 @@ mod tests {
         assert_eq!(parse("  view   split ").unwrap(), Step::View(ViewMode::Split));
         assert_eq!(parse("orbit 40 -10").unwrap(), Step::Orbit(Vec2::new(40.0, -10.0)));
         assert_eq!(parse("wait traced").unwrap(), Step::WaitTraced);
+        assert_eq!(parse("wait checked").unwrap(), Step::WaitChecked);
+        assert_eq!(parse("lab check").unwrap(), Step::LabCheck);
         assert_eq!(parse("probe").unwrap(), Step::Probe);
         assert_eq!(parse("wait 3").unwrap(), Step::Wait(3));
         assert_eq!(parse("wait 1.5s").unwrap(), Step::WaitFor(std::time::Duration::from_millis(1500)));

@@ -93,6 +93,8 @@ pub struct UiOutput {
     pub lab_shown: Option<LabShown>,
     /// The page's lab editor changed the student's text.
     pub lab_edited: bool,
+    /// The lab panel's Check button was pressed.
+    pub lab_check: bool,
 }
 
 /// Draws the whole window.
@@ -294,6 +296,15 @@ fn lab_section(ui: &mut egui::Ui, lab: &LabPanel, output: &mut UiOutput) {
         ui.small("Compiles.");
     } else {
         ui.colored_label(ui.visuals().error_fg_color, format!("Does not compile: {} drawn.", lab.fallback));
+    }
+    let running = lab.checking.is_some_and(super::lab::Checking::running);
+    let check = ui.add_enabled(!running, egui::Button::new("Check")).on_hover_text(
+        "Run the lab's tests on your file as it is now: each function on known inputs, then the lab's \
+         scenes drawn with it against Mirador's and the ray tracer's images.",
+    );
+    output.lab_check |= check.clicked();
+    if let Some(checking) = lab.checking {
+        checking.show(ui);
     }
 }
 

@@ -145,6 +145,9 @@ impl App {
         }
         page::remember_view(viewer.view_pixels);
         page::remember_lab_file(viewer.lab_file());
+        if let Some(json) = viewer.lab_results.take() {
+            page::lab_checked(json);
+        }
         // Steps run one a frame, as a scripted native run does.
         if !viewer.script_done() {
             screen.window.request_redraw();

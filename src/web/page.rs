@@ -26,6 +26,8 @@ thread_local! {
     static LAB_TEXT: RefCell<Option<String>> = const { RefCell::new(None) };
     /// The open lab's file name and text at the last frame, for the download.
     static LAB_FILE: RefCell<Option<(String, String)>> = const { RefCell::new(None) };
+    /// The last finished check's `results.json`, for the download.
+    static LAB_RESULTS: RefCell<Option<String>> = const { RefCell::new(None) };
 }
 
 pub(super) fn set_proxy(proxy: EventLoopProxy<Wake>) {
@@ -106,6 +108,20 @@ pub(super) fn take_lab_asked() -> Option<String> {
 
 pub(super) fn remember_lab_file(file: Option<(String, String)>) {
     LAB_FILE.with(|f| *f.borrow_mut() = file);
+}
+
+/// The last finished check's `results.json` (Gradescope's format, as `mirador lab check` writes
+/// it), for the page's download button; empty before the first check.
+#[wasm_bindgen]
+pub fn lab_results() -> String {
+    LAB_RESULTS.with(|r| r.borrow().clone().unwrap_or_default())
+}
+
+/// A check finished: its `results.json` is kept for the download, and handed to the page's
+/// `window.miradorLabChecked(json)` if it defines one (web/test.js does).
+pub(super) fn lab_checked(json: String) {
+    call_page("miradorLabChecked", &[JsValue::from_str(&json)]);
+    LAB_RESULTS.with(|r| *r.borrow_mut() = Some(json));
 }
 
 /// The built-in scenes' paths, for the page's menu.

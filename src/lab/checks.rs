@@ -1,0 +1,324 @@
+//! A lab's tests, one at a time, natively and in the page alike: a known-answer test calls one of
+//! the student's functions ([`super::harness`]), an image test draws a scene with them
+//! ([`super::images`]), and a test that fails is matched against the lab's known mistakes.
+//!
+//! A test is a future whose only waits are GPU readbacks. Natively `mirador lab run` waits for
+//! each ([`crate::gpu::readback::block_on`]); the page polls it once a frame, because a browser
+//! maps a buffer only after the page returns to its event loop. The same code gives the same
+//! findings in both.
+
+use super::harness::Harness;
+use super::images::{self, Outcome};
+use super::report::TestResult;
+use super::{Against, ImageTest, KnownAnswer, Lab, Mistake, source};
+use crate::gpu::Gpu;
+use crate::shaders::Wgsl;
+use image::RgbaImage;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// A test of a lab: the lab's own, or a teacher's hidden one (from `folder`).
+#[derive(Clone, Debug)]
+pub enum Test {
+    Known(KnownAnswer),
+    Image(ImageTest, Option<PathBuf>),
+}
+
+impl Test {
+    pub fn name(&self) -> &str {
+        match self {
+            Test::Known(test) => &test.name,
+            Test::Image(test, _) => &test.name,
+        }
+    }
+
+    pub fn points(&self) -> f32 {
+        match self {
+            Test::Known(test) => test.points,
+            Test::Image(test, _) => test.points,
+        }
+    }
+
+    /// The lab's own tests: its known answers, then its image tests.
+    pub fn of(lab: &Lab) -> Vec<Test> {
+        let mut tests: Vec<Test> = lab.known_answers.iter().cloned().map(Test::Known).collect();
+        tests.extend(lab.images.iter().cloned().map(|t| Test::Image(t, None)));
+        tests
+    }
+
+    /// The result of this test with `finding`, at `points`' score for it when they name it.
+    pub fn result(&self, finding: Finding, points: &BTreeMap<String, f32>) -> TestResult {
+        let max_score = points.get(self.name()).copied().unwrap_or(self.points());
+        let mut output = finding.output;
+        if let Some((name, sentence)) = &finding.mistake {
+            output.push_str(&format!("\nThis looks like a known mistake, {name}: {sentence}"));
+        }
+        TestResult {
+            name: self.name().to_owned(),
+            score: if finding.passed { max_score } else { 0.0 },
+            max_score,
+            output,
+            mistake: finding.mistake.map(|(name, _)| name),
+            passed: finding.passed,
+            images: finding.images,
+        }
+    }
+}
+
+/// What one test found, as the run reports it to the checker.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Finding {
+    pub index: usize,
+    pub passed: bool,
+    pub output: String,
+    /// The known mistake the student's result matches, and what to tell them.
+    pub mistake: Option<(String, String)>,
+    /// Correct, yours, difference: the image test's PNGs, relative to the lab's folder.
+    pub images: Option<[String; 3]>,
+}
+
+impl Finding {
+    /// A test that did not run, and why.
+    pub fn unfinished(index: usize, why: &str) -> Finding {
+        Finding { index, passed: false, output: why.to_owned(), mistake: None, images: None }
+    }
+}
+
+/// What a test found and, for an image test, its pictures: correct, yours, difference.
+pub struct Checked {
+    pub finding: Finding,
+    pub pictures: Option<[RgbaImage; 3]>,
+}
+
+/// What every test of one check shares: the device, the harness, and the student's, Mirador's
+/// and each known mistake's functions, compiled once.
+pub struct Checker {
+    pub gpu: Gpu,
+    harness: Harness,
+    student: Wgsl,
+    reference: Wgsl,
+    mistakes: Vec<(Mistake, Wgsl)>,
+}
+
+impl Checker {
+    /// The checker of `text` (the student's file) for `lab`, on `gpu`.
+    pub fn new(gpu: Gpu, lab: &Lab, text: &str) -> Checker {
+        let mistakes = lab.mistakes.iter().map(|m| (m.clone(), source::student(lab, &lab.mistaken(m)))).collect();
+        Checker {
+            harness: Harness::new(&gpu),
+            student: source::student(lab, text),
+            reference: source::reference(lab),
+            mistakes,
+            gpu,
+        }
+    }
+
+    /// Runs `test`, the `index`-th of the check. An image test's scene is read from `folder`
+    /// when the test came from there (a teacher's hidden tests).
+    pub async fn run(&self, test: &Test, index: usize) -> Checked {
+        match test {
+            Test::Known(known) => Checked { finding: self.known_answer(known, index).await, pictures: None },
+            Test::Image(image, folder) => self.image_test(image, folder.as_deref(), index).await,
+        }
+    }
+
+    async fn known_answer(&self, test: &KnownAnswer, index: usize) -> Finding {
+        let value = match self.harness.call(&self.gpu, &self.student, &test.call).await {
+            Ok(value) => value,
+            Err(error) => return Finding { index, passed: false, output: error, mistake: None, images: None },
+        };
+        let (passed, wanted) = judge_value(test, value);
+        let shown = |v: [f32; 4]| format!("({}, {}, {}, {})", v[0], v[1], v[2], v[3]);
+        let output = format!("{} = {}; {wanted}", test.call, shown(value));
+        let mut mistake = None;
+        if !passed {
+            // The mistake whose own value is this one (and is wrong).
+            let tolerance = test.tolerance.max(1e-5);
+            for (m, wgsl) in &self.mistakes {
+                let Ok(theirs) = self.harness.call(&self.gpu, wgsl, &test.call).await else { continue };
+                let same =
+                    theirs.iter().zip(value).all(|(a, b)| (a - b).abs() <= tolerance || (a.is_nan() && b.is_nan()));
+                if same && !judge_value(test, theirs).0 {
+                    mistake = Some((m.name.clone(), m.sentence.clone()));
+                    break;
+                }
+            }
+        }
+        Finding { index, passed, output, mistake, images: None }
+    }
+
+    async fn image_test(&self, test: &ImageTest, folder: Option<&Path>, index: usize) -> Checked {
+        let fail = |output: String| Checked {
+            finding: Finding { index, passed: false, output, mistake: None, images: None },
+            pictures: None,
+        };
+        let gpu = &self.gpu;
+        let scene = match images::scene(test, folder) {
+            Ok(scene) => scene,
+            Err(error) => return fail(format!("the test's scene: {error}")),
+        };
+        let yours = match images::drawn(gpu, &scene, &self.student).await {
+            Ok(image) => image,
+            Err(error) => return fail(format!("drawing with your functions: {error}")),
+        };
+        let mirador = match images::drawn(gpu, &scene, &self.reference).await {
+            Ok(image) => image,
+            Err(error) => return fail(format!("drawing with Mirador's functions: {error}")),
+        };
+        let (correct, outcome) = match test.against {
+            Against::Reference => (mirador.clone(), images::judge(test, &mirador, &yours, None)),
+            Against::Tracer => {
+                let traced = images::traced(&scene);
+                let outcome = images::judge(test, &traced, &yours, Some(&mirador));
+                (traced, outcome)
+            }
+        };
+        let Outcome { passed, error_map, output, .. } = outcome;
+        let mut mistake = None;
+        if !passed {
+            for (m, wgsl) in &self.mistakes {
+                let Ok(theirs) = images::drawn(gpu, &scene, wgsl).await else { continue };
+                let (same, _) = images::figures(&theirs, &yours);
+                if same.mean <= 0.002 && same.worst_region <= 0.02 {
+                    mistake = Some((m.name.clone(), m.sentence.clone()));
+                    break;
+                }
+            }
+        }
+        Checked {
+            finding: Finding { index, passed, output, mistake, images: None },
+            pictures: Some([correct, yours, error_map]),
+        }
+    }
+}
+
+/// Whether `value` is right, and what was wanted.
+fn judge_value(test: &KnownAnswer, value: [f32; 4]) -> (bool, String) {
+    if let Some(expect) = test.expect {
+        let ok = value.iter().zip(expect).all(|(v, e)| (v - e).abs() <= test.tolerance);
+        return (
+            ok,
+            format!("expected ({}, {}, {}, {}) ± {}", expect[0], expect[1], expect[2], expect[3], test.tolerance),
+        );
+    }
+    let min = test.min.unwrap_or([f32::NEG_INFINITY; 4]);
+    let max = test.max.unwrap_or([f32::INFINITY; 4]);
+    let ok = (0..4).all(|i| value[i] >= min[i] && value[i] <= max[i]);
+    (ok, format!("expected each component within [{:?}, {:?}]", min, max))
+}
+
+/// A test under way: a future the page polls once a frame.
+type Running = std::pin::Pin<Box<dyn std::future::Future<Output = Checked>>>;
+
+/// A whole check polled a step at a time ([`Progress::advance`]), as the viewer's lab panel runs
+/// it: in the page, where nothing may wait, and natively alike. It finds what `mirador lab check`
+/// finds for the same text, without the child process and its time limit.
+pub struct Progress {
+    lab: Lab,
+    problems: Vec<source::Problem>,
+    checker: std::rc::Rc<Checker>,
+    tests: Vec<Test>,
+    running: Option<Running>,
+    results: Vec<TestResult>,
+    pictures: Vec<Option<[RgbaImage; 3]>>,
+    started: web_time::Instant,
+    seconds: Option<f64>,
+}
+
+impl Progress {
+    /// Starts checking `text` against `lab`'s own tests on `gpu`: its problems first (as the
+    /// device compiles it); a text with any runs no test.
+    pub fn start(gpu: &Gpu, lab: &Lab, text: &str) -> Progress {
+        let problems = source::problems_on(lab, text, gpu.profile());
+        let tests = Test::of(lab);
+        let mut progress = Progress {
+            lab: lab.clone(),
+            checker: std::rc::Rc::new(Checker::new(gpu.clone(), lab, text)),
+            tests,
+            running: None,
+            results: Vec::new(),
+            pictures: Vec::new(),
+            started: web_time::Instant::now(),
+            seconds: None,
+            problems,
+        };
+        if !progress.problems.is_empty() {
+            let why = format!("not run: {} does not compile (see the first problem above)", lab.file);
+            for index in 0..progress.tests.len() {
+                progress.finish(Checked { finding: Finding::unfinished(index, &why), pictures: None });
+            }
+        }
+        progress
+    }
+
+    /// Polls the test under way once, starting it first if none is; returns whether a test
+    /// finished.
+    pub fn advance(&mut self) -> bool {
+        let index = self.results.len();
+        if index == self.tests.len() {
+            return false;
+        }
+        let running = self.running.get_or_insert_with(|| {
+            let (checker, test) = (self.checker.clone(), self.tests[index].clone());
+            Box::pin(async move { checker.run(&test, index).await })
+        });
+        match crate::gpu::readback::poll_once(running.as_mut()) {
+            Some(checked) => {
+                self.running = None;
+                self.finish(checked);
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn finish(&mut self, checked: Checked) {
+        let test = &self.tests[self.results.len()];
+        self.results.push(test.result(checked.finding, &BTreeMap::new()));
+        self.pictures.push(checked.pictures);
+        if self.results.len() == self.tests.len() {
+            self.seconds = Some(self.started.elapsed().as_secs_f64());
+        }
+    }
+
+    /// Whether every test has run.
+    pub fn done(&self) -> bool {
+        self.seconds.is_some()
+    }
+
+    /// How many tests the check runs.
+    pub fn len(&self) -> usize {
+        self.tests.len()
+    }
+
+    /// Whether the lab has no test at all.
+    pub fn is_empty(&self) -> bool {
+        self.tests.is_empty()
+    }
+
+    /// The results so far, in the tests' order.
+    pub fn results(&self) -> &[TestResult] {
+        &self.results
+    }
+
+    /// Each finished test's pictures (correct, yours, difference), for an image test.
+    pub fn pictures(&self) -> &[Option<[RgbaImage; 3]>] {
+        &self.pictures
+    }
+
+    /// The problems that kept the tests from running.
+    pub fn problems(&self) -> &[source::Problem] {
+        &self.problems
+    }
+
+    /// The check's report so far (whole once [`Progress::done`]): what `results.json` holds.
+    pub fn report(&self) -> super::report::Report {
+        super::report::Report {
+            lab: self.lab.clone(),
+            problems: self.problems.clone(),
+            results: self.results.clone(),
+            seconds: self.seconds.unwrap_or_else(|| self.started.elapsed().as_secs_f64()),
+        }
+    }
+}
