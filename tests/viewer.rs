@@ -605,6 +605,8 @@ fn lab_mode_redraws_a_saved_edit_shows_a_broken_one_and_recovers() {
         steps.push(format!("wait {wait}"));
         steps.push(format!("screenshot {}", shot(n).display()));
     }
+    // The panel's Check button on the fixed file: every test passes, as `lab check` finds.
+    steps.extend(["lab check".to_owned(), "wait checked".to_owned()]);
     assert!(on_path("xvfb-run"), "install Xvfb (`sudo apt-get install xvfb`) to run the viewer tests");
     let mut command = Command::new("xvfb-run");
     command.args(["-a", "-s", "-screen 0 1920x1080x24", binary, "view", "--lab"]).arg(&lab_dir);
@@ -670,7 +672,17 @@ fn lab_mode_redraws_a_saved_edit_shows_a_broken_one_and_recovers() {
     assert_eq!(error_fill(&shots[4]), 0, "the error box stayed after the fix");
     let recovered = common::difference(&view(1), &view(5)).flip_mean;
     assert!(recovered < 0.005, "the fixed file does not draw the first image (mean FLIP {recovered})");
+    let lab = mirador::lab::find("transparency").expect("a built-in lab");
+    let tests = lab.known_answers.len() + lab.images.len();
+    let passed = format!("lab transparency: {0} / {0} points, {tests} of {tests} tests passed", lab_points(&lab));
+    assert!(stdout.contains(&passed), "the panel's check of the fixed file: no `{passed}` in\n{stdout}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A lab's full marks, as the reports write them.
+fn lab_points(lab: &mirador::lab::Lab) -> String {
+    let total: f32 = lab.known_answers.iter().map(|t| t.points).chain(lab.images.iter().map(|t| t.points)).sum();
+    mirador::lab::report::points(total)
 }
 
 /// Settings changed in one scene stay with it: the next scene opens with its own, the first

@@ -10,8 +10,9 @@
 //! shadows in the page gives the headless image without shadows, the split view's halves are the raster and the traced
 //! images (the tracer ran in the page, in slices: exactly the native image), and the difference view is the page's
 //! FLIP map of those two images, as `compare` makes it; the hybrid's traced shadows are `render`'s;
-//! and a lab's stub, reference, a student's solution typed into the editor and then a typo are
-//! drawn as the native renderer compiled from the same WGSL draws them.
+//! a lab's stub, reference, difference, a student's solution typed into the editor and then a
+//! typo are drawn as the native renderer compiled from the same WGSL draws them; and the lab's
+//! checks in the page score a wrong solution and a right one as the native checker does.
 
 mod common;
 
@@ -172,6 +173,17 @@ fn the_page_draws_what_the_native_renderers_draw() {
         apart >= MIN_TOGGLE_RATIO * error,
         "the page's stub is as near the reference ({apart}) as the page's reference is ({error})"
     );
+
+    // The lab's difference view in the page: the error map between the reference and the stub,
+    // as `compare` makes it from the native images (the page's own images differ from the
+    // native ones by a little, so the map does too; against the stub's image it is far).
+    let (difference, difference_view) = shot(&dir, "lab-difference.png");
+    assert_eq!(difference_view, lab_view);
+    let native_map = mirador::compare::difference(&native_reference, &native_stub).expect("same sizes").error_map;
+    let error = flip(&native_map, &crop(&difference, lab_view), "lab-difference", &dir);
+    assert!(error <= MAX_CROSS_GPU_FLIP, "the page's lab difference differs from the native map: {error}");
+    let apart = flip(&native_map, &crop(&stub, lab_view), "lab-difference-against-stub", &dir);
+    assert!(apart >= MIN_TOGGLE_RATIO * error, "the page's difference view is as near the stub ({apart}) as the map");
 
     // The student's reflection typed into the editor draws the reference's image; a typo then
     // keeps it drawn (the last version that compiled), with the problem over the view's top left.

@@ -2,7 +2,7 @@
 // page's own interface, `mirador.step(...)`, which the scene menu and the file picker use too:
 // the showcase as it opens, the shadows toggled off, the split view once the tracer has finished
 // in the page, the difference view, the hybrid's traced shadows over acned shadow maps, a lab's
-// stub and reference, a student's edits, and the lab's checks run in the page on a wrong solution
+// stub, reference and difference, a student's edits, and the lab's checks run in the page on a wrong solution
 // and a right one (their results.json posted as `lab-wrong.json`, `lab-right.json`, with the
 // texts checked). Each screenshot (the whole canvas, PNG) is posted to the
 // test server with the 3D view's rectangle; `done` ends the run, `failed` says why it stopped.
@@ -19,7 +19,7 @@ const count = async () => {
 export function run(mirador) {
   // What the page does next once a screenshot is posted: the lab's steps follow one another.
   const after = {
-    "lab-reference.png": () => editTheLab(mirador),
+    "lab-difference.png": () => editTheLab(mirador),
     "lab-solved.png": () => typo(mirador),
     "lab-typo.png": () => check(mirador, "lab-wrong", WRONG),
     "lab-checked.png": () => check(mirador, "lab-right", REFLECTION),
@@ -74,6 +74,9 @@ export function run(mirador) {
     "lab reference",
     "wait 4s",
     "screenshot lab-reference.png",
+    "lab difference",
+    "wait 4s",
+    "screenshot lab-difference.png",
   ];
   const screenshots = [...steps, ...LAB_EDITS, ...LAB_TYPO, ...CHECK].filter((s) => s.startsWith("screenshot"));
   // And each check's text and results.json.
@@ -81,7 +84,7 @@ export function run(mirador) {
   for (const step of steps) mirador.step(step);
 }
 
-// What a student does next, once the reference is shown: writes the reflection (this text, as
+// What a student does next, once the reference and the difference are shown: writes the reflection (this text, as
 // if typed into the editor), sees it drawn, then saves a version with a typo: the view keeps the
 // last version that compiled and shows the problem.
 const REFLECTION = `fn mirror_reflection(plane: vec4f) -> mat4x4f {

@@ -612,7 +612,7 @@ impl Viewer {
         // frame or two after they are asked for, and the hybrid's traced terms are refined frame
         // by frame while the camera rests.
         let busy = self.traced.worker.busy()
-            || self.lab.as_ref().is_some_and(LabMode::checking)
+            || self.lab.as_ref().is_some_and(|lab| lab.checking() || lab.drawing())
             || self.raster.reading_back()
             || self.raster.refining()
             || screen.screenshots_pending();

@@ -21,8 +21,8 @@
 //! In the page (`index.html`'s lab menu) the student's file is the text of an editor beside the
 //! view, taken in a moment after the last keystroke, checked the same way (naga's messages, at
 //! the same `line:column`; on WebGL2 also as WebGL2 compiles it), and downloaded with the page's
-//! button, as is the last check's `results.json`. The page draws the student's functions and the
-//! reference and runs the checks; its difference view is the check's pictures.
+//! button, as is the last check's `results.json`. Everything else is as natively: the three
+//! views, the checks ([`super::lab_difference`] and the checks draw over a few frames there).
 
 /// What the view shows in lab mode.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -73,7 +73,7 @@ pub struct LabPanel<'a> {
     pub fallback: &'static str,
     /// The difference view's error map and its mean, once made for the current view.
     pub difference: Option<(egui::TextureId, f32)>,
-    /// What the view can show: the page's difference view is the check's pictures.
+    /// What the view can show.
     pub choices: &'static [LabShown],
     /// When the student's text is taken in.
     pub how: &'static str,
@@ -244,14 +244,13 @@ mod native {
     use web_time::Instant;
 
     use super::LabShown;
+    use crate::Scene;
     use crate::gpu::Gpu;
     use crate::lab::check::LabFolder;
     use crate::lab::{Lab, source};
-    use crate::raster::Headless;
-    use crate::scene::{Camera, Light};
     use crate::shaders::Wgsl;
+    use crate::viewer::lab_difference::DifferenceView;
     use crate::viewer::scene_state::{WATCH_PERIOD, modified};
-    use crate::{RenderSettings, Scene};
 
     pub struct LabMode {
         pub lab: Lab,
@@ -264,37 +263,10 @@ mod native {
         /// What the view draws of the student's file.
         compiled: super::Compiled,
         pub shown: LabShown,
-        /// The difference view's image and mean, and what it was made from.
-        pub difference: Option<ShownDifference>,
-        /// The renderers that draw it, kept from one view to the next.
-        renderers: Option<DifferenceRenderers>,
+        /// The difference view.
+        difference: DifferenceView,
         /// The last check run from the panel.
         pub checking: Option<super::Checking>,
-    }
-
-    /// The two renderers the difference view draws with, kept while the student's functions, the
-    /// scene and the view's size stay the same: making one compiles every pass.
-    struct DifferenceRenderers {
-        /// The student's version, the scene's revision and the image size they were made for.
-        made_for: (u64, u64, (u32, u32)),
-        reference: Headless,
-        student: Headless,
-    }
-
-    pub struct ShownDifference {
-        pub texture: egui::TextureHandle,
-        pub flip_mean: f32,
-        inputs: DifferenceInputs,
-    }
-
-    /// Everything the difference image depends on.
-    #[derive(Clone, PartialEq)]
-    struct DifferenceInputs {
-        camera: Camera,
-        lights: Vec<Light>,
-        settings: RenderSettings,
-        revision: u64,
-        generation: u64,
     }
 
     impl LabMode {
@@ -321,8 +293,7 @@ mod native {
                 checked: Instant::now(),
                 file,
                 shown: LabShown::Student,
-                difference: None,
-                renderers: None,
+                difference: DifferenceView::default(),
                 checking: None,
             };
             mode.read();
@@ -388,7 +359,7 @@ mod native {
                 shown: self.shown,
                 problems: &self.compiled.problems,
                 fallback: self.compiled.fallback(),
-                difference: self.difference.as_ref().map(|d| (d.texture.id(), d.flip_mean)),
+                difference: self.difference.shown(),
                 choices: &LabShown::ALL,
                 how: "redrawn when saved",
                 checking: self.checking.as_ref(),
@@ -419,60 +390,15 @@ mod native {
         /// In the difference view, the error map between the reference's image and the
         /// student's of `scene` (at the view's size) unless it already shows them.
         pub fn update_difference(&mut self, gpu: &Gpu, ctx: &egui::Context, scene: &Scene, revision: u64) {
-            if self.shown != LabShown::Difference {
-                return;
+            if self.shown == LabShown::Difference {
+                let functions = (&source::reference(&self.lab), &self.compiled.student, self.compiled.generation);
+                self.difference.update(gpu, ctx, functions, scene, revision);
             }
-            let inputs = DifferenceInputs {
-                camera: scene.camera.clone(),
-                lights: scene.lights.clone(),
-                settings: scene.settings.clone(),
-                revision,
-                generation: self.compiled.generation,
-            };
-            if self.difference.as_ref().is_some_and(|d| d.inputs == inputs) {
-                return;
-            }
-            let made_for = (self.compiled.generation, revision, (scene.camera.width, scene.camera.height));
-            let (lab, student, kept) = (&self.lab, &self.compiled.student, &mut self.renderers);
-            let drawn = gpu.checked(|| {
-                let renderers = match kept.take() {
-                    Some(renderers) if renderers.made_for == made_for => renderers,
-                    _ => DifferenceRenderers {
-                        made_for,
-                        reference: Headless::with_wgsl(gpu, scene, source::reference(lab)),
-                        student: Headless::with_wgsl(gpu, scene, student.clone()),
-                    },
-                };
-                let renderers = kept.insert(renderers);
-                let reference = renderers.reference.render(gpu, scene, &scene.settings);
-                (reference, renderers.student.render(gpu, scene, &scene.settings))
-            });
-            let (reference, student) = match drawn {
-                Ok(images) => images,
-                Err(e) => {
-                    self.renderers = None;
-                    log::warn!("lab difference: {e}");
-                    return;
-                }
-            };
-            let Ok(difference) = crate::compare::difference(&reference, &student) else { return };
-            let map = &difference.error_map;
-            let image =
-                egui::ColorImage::from_rgba_unmultiplied([map.width() as usize, map.height() as usize], map.as_raw());
-            let options = egui::TextureOptions::NEAREST;
-            let texture = match self.difference.take() {
-                Some(mut shown) => {
-                    shown.texture.set(image, options);
-                    shown.texture
-                }
-                None => ctx.load_texture("viewer::lab_difference", image, options),
-            };
-            println!(
-                "lab: difference against the reference, {} mean {:.4}",
-                crate::compare::METRIC,
-                difference.flip_mean
-            );
-            self.difference = Some(ShownDifference { texture, flip_mean: difference.flip_mean, inputs });
+        }
+
+        /// Whether the difference view's images are being drawn.
+        pub fn drawing(&self) -> bool {
+            self.difference.drawing()
         }
     }
 }
@@ -506,6 +432,7 @@ mod page {
         profile: Profile,
         /// The last check run from the panel.
         pub checking: Option<super::Checking>,
+        difference: super::super::lab_difference::DifferenceView,
     }
 
     impl LabMode {
@@ -526,6 +453,7 @@ mod page {
                 shown: LabShown::Student,
                 profile,
                 checking: None,
+                difference: Default::default(),
             };
             Ok((mode, scene))
         }
@@ -588,8 +516,8 @@ mod page {
                 shown: self.shown,
                 problems: &self.compiled.problems,
                 fallback: self.compiled.fallback(),
-                difference: None,
-                choices: &[LabShown::Student, LabShown::Reference],
+                difference: self.difference.shown(),
+                choices: &LabShown::ALL,
                 how: "redrawn as you type",
                 checking: self.checking.as_ref(),
             }
@@ -605,17 +533,33 @@ mod page {
             self.checking = Some(super::Checking::start(gpu, &self.lab, &self.text));
         }
 
-        /// Shows `shown`; the page's difference view is the check's pictures, so the L key goes
-        /// back to the student's.
+        /// Shows `shown` from the next frame on.
         pub fn show(&mut self, shown: LabShown) {
-            let shown = if shown == LabShown::Difference { LabShown::Student } else { shown };
             if shown != self.shown {
                 self.shown = shown;
                 self.compiled.changed = true;
             }
         }
 
-        pub fn update_difference(&mut self, _: &crate::gpu::Gpu, _: &egui::Context, _: &crate::Scene, _: u64) {}
+        /// In the difference view, the error map between the reference's image and the
+        /// student's of `scene`, drawn over the next frames unless it already shows them.
+        pub fn update_difference(
+            &mut self,
+            gpu: &crate::gpu::Gpu,
+            ctx: &egui::Context,
+            scene: &crate::Scene,
+            revision: u64,
+        ) {
+            if self.shown == LabShown::Difference {
+                let functions = (&source::reference(&self.lab), &self.compiled.student, self.compiled.generation);
+                self.difference.update(gpu, ctx, functions, scene, revision);
+            }
+        }
+
+        /// Whether the difference view's images are being drawn.
+        pub fn drawing(&self) -> bool {
+            self.difference.drawing()
+        }
     }
 }
 

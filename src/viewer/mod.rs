@@ -33,6 +33,7 @@ pub mod hud;
 pub mod inspect;
 pub mod kept;
 pub mod lab;
+pub mod lab_difference;
 pub mod panel;
 pub mod picking;
 pub mod raster_view;
