@@ -80,8 +80,8 @@ pub fn is_missing(path: &Path) -> bool {
 }
 
 /// The files built into the browser's page, by their paths in the source tree: every file under
-/// `assets/` but the READMEs (`tests/web.rs` checks the list), and the model a course scene
-/// borrows from the tests. [`builtin_bytes`] holds their bytes, in the browser build only.
+/// `assets/` but the READMEs and the [`FETCHED`] ones (`tests/web.rs` checks the lists), and the
+/// model a course scene borrows from the tests. [`builtin_bytes`] holds their bytes, in the browser build only.
 macro_rules! builtin_files {
     ($($path:literal),* $(,)?) => {
         pub const BUILTIN: &[&str] = &[$($path),*];
@@ -132,10 +132,14 @@ builtin_files!(
     "assets/scenes/volume.toml",
     "assets/textures/checker.png",
     "assets/textures/cobbles-height.png",
-    "assets/volumes/phantom.nrrd",
-    "tests/data/obj/teapot.obj",
     "tests/data/obj/teapot.mtl",
 );
+
+/// The files the page fetches beside its module when it starts, rather than carrying them: the
+/// largest (the phantom is 0.2 MB that compression cannot shrink, the teapot 0.07 MB compressed),
+/// which only a few scenes name. web/build.sh copies them into the page's folder at the same
+/// paths; web/files.js fetches them, and the page's scene and lab menus wait for them.
+pub const FETCHED: &[&str] = &["assets/volumes/phantom.nrrd", "tests/data/obj/teapot.obj"];
 
 /// The browser's files: a map from a normalized path (`assets/scenes/showcase.toml`,
 /// `opened/model.glb`) to the file's bytes, filled at start with the built-in assets and then by

@@ -5,8 +5,8 @@
 use std::path::Path;
 use std::process::Command;
 
-/// Every file under assets/ but the READMEs is built into the page (`files::BUILTIN`), and every
-/// name in the list exists: a scene added without its texture, or a list left behind, fails here
+/// Every file under assets/ but the READMEs is built into the page (`files::BUILTIN`) or fetched by
+/// it (`files::FETCHED`), and every name in the lists exists: a scene added without its texture, or a list left behind, fails here
 /// rather than in a browser.
 #[test]
 fn the_page_carries_every_asset() {
@@ -24,12 +24,15 @@ fn the_page_carries_every_asset() {
         }
     }
     on_disk.sort();
-    let mut built_in: Vec<String> =
-        mirador::files::BUILTIN.iter().filter(|p| p.starts_with("assets/")).map(|p| p.to_string()).collect();
-    built_in.sort();
-    assert_eq!(built_in, on_disk, "src/files.rs's builtin_files! list and assets/ differ");
-    for path in mirador::files::BUILTIN {
-        assert!(root.join(path).is_file(), "{path} is built into the page but is not a file");
+    let files = || mirador::files::BUILTIN.iter().chain(mirador::files::FETCHED);
+    let mut in_page: Vec<String> = files().filter(|p| p.starts_with("assets/")).map(|p| p.to_string()).collect();
+    in_page.sort();
+    assert_eq!(in_page, on_disk, "src/files.rs's lists (built in and fetched) and assets/ differ");
+    for path in files() {
+        assert!(root.join(path).is_file(), "{path} is in the page but is not a file");
+    }
+    for path in mirador::files::FETCHED {
+        assert!(!mirador::files::BUILTIN.contains(path), "{path} is both built in and fetched");
     }
 }
 
@@ -39,18 +42,23 @@ fn the_page_carries_every_asset() {
 #[test]
 fn the_library_compiles_for_the_browser() {
     let target_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("web-check");
-    let output = Command::new(env!("CARGO"))
-        .args(["check", "--locked", "--lib", "--target", "wasm32-unknown-unknown", "--message-format", "short"])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env("CARGO_TARGET_DIR", &target_dir)
-        .output()
-        .expect("running cargo");
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(
-        !stderr.contains("can't find crate for `core`") && !stderr.contains("target may not be installed"),
-        "the wasm32-unknown-unknown standard library is missing: `rustup target add wasm32-unknown-unknown` \
-         (README's install line)\n{stderr}"
-    );
-    assert!(output.status.success(), "the library does not compile for the browser:\n{stderr}");
-    assert!(!stderr.contains("warning:"), "the browser build warns:\n{stderr}");
+    // Both of the page's modules: WebGPU's, and the one with WebGL2 (web/build.sh).
+    for features in [None, Some("--features=webgl2")] {
+        let output = Command::new(env!("CARGO"))
+            .args(["check", "--locked", "--lib", "--target", "wasm32-unknown-unknown", "--message-format", "short"])
+            .args(features)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .env("CARGO_TARGET_DIR", &target_dir)
+            .output()
+            .expect("running cargo");
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(
+            !stderr.contains("can't find crate for `core`") && !stderr.contains("target may not be installed"),
+            "the wasm32-unknown-unknown standard library is missing: `rustup target add wasm32-unknown-unknown` \
+             (README's install line)\n{stderr}"
+        );
+        let module = features.map_or("WebGPU", |_| "WebGL2");
+        assert!(output.status.success(), "the library does not compile for the browser ({module}):\n{stderr}");
+        assert!(!stderr.contains("warning:"), "the browser build warns ({module}):\n{stderr}");
+    }
 }

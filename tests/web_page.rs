@@ -151,6 +151,18 @@ fn the_page_draws_what_the_native_renderers_draw() {
         "the page's hybrid is as close to the acne ({against_acne}) as to the traced shadows ({error})"
     );
 
+    // A scene whose volume the page fetched beside its module (files::FETCHED), as `render` draws it.
+    let (phantom, phantom_view) = shot(&dir, "phantom.png");
+    assert_eq!(phantom_view, view);
+    let path = mirador::scene::builtin_path("course/volume-phantom.toml");
+    let mut scene = Scene::load(&path).expect("the phantom's scene");
+    (scene.camera.width, scene.camera.height) = (view[2], view[3]);
+    let expected = common::raster(&scene, &scene.settings);
+    let error = flip(&expected, &crop(&phantom, view), "phantom", &dir);
+    assert!(error <= MAX_CROSS_GPU_FLIP, "the phantom in the page differs from `render`'s: {error}");
+    let against_showcase = flip(&raster, &crop(&phantom, view), "phantom-against-showcase", &dir);
+    assert!(against_showcase >= MIN_TOGGLE_RATIO * error, "the page did not draw the phantom: {against_showcase}");
+
     // The lab in the page: the planar-mirrors lab's scene drawn with the stub's functions and with
     // Mirador's, each against the native renderer compiled from the same WGSL (the editor beside
     // the view leaves the view narrower).

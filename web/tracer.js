@@ -1,13 +1,18 @@
-// The page's tracer worker (src/web/tracer.rs, src/viewer/traced/pool.rs): the same module as the
-// page, without a window. It is given a job (the scene as the page has it, and the files the
-// person opened), then rows of the full image, and posts back their radiance.
-import init, * as mirador from "./mirador.js";
+// The page's tracer worker (src/web/tracer.rs, src/viewer/traced/pool.rs): the module the page
+// loaded (`?module=`), without a window. It is given a job (the scene as the page has it, and the
+// files the person opened), then rows of the full image, and posts back their radiance.
+import { fetchAssets } from "./files.js";
 
-const ready = init();
+const module = new URL(self.location.href).searchParams.get("module") ?? "mirador.js";
+const ready = import(`./${module}`).then(async (mirador) => {
+  await mirador.default();
+  await fetchAssets(mirador);
+  return mirador;
+});
 self.onmessage = async (event) => {
-  await ready;
   const message = event.data;
   try {
+    const mirador = await ready;
     if (message.files) {
       for (const [name, bytes] of message.files) mirador.add_file(name, bytes);
     }

@@ -14,7 +14,11 @@ impl GpuTexture {
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
-        Self::image(device, label, size, format, usage)
+        let target = Self::image(device, label, size, format, usage);
+        if format.is_depth_stencil_format() {
+            depth_texels_nearest(device, &target.texture);
+        }
+        target
     }
 
     /// An image that receives copies of a target (`COPY_DST`) for shaders to read: a frame's
@@ -212,6 +216,42 @@ impl Layers {
             ..Default::default()
         });
         GpuTexture { texture, view }
+    }
+}
+
+/// On wgpu's GL backend, a depth image is set to filter NEAREST, so that shaders can read it with
+/// `textureLoad` (as unfilterable floats, [`super::layout::depth_texels`]). OpenGL ES, and so
+/// WebGL2, counts a depth texture that filters linearly without a comparison as incomplete, and
+/// reads zeros from it: the volume ended every ray at the near plane and drew nothing in the
+/// page's WebGL2 (desktop GL, llvmpipe's, reads it anyway). wgpu sets NEAREST for the colour
+/// formats that cannot filter, not for depth. A comparison sampler's own filter still applies.
+#[cfg_attr(all(target_arch = "wasm32", not(feature = "webgl2")), allow(unused_variables))]
+fn depth_texels_nearest(device: &wgpu::Device, texture: &wgpu::Texture) {
+    #[cfg(any(
+        windows,
+        target_os = "linux",
+        target_os = "android",
+        target_os = "freebsd",
+        all(target_arch = "wasm32", feature = "webgl2")
+    ))]
+    {
+        use glow::HasContext;
+        use wgpu::hal::api::Gles;
+        // SAFETY: the context is wgpu's own, locked (and made current) for the call; the texture
+        // is bound, given two parameters wgpu never sets for it, and unbound, before wgpu records
+        // anything with it (wgpu binds each texture it draws with at each draw).
+        unsafe {
+            let (Some(hal_device), Some(hal_texture)) = (device.as_hal::<Gles>(), texture.as_hal::<Gles>()) else {
+                return;
+            };
+            if let wgpu::hal::gles::TextureInner::Texture { raw, target } = hal_texture.inner {
+                let gl = hal_device.context().lock();
+                gl.bind_texture(target, Some(raw));
+                gl.tex_parameter_i32(target, glow::TEXTURE_MIN_FILTER, glow::NEAREST as i32);
+                gl.tex_parameter_i32(target, glow::TEXTURE_MAG_FILTER, glow::NEAREST as i32);
+                gl.bind_texture(target, None);
+            }
+        }
     }
 }
 

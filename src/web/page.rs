@@ -53,6 +53,19 @@ pub fn add_file(name: &str, bytes: Vec<u8>) {
     crate::files::add(&Path::new("opened").join(name), bytes);
 }
 
+/// The files the page fetches when it starts (`files::FETCHED`), by their paths relative to the
+/// page (web/files.js).
+#[wasm_bindgen]
+pub fn fetched_files() -> Vec<String> {
+    crate::files::FETCHED.iter().map(|path| path.to_string()).collect()
+}
+
+/// Adds a file the page fetched (web/files.js) at its own path, `assets/volumes/phantom.nrrd`.
+#[wasm_bindgen]
+pub fn add_asset(path: &str, bytes: Vec<u8>) {
+    crate::files::add(Path::new(path), bytes);
+}
+
 /// Queues one scripted step (`load opened/scene.toml`, `set shadows.enabled=false`, `view split`,
 /// `screenshot NAME`); an error names what is wrong with it.
 #[wasm_bindgen]

@@ -47,6 +47,12 @@ pub(super) struct Pool {
 impl Pool {
     /// One worker a core (at most 16), or `None` where the browser gives one core or no workers.
     pub fn start() -> Option<Pool> {
+        // The workers load the module the page loaded (web/index.html), from the browser's cache.
+        const WORKER: &str = if cfg!(feature = "webgl2") {
+            "./tracer.js?module=mirador_webgl2.js"
+        } else {
+            "./tracer.js?module=mirador.js"
+        };
         let cores = web_sys::window()?.navigator().hardware_concurrency() as usize;
         if cores < 2 {
             return None;
@@ -62,7 +68,7 @@ impl Pool {
         });
         let (mut workers, mut listeners) = (Vec::new(), Vec::new());
         for index in 0..cores.min(16) {
-            let worker = web_sys::Worker::new_with_options("./tracer.js", &options).ok()?;
+            let worker = web_sys::Worker::new_with_options(WORKER, &options).ok()?;
             let shared = inbox.clone();
             let listener = Closure::<dyn FnMut(web_sys::MessageEvent)>::new(move |event: web_sys::MessageEvent| {
                 let mut inbox = shared.borrow_mut();
