@@ -11,8 +11,8 @@
 //! - `lab_depth`: `texture_depth_2d_array`, 4×4, one layer, depth (x + 4y + 1)/20 at texel
 //!   (x, y): 0.05 in the top-left corner to 0.8 in the bottom-right.
 
-use crate::gpu::Gpu;
 use crate::gpu::readback::Pending;
+use crate::gpu::{Gpu, layout};
 use wgpu::util::DeviceExt;
 
 /// The harness's bindings, declared before the entry points.
@@ -38,24 +38,22 @@ pub struct Harness {
 impl Harness {
     pub fn new(gpu: &Gpu) -> Harness {
         let device = &gpu.device;
-        let entry = |binding, sample_type, view_dimension| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture { sample_type, view_dimension, multisampled: false },
-            count: None,
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        let group_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("lab::harness"),
             entries: &[
-                entry(0, wgpu::TextureSampleType::Float { filterable: false }, wgpu::TextureViewDimension::D2),
-                entry(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
+                layout::texture(
+                    0,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    wgpu::TextureViewDimension::D2,
+                ),
+                layout::texture(1, wgpu::TextureSampleType::Depth, wgpu::TextureViewDimension::D2Array),
             ],
         });
         let texture = colour_texture(gpu);
         let depth = depth_texture(gpu);
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("lab::harness"),
-            layout: &layout,
+            layout: &group_layout,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,
@@ -80,7 +78,7 @@ impl Harness {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
-        Harness { layout, group, target }
+        Harness { layout: group_layout, group, target }
     }
 
     /// The module that computes `call` (a `vec4f` expression) in the shared WGSL as `wgsl`
@@ -124,51 +122,25 @@ fn lab_main() -> @location(0) vec4u {{
             label: Some("lab::call"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("lab::call"),
             bind_group_layouts: &[Some(&self.layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("lab::call"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("lab_vertex"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("lab_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(TARGET.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let targets = [Some(TARGET.into())];
+        let pipeline = layout::fullscreen_pipeline(
+            device,
+            "lab::call",
+            &pipeline_layout,
+            &module,
+            ("lab_vertex", "lab_main"),
+            &targets,
+        );
         let view = self.target.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
         {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("lab::call"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let attachments = [Some(layout::color_attachment(&view, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))];
+            let mut pass = encoder.begin_render_pass(&layout::pass("lab::call", &attachments, None));
             pass.set_pipeline(&pipeline);
             pass.set_bind_group(0, &self.group, &[]);
             pass.draw(0..3, 0..1);

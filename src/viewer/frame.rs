@@ -827,18 +827,19 @@ impl Viewer {
         }
     }
 
-    /// Runs the next scripted step, or goes on waiting.
-    fn run_script(&mut self, input: &mut CameraInput) -> anyhow::Result<()> {
+    /// Whether a scripted wait (frames, time, the traced image, the lab's check) goes on this
+    /// frame; a wait that can never end is an error.
+    fn script_waits(&mut self) -> anyhow::Result<bool> {
         if self.screenshot.is_some() {
-            return Ok(());
+            return Ok(true);
         }
         if self.script.wait_frames > 0 {
             self.script.wait_frames -= 1;
-            return Ok(());
+            return Ok(true);
         }
         if let Some(until) = self.script.wait_until {
             if Instant::now() < until {
-                return Ok(());
+                return Ok(true);
             }
             self.script.wait_until = None;
         }
@@ -848,7 +849,7 @@ impl Viewer {
             } else if since.elapsed() > TRACE_TIMEOUT {
                 bail!("`wait checked`: the lab's check had not finished after {} s", TRACE_TIMEOUT.as_secs());
             } else {
-                return Ok(());
+                return Ok(true);
             }
         }
         if let Some(since) = self.script.wait_traced_since {
@@ -860,8 +861,16 @@ impl Viewer {
             } else if !self.view.mode.needs_traced() {
                 bail!("`wait traced` in the raster view: switch to traced, split or difference first");
             } else {
-                return Ok(());
+                return Ok(true);
             }
+        }
+        Ok(false)
+    }
+
+    /// Runs the next scripted step, or goes on waiting.
+    fn run_script(&mut self, input: &mut CameraInput) -> anyhow::Result<()> {
+        if self.script_waits()? {
+            return Ok(());
         }
         let Some(step) = self.script.steps.pop_front() else { return Ok(()) };
         log::info!("step: {step:?}");

@@ -15,9 +15,8 @@ use image::RgbaImage;
 
 use crate::gpu::Gpu;
 use crate::raster::Headless;
-use crate::scene::{Camera, Light};
 use crate::shaders::Wgsl;
-use crate::{RenderSettings, Scene};
+use crate::Scene;
 
 /// The difference view of a lab mode: what it shows, and what is being drawn for it.
 #[derive(Default)]
@@ -46,15 +45,9 @@ struct Shown {
     inputs: Inputs,
 }
 
-/// Everything the difference image depends on.
-#[derive(Clone, PartialEq)]
-struct Inputs {
-    camera: Camera,
-    lights: Vec<Light>,
-    settings: RenderSettings,
-    revision: u64,
-    generation: u64,
-}
+/// Everything the difference image depends on: what a raster image does, and the student's
+/// functions' version.
+type Inputs = (super::raster_view::Inputs, u64);
 
 impl DifferenceView {
     /// The error map and its mean, once made for the current view.
@@ -78,13 +71,7 @@ impl DifferenceView {
         scene: &Scene,
         revision: u64,
     ) {
-        let inputs = Inputs {
-            camera: scene.camera.clone(),
-            lights: scene.lights.clone(),
-            settings: scene.settings.clone(),
-            revision,
-            generation,
-        };
+        let inputs = (super::raster_view::Inputs::of(scene, &scene.settings, revision), generation);
         if self.shown.as_ref().is_some_and(|shown| shown.inputs == inputs) {
             self.pending = None;
             return;

@@ -64,13 +64,20 @@ pub struct RasterView {
 /// The stride a new image's traced terms start at: one pixel in 16, refined to 4, then to all.
 const COARSE_TRACED_STRIDE: u32 = 4;
 
-/// Everything a raster image depends on.
+/// Everything a raster image depends on (the lab's difference view keeps the same).
 #[derive(Clone, PartialEq)]
-struct Inputs {
+pub(super) struct Inputs {
     camera: Camera,
     lights: Vec<Light>,
     settings: RenderSettings,
     revision: u64,
+}
+
+impl Inputs {
+    /// What `scene` (at its `revision`) drawn with `settings` depends on.
+    pub(super) fn of(scene: &Scene, settings: &RenderSettings, revision: u64) -> Inputs {
+        Inputs { camera: scene.camera.clone(), lights: scene.lights.clone(), settings: settings.clone(), revision }
+    }
 }
 
 struct SizedTargets {
@@ -157,8 +164,7 @@ impl RasterView {
         settings: &RenderSettings,
         (profile, filter): (bool, wgpu::FilterMode),
     ) -> Drawn {
-        let inputs =
-            Inputs { camera: scene.camera.clone(), lights: scene.lights.clone(), settings: settings.clone(), revision };
+        let inputs = Inputs::of(scene, settings, revision);
         if self.drawn.as_ref() == Some(&inputs) {
             if !self.refining() {
                 return Drawn::Kept;
