@@ -163,6 +163,22 @@ fn the_page_draws_what_the_native_renderers_draw() {
     let against_showcase = flip(&raster, &crop(&phantom, view), "phantom-against-showcase", &dir);
     assert!(against_showcase >= MIN_TOGGLE_RATIO * error, "the page did not draw the phantom: {against_showcase}");
 
+    // Screen-space refraction, which reads the view's depth with textureLoad (WebGL2 read zeros
+    // from a depth texture that filtered linearly), as `render` draws it.
+    let (refraction, refraction_view) = shot(&dir, "refraction.png");
+    assert_eq!(refraction_view, view);
+    let mut scene = Scene::load(&mirador::scene::builtin_path("refraction.toml")).expect("the refraction scene");
+    (scene.camera.width, scene.camera.height) = (view[2], view[3]);
+    scene.settings.transparency.refraction = mirador::settings::Refraction::Screen;
+    let expected = common::raster(&scene, &scene.settings);
+    let error = flip(&expected, &crop(&refraction, view), "screen-refraction", &dir);
+    assert!(error <= MAX_CROSS_GPU_FLIP, "screen-space refraction in the page differs from `render`'s: {error}");
+    let mut straight = scene.settings.clone();
+    straight.transparency.refraction = mirador::settings::Refraction::None;
+    let against =
+        flip(&common::raster(&scene, &straight), &crop(&refraction, view), "screen-refraction-against-none", &dir);
+    assert!(against >= MIN_TOGGLE_RATIO * error, "the page's refraction is as near no refraction ({against})");
+
     // The lab in the page: the planar-mirrors lab's scene drawn with the stub's functions and with
     // Mirador's, each against the native renderer compiled from the same WGSL (the editor beside
     // the view leaves the view narrower).

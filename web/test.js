@@ -2,7 +2,7 @@
 // page's own interface, `mirador.step(...)`, which the scene menu and the file picker use too:
 // the showcase as it opens, the shadows toggled off, the split view once the tracer has finished
 // in the page, the difference view, the hybrid's traced shadows over acned shadow maps, a lab's
-// stub, reference and difference, a student's edits, a scene whose volume the page fetches, and the lab's checks run in the page on a wrong solution
+// stub, reference and difference, a student's edits, a scene whose volume the page fetches, screen-space refraction, and the lab's checks run in the page on a wrong solution
 // and a right one (their results.json posted as `lab-wrong.json`, `lab-right.json`, with the
 // texts checked). Each screenshot (the whole canvas, PNG) is posted to the
 // test server with the 3D view's rectangle; `done` ends the run, `failed` says why it stopped.
@@ -70,6 +70,12 @@ export function run(mirador) {
     "load assets/scenes/course/volume-phantom.toml",
     "wait 4s",
     "screenshot phantom.png",
+    "wait 2s",
+    // Screen-space refraction, which follows rays through the view's depth (read with textureLoad).
+    "load assets/scenes/refraction.toml",
+    "set transparency.refraction=screen",
+    "wait 4s",
+    "screenshot refraction.png",
     "wait 2s",
     // The lab in the page: the planar-mirrors lab's stub (its neutral reflection: the mirror
     // shows the room unreflected), then the reference; the editor narrows the view.

@@ -13,10 +13,10 @@ use std::rc::Rc;
 
 use image::RgbaImage;
 
+use crate::Scene;
 use crate::gpu::Gpu;
 use crate::raster::Headless;
 use crate::shaders::Wgsl;
-use crate::Scene;
 
 /// The difference view of a lab mode: what it shows, and what is being drawn for it.
 #[derive(Default)]
