@@ -757,7 +757,7 @@ impl Viewer {
         let mut scene = self.scene.scene.clone();
         (scene.camera.width, scene.camera.height) = size;
         let at = (pixel.x.max(0.0) as u32, pixel.y.max(0.0) as u32);
-        let wgsl = self.lab.as_ref().map_or_else(Wgsl::builtin, LabMode::wgsl);
+        let wgsl = self.lab.as_ref().map_or_else(Wgsl::builtin, |lab| lab.wgsl());
         match Inspection::new(&screen.gpu, &scene, &self.settings, at, wgsl) {
             Ok(inspection) => {
                 let summary = inspection.summary();
@@ -844,7 +844,7 @@ impl Viewer {
             self.script.wait_until = None;
         }
         if let Some(since) = self.script.wait_checked_since {
-            if !self.lab.as_ref().is_some_and(LabMode::checking) {
+            if !self.lab.as_ref().is_some_and(|lab| lab.checking()) {
                 self.script.wait_checked_since = None;
             } else if since.elapsed() > TRACE_TIMEOUT {
                 bail!("`wait checked`: the lab's check had not finished after {} s", TRACE_TIMEOUT.as_secs());

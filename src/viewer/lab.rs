@@ -233,6 +233,110 @@ impl Compiled {
     }
 }
 
+/// A lab as the viewer shows it, natively and in the page alike: the lab, what is drawn of the
+/// student's functions, which view, the difference view and the last check. Each `LabMode` adds
+/// where the student's text comes from (a file, or the page's editor) and derefs to this.
+pub struct LabView {
+    pub lab: crate::lab::Lab,
+    compiled: Compiled,
+    pub shown: LabShown,
+    difference: super::lab_difference::DifferenceView,
+    /// The last check run from the panel.
+    pub checking: Option<Checking>,
+}
+
+impl LabView {
+    fn new(lab: crate::lab::Lab) -> LabView {
+        LabView {
+            compiled: Compiled::stub(&lab),
+            lab,
+            shown: LabShown::Student,
+            difference: Default::default(),
+            checking: None,
+        }
+    }
+
+    /// Whether the shader the view draws with changed since the last call.
+    pub fn take_changed(&mut self) -> bool {
+        std::mem::take(&mut self.compiled.changed)
+    }
+
+    /// What the view draws with ([`Compiled::wgsl`]).
+    pub fn wgsl(&self) -> crate::shaders::Wgsl {
+        self.compiled.wgsl(&self.lab, self.shown)
+    }
+
+    /// What the window shows of the lab, the student's text being `file`, taken in `how`.
+    fn panel<'a>(&'a self, file: &'a std::path::Path, how: &'static str) -> LabPanel<'a> {
+        LabPanel {
+            name: &self.lab.name,
+            title: &self.lab.title,
+            file,
+            shown: self.shown,
+            problems: &self.compiled.problems,
+            fallback: self.compiled.fallback(),
+            difference: self.difference.shown(),
+            choices: &LabShown::ALL,
+            how,
+            checking: self.checking.as_ref(),
+        }
+    }
+
+    /// Whether a check is under way.
+    pub fn checking(&self) -> bool {
+        self.checking.as_ref().is_some_and(Checking::running)
+    }
+
+    /// Shows `shown` from the next frame on.
+    pub fn show(&mut self, shown: LabShown) {
+        if shown != self.shown {
+            self.shown = shown;
+            self.compiled.changed = true;
+        }
+    }
+
+    /// In the difference view, the error map between the reference's image and the student's of
+    /// `scene` (at the view's size) unless it already shows them: at once natively, over the
+    /// next frames in the page.
+    pub fn update_difference(
+        &mut self,
+        gpu: &crate::gpu::Gpu,
+        ctx: &egui::Context,
+        scene: &crate::Scene,
+        revision: u64,
+    ) {
+        if self.shown == LabShown::Difference {
+            let functions =
+                (&crate::lab::source::reference(&self.lab), &self.compiled.student, self.compiled.generation);
+            self.difference.update(gpu, ctx, functions, scene, revision);
+        }
+    }
+
+    /// Whether the difference view's images are being drawn.
+    pub fn drawing(&self) -> bool {
+        self.difference.drawing()
+    }
+}
+
+/// A `LabMode` (a `view: LabView` and where the student's text comes from) reads and changes its
+/// view as its own.
+macro_rules! derefs_to_view {
+    ($mode:ty) => {
+        impl std::ops::Deref for $mode {
+            type Target = LabView;
+            fn deref(&self) -> &LabView {
+                &self.view
+            }
+        }
+
+        impl std::ops::DerefMut for $mode {
+            fn deref_mut(&mut self) -> &mut LabView {
+                &mut self.view
+            }
+        }
+    };
+}
+
 #[cfg(not(target_arch = "wasm32"))]
 pub use native::LabMode;
 
@@ -243,31 +347,25 @@ mod native {
 
     use web_time::Instant;
 
-    use super::LabShown;
+    use super::LabView;
     use crate::Scene;
     use crate::gpu::Gpu;
     use crate::lab::check::LabFolder;
-    use crate::lab::{Lab, source};
-    use crate::shaders::Wgsl;
-    use crate::viewer::lab_difference::DifferenceView;
+    use crate::lab::source;
     use crate::viewer::scene_state::{WATCH_PERIOD, modified};
 
+    /// Lab mode natively: the lab's view, and the student's file, watched on disk.
     pub struct LabMode {
-        pub lab: Lab,
+        view: LabView,
         /// The student's file.
         pub file: PathBuf,
         /// The file's modification time and length when last read: an editor that truncates and
         /// writes within one tick of the clock still changes the length.
         modified: Option<(SystemTime, u64)>,
         checked: Instant,
-        /// What the view draws of the student's file.
-        compiled: super::Compiled,
-        pub shown: LabShown,
-        /// The difference view.
-        difference: DifferenceView,
-        /// The last check run from the panel.
-        pub checking: Option<super::Checking>,
     }
+
+    derefs_to_view!(LabMode);
 
     impl LabMode {
         /// The lab in folder `dir` (made by `mirador lab new`), and the scene it starts from:
@@ -286,16 +384,7 @@ mod native {
             };
             let scene = crate::lab::images::scene(&test, Some(dir)).map_err(anyhow::Error::msg)?;
             let file = dir.join(&lab.file);
-            let mut mode = LabMode {
-                compiled: super::Compiled::stub(&lab),
-                lab,
-                modified: None,
-                checked: Instant::now(),
-                file,
-                shown: LabShown::Student,
-                difference: DifferenceView::default(),
-                checking: None,
-            };
+            let mut mode = LabMode { view: LabView::new(lab), modified: None, checked: Instant::now(), file };
             mode.read();
             Ok((mode, scene))
         }
@@ -308,15 +397,16 @@ mod native {
             let text = match std::fs::read_to_string(&self.file) {
                 Ok(text) => text,
                 Err(e) => {
-                    self.compiled.problems = vec![format!("{}: {e}", self.file.display())];
+                    self.view.compiled.problems = vec![format!("{}: {e}", self.file.display())];
                     return true;
                 }
             };
             let problems = source::problems(&self.lab, &text);
-            if self.compiled.take_in(&self.lab, &text, &problems) {
+            let view = &mut self.view;
+            if view.compiled.take_in(&view.lab, &text, &problems) {
                 println!("lab: {name} compiles; the view draws it");
             } else {
-                let (fallback, first) = (self.compiled.fallback(), &self.compiled.problems[0]);
+                let (fallback, first) = (view.compiled.fallback(), &view.compiled.problems[0]);
                 println!("lab: {name} does not compile; the view draws {fallback}\n{first}");
             }
             true
@@ -335,70 +425,22 @@ mod native {
             self.read()
         }
 
-        /// Whether the shader the view draws with changed since the last call.
-        pub fn take_changed(&mut self) -> bool {
-            std::mem::take(&mut self.compiled.changed)
-        }
-
         /// When the file is next due a look.
         pub fn next_poll(&self) -> Instant {
             self.checked + WATCH_PERIOD
         }
 
-        /// What the view draws with ([`super::Compiled::wgsl`]).
-        pub fn wgsl(&self) -> Wgsl {
-            self.compiled.wgsl(&self.lab, self.shown)
-        }
-
         /// What the window shows of the lab.
         pub fn panel(&self) -> super::LabPanel<'_> {
-            super::LabPanel {
-                name: &self.lab.name,
-                title: &self.lab.title,
-                file: &self.file,
-                shown: self.shown,
-                problems: &self.compiled.problems,
-                fallback: self.compiled.fallback(),
-                difference: self.difference.shown(),
-                choices: &LabShown::ALL,
-                how: "redrawn when saved",
-                checking: self.checking.as_ref(),
-            }
-        }
-
-        /// Whether a check is under way.
-        pub fn checking(&self) -> bool {
-            self.checking.as_ref().is_some_and(super::Checking::running)
+            self.view.panel(&self.file, "redrawn when saved")
         }
 
         /// Runs the lab's tests on the file as saved now (the panel's Check button).
         pub fn start_check(&mut self, gpu: &Gpu) {
             match std::fs::read_to_string(&self.file) {
-                Ok(text) => self.checking = Some(super::Checking::start(gpu, &self.lab, &text)),
-                Err(e) => self.compiled.problems = vec![format!("{}: {e}", self.file.display())],
+                Ok(text) => self.view.checking = Some(super::Checking::start(gpu, &self.lab, &text)),
+                Err(e) => self.view.compiled.problems = vec![format!("{}: {e}", self.file.display())],
             }
-        }
-
-        /// Shows `shown` from the next frame on.
-        pub fn show(&mut self, shown: LabShown) {
-            if shown != self.shown {
-                self.shown = shown;
-                self.compiled.changed = true;
-            }
-        }
-
-        /// In the difference view, the error map between the reference's image and the
-        /// student's of `scene` (at the view's size) unless it already shows them.
-        pub fn update_difference(&mut self, gpu: &Gpu, ctx: &egui::Context, scene: &Scene, revision: u64) {
-            if self.shown == LabShown::Difference {
-                let functions = (&source::reference(&self.lab), &self.compiled.student, self.compiled.generation);
-                self.difference.update(gpu, ctx, functions, scene, revision);
-            }
-        }
-
-        /// Whether the difference view's images are being drawn.
-        pub fn drawing(&self) -> bool {
-            self.difference.drawing()
         }
     }
 }
@@ -412,28 +454,25 @@ mod page {
 
     use web_time::Instant;
 
-    use super::LabShown;
-    use crate::lab::{Lab, source};
-    use crate::shaders::{Profile, Wgsl};
+    use super::LabView;
+    use crate::lab::source;
+    use crate::shaders::Profile;
 
     /// How long after the last keystroke the editor's text is checked and drawn.
     const PAUSE: Duration = Duration::from_millis(300);
 
+    /// Lab mode in the page: the lab's view, and the student's file as the editor holds it.
     pub struct LabMode {
-        pub lab: Lab,
+        view: LabView,
         /// The student's file, as the editor holds it.
         pub text: String,
         /// The last keystroke not yet checked.
         edited: Option<Instant>,
-        /// What the view draws of the student's text.
-        compiled: super::Compiled,
-        pub shown: LabShown,
         /// The device's profile: on WebGL2 the text must also compile to its shading language.
         profile: Profile,
-        /// The last check run from the panel.
-        pub checking: Option<super::Checking>,
-        difference: super::super::lab_difference::DifferenceView,
     }
+
+    derefs_to_view!(LabMode);
 
     impl LabMode {
         /// The built-in lab `name`, its text the stub, and the scene its first image test draws.
@@ -445,16 +484,7 @@ mod page {
             }
             let test = lab.images.first().ok_or_else(|| anyhow::anyhow!("lab {} has no scene", lab.name))?;
             let scene = crate::lab::images::scene(test, None).map_err(anyhow::Error::msg)?;
-            let mode = LabMode {
-                compiled: super::Compiled::stub(&lab),
-                text: lab.stub(),
-                lab,
-                edited: None,
-                shown: LabShown::Student,
-                profile,
-                checking: None,
-                difference: Default::default(),
-            };
+            let mode = LabMode { text: lab.stub(), view: LabView::new(lab), edited: None, profile };
             Ok((mode, scene))
         }
 
@@ -474,12 +504,13 @@ mod page {
         /// adopted when it compiles.
         fn check(&mut self) {
             let problems = source::problems_on(&self.lab, &self.text, self.profile);
-            self.compiled.take_in(&self.lab, &self.text, &problems);
+            let view = &mut self.view;
+            view.compiled.take_in(&view.lab, &self.text, &problems);
         }
 
         /// Why the text is not the one drawn, each problem at its place.
         pub fn problems(&self) -> &[String] {
-            &self.compiled.problems
+            &self.view.compiled.problems
         }
 
         /// Checks the text once the student paused; returns whether the window must be drawn.
@@ -500,65 +531,14 @@ mod page {
             self.edited.map_or_else(|| Instant::now() + Duration::from_secs(3600), |at| at + PAUSE)
         }
 
-        pub fn take_changed(&mut self) -> bool {
-            std::mem::take(&mut self.compiled.changed)
-        }
-
-        pub fn wgsl(&self) -> Wgsl {
-            self.compiled.wgsl(&self.lab, self.shown)
-        }
-
+        /// What the window shows of the lab.
         pub fn panel(&self) -> super::LabPanel<'_> {
-            super::LabPanel {
-                name: &self.lab.name,
-                title: &self.lab.title,
-                file: std::path::Path::new(&self.lab.file),
-                shown: self.shown,
-                problems: &self.compiled.problems,
-                fallback: self.compiled.fallback(),
-                difference: self.difference.shown(),
-                choices: &LabShown::ALL,
-                how: "redrawn as you type",
-                checking: self.checking.as_ref(),
-            }
-        }
-
-        /// Whether a check is under way.
-        pub fn checking(&self) -> bool {
-            self.checking.as_ref().is_some_and(super::Checking::running)
+            self.view.panel(std::path::Path::new(&self.lab.file), "redrawn as you type")
         }
 
         /// Runs the lab's tests on the editor's text (the panel's Check button).
         pub fn start_check(&mut self, gpu: &crate::gpu::Gpu) {
-            self.checking = Some(super::Checking::start(gpu, &self.lab, &self.text));
-        }
-
-        /// Shows `shown` from the next frame on.
-        pub fn show(&mut self, shown: LabShown) {
-            if shown != self.shown {
-                self.shown = shown;
-                self.compiled.changed = true;
-            }
-        }
-
-        /// In the difference view, the error map between the reference's image and the
-        /// student's of `scene`, drawn over the next frames unless it already shows them.
-        pub fn update_difference(
-            &mut self,
-            gpu: &crate::gpu::Gpu,
-            ctx: &egui::Context,
-            scene: &crate::Scene,
-            revision: u64,
-        ) {
-            if self.shown == LabShown::Difference {
-                let functions = (&source::reference(&self.lab), &self.compiled.student, self.compiled.generation);
-                self.difference.update(gpu, ctx, functions, scene, revision);
-            }
-        }
-
-        /// Whether the difference view's images are being drawn.
-        pub fn drawing(&self) -> bool {
-            self.difference.drawing()
+            self.view.checking = Some(super::Checking::start(gpu, &self.lab, &self.text));
         }
     }
 }
