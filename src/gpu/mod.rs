@@ -273,18 +273,7 @@ impl Gpu {
     /// result is returned when the GPU reported nothing.
     #[cfg(not(target_arch = "wasm32"))]
     pub fn checked<T>(&self, work: impl FnOnce() -> T) -> Result<T, GpuError> {
-        let out_of_memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let internal = self.device.push_error_scope(wgpu::ErrorFilter::Internal);
-        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let value = work();
-        // Popped innermost first, as scopes must be.
-        let validation = pollster::block_on(validation.pop());
-        let internal = pollster::block_on(internal.pop());
-        let out_of_memory = pollster::block_on(out_of_memory.pop());
-        match out_of_memory.or(internal).or(validation) {
-            None => Ok(value),
-            Some(error) => Err(reported(&error)),
-        }
+        pollster::block_on(self.checked_later(work))
     }
 }
 

@@ -287,6 +287,16 @@ impl Progress {
         self.seconds.is_some()
     }
 
+    /// How long the whole check took, once it is done.
+    pub fn seconds(&self) -> Option<f64> {
+        self.seconds
+    }
+
+    /// The lab checked.
+    pub fn lab(&self) -> &Lab {
+        &self.lab
+    }
+
     /// How many tests the check runs.
     pub fn len(&self) -> usize {
         self.tests.len()

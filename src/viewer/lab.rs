@@ -134,25 +134,24 @@ impl Checking {
     pub fn show(&self, ui: &mut egui::Ui) {
         use crate::lab::report::points;
         let (progress, error) = (&self.progress, ui.visuals().error_fg_color);
-        let report = progress.report();
-        let passed = report.results.iter().filter(|r| r.passed).count();
-        let summary = if progress.done() {
-            format!(
-                "{} / {} points: {passed} of {} tests passed ({:.1} s).",
-                points(report.score()),
-                points(report.max_score()),
+        // Read in place: the panel is drawn every frame, and a report would copy the lab.
+        let results = progress.results();
+        let passed = results.iter().filter(|r| r.passed).count();
+        let summary = match progress.seconds() {
+            Some(seconds) => format!(
+                "{} / {} points: {passed} of {} tests passed ({seconds:.1} s).",
+                points(results.iter().map(|r| r.score).sum()),
+                points(results.iter().map(|r| r.max_score).sum()),
                 progress.len(),
-                report.seconds
-            )
-        } else {
-            format!("Checking: {} of {} tests run…", report.results.len(), progress.len())
+            ),
+            None => format!("Checking: {} of {} tests run…", results.len(), progress.len()),
         };
         ui.label(egui::RichText::new(summary).strong());
         if let Some(problem) = progress.problems().first() {
-            ui.colored_label(error, egui::RichText::new(problem.display(&report.lab.file)).monospace().small());
+            ui.colored_label(error, egui::RichText::new(problem.display(&progress.lab().file)).monospace().small());
         }
         let pass = egui::Color32::from_rgb(90, 190, 110);
-        for (index, result) in report.results.iter().enumerate() {
+        for (index, result) in results.iter().enumerate() {
             let (mark, colour) = if result.passed { ("pass", pass) } else { ("FAIL", error) };
             ui.horizontal_wrapped(|ui| {
                 let score = format!("{mark} {}/{}", points(result.score), points(result.max_score));
@@ -306,8 +305,7 @@ impl LabView {
         revision: u64,
     ) {
         if self.shown == LabShown::Difference {
-            let functions =
-                (&crate::lab::source::reference(&self.lab), &self.compiled.student, self.compiled.generation);
+            let functions = (&self.lab, &self.compiled.student, self.compiled.generation);
             self.difference.update(gpu, ctx, functions, scene, revision);
         }
     }

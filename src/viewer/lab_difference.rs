@@ -61,13 +61,13 @@ impl DifferenceView {
     }
 
     /// Brings the error map up to date with `scene` (at the view's size, its `revision`) and the
-    /// student's functions `student` (their `generation`): starts drawing when it is not, and
+    /// student's functions `student` (their `generation`) for `lab`: starts drawing when it is not, and
     /// takes the images when they are ready.
     pub fn update(
         &mut self,
         gpu: &Gpu,
         ctx: &egui::Context,
-        (reference, student, generation): (&Wgsl, &Wgsl, u64),
+        (lab, student, generation): (&crate::lab::Lab, &Wgsl, u64),
         scene: &Scene,
         revision: u64,
     ) {
@@ -78,13 +78,9 @@ impl DifferenceView {
         }
         if self.pending.as_ref().is_none_or(|(drawing, _)| *drawing != inputs) {
             let made_for = (generation, revision, (scene.camera.width, scene.camera.height));
-            let drawing = draw(
-                gpu.clone(),
-                scene.clone(),
-                (reference.clone(), student.clone()),
-                made_for,
-                self.renderers.clone(),
-            );
+            // Mirador's functions composed only when a drawing starts, not every frame.
+            let functions = (crate::lab::source::reference(lab), student.clone());
+            let drawing = draw(gpu.clone(), scene.clone(), functions, made_for, self.renderers.clone());
             self.pending = Some((inputs, Box::pin(drawing)));
         }
         let Some((_, drawing)) = self.pending.as_mut() else { return };

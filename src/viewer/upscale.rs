@@ -45,18 +45,7 @@ impl Upscale {
         target: &wgpu::TextureView,
         [x, y, width, height]: Viewport,
     ) {
-        if self.input.as_ref().is_none_or(|(view, _)| view != image) {
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("upscale::bind_group"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(image) },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
-                ],
-            });
-            self.input = Some((image.clone(), group));
-        }
-        let (_, group) = self.input.as_ref().expect("made just above");
+        let group = image_group(&mut self.input, device, (&self.layout, &self.sampler), image, "upscale::bind_group");
         let mut pass = encoder.begin_render_pass(&layout::pass(
             "upscale::pass",
             &[Some(layout::color_attachment(target, wgpu::LoadOp::Load))],
@@ -130,18 +119,8 @@ impl Reencode {
         image: &wgpu::TextureView,
         target: &wgpu::TextureView,
     ) {
-        if self.input.as_ref().is_none_or(|(view, _)| view != image) {
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("upscale::reencode_group"),
-                layout: &self.layout,
-                entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(image) },
-                    wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
-                ],
-            });
-            self.input = Some((image.clone(), group));
-        }
-        let (_, group) = self.input.as_ref().expect("made just above");
+        let group =
+            image_group(&mut self.input, device, (&self.layout, &self.sampler), image, "upscale::reencode_group");
         let mut pass = encoder.begin_render_pass(&layout::pass(
             "upscale::reencode",
             &[Some(layout::color_attachment(target, wgpu::LoadOp::Clear(wgpu::Color::BLACK)))],
@@ -151,4 +130,27 @@ impl Reencode {
         pass.set_bind_group(0, group, &[]);
         pass.draw(0..3, 0..1);
     }
+}
+
+/// The bind group that reads `image` with `sampler`, made when `image` is not the one `kept` was
+/// made for, and kept while it stays the same (the view's image changes only with its size).
+fn image_group<'a>(
+    kept: &'a mut Option<(wgpu::TextureView, wgpu::BindGroup)>,
+    device: &wgpu::Device,
+    (layout, sampler): (&wgpu::BindGroupLayout, &wgpu::Sampler),
+    image: &wgpu::TextureView,
+    label: &str,
+) -> &'a wgpu::BindGroup {
+    if kept.as_ref().is_none_or(|(view, _)| view != image) {
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(image) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(sampler) },
+            ],
+        });
+        *kept = Some((image.clone(), group));
+    }
+    &kept.as_ref().expect("made just above").1
 }
