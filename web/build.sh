@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds Mirador's page: `bash web/build.sh [OUT]` writes a static folder (default web/dist/) that
 # any web server can serve: index.html, files.js, tracer.js, test.js, two modules (mirador.js and
-# mirador_bg.wasm for WebGPU; mirador_webgl2.js and mirador_webgl2_bg.wasm with WebGL2 too, each
+# mirador_bg.wasm for WebGPU; mirador_webgl2.js and mirador_webgl2_bg.wasm for WebGL2, each
 # the viewer with the built-in scenes inside) and the few assets fetched beside them. Installs what it needs when missing: rustup's
 # wasm32-unknown-unknown standard library, and wasm-bindgen-cli at the version Cargo.lock pins
 # (it must equal the wasm-bindgen crate's). Cold: about 6 minutes for wasm-bindgen-cli, then the
@@ -24,11 +24,11 @@ target_dir=$(cargo metadata --format-version 1 --no-deps | sed 's/.*"target_dire
 # Built beside the output and moved in at the end: a failed build leaves no half-written page.
 staging=$(mktemp -d "${out%/}.partial.XXXXXX")
 trap 'rm -rf "$staging"' EXIT
-# Two modules: WebGPU's, and one with wgpu's WebGL2 backend too (the `webgl2` feature), which the
-# page loads where the browser has no WebGPU. Each without the function names (1 MB; a panic's
+# Two modules: WebGPU's (the default features), and one with wgpu's WebGL2 backend instead (the
+# `webgl2` feature alone), which the page loads where the browser has no WebGPU. Each without the function names (1 MB; a panic's
 # stack then shows numbers) and the producers section.
 for module in mirador mirador_webgl2; do
-    features=$([ "$module" = mirador_webgl2 ] && echo "--features=webgl2" || true)
+    features=$([ "$module" = mirador_webgl2 ] && echo "--no-default-features --features=webgl2" || true)
     cargo rustc --lib --profile web --locked --target wasm32-unknown-unknown --crate-type cdylib $features
     wasm-bindgen --target web --no-typescript --out-name "$module" --out-dir "$staging" \
         --remove-name-section --remove-producers-section \
