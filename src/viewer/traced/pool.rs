@@ -1,10 +1,13 @@
 //! Web Workers for the page's traced image, one a core (web/tracer.js, `crate::web::tracer`):
 //! each is given the job (the scene as the page has it) and then rows of the full image, one band
-//! at a time, and posts back their radiance. The page's thread hands out bands and assembles them
-//! between frames; no memory is shared, so the page needs no special headers from its server.
+//! at a time, and posts back their radiance. A worker's answer is followed at once by its next
+//! band, from the job's queue, in the answer's message handler: the workers never wait for the
+//! page's next frame, which on a page drawn on the CPU can take a second. The page's thread
+//! assembles the bands between frames; no memory is shared, so the page needs no special headers
+//! from its server.
 
 use std::cell::RefCell;
-use std::collections::HashMap;
+use std::collections::{HashMap, VecDeque};
 use std::rc::Rc;
 
 use glam::Vec3;
@@ -13,10 +16,11 @@ use wasm_bindgen::prelude::*;
 
 /// The rows a worker traces at a time: small enough to share the image evenly, large enough that
 /// messages cost little beside the tracing.
-pub(super) const BAND: u32 = 8;
-/// Bands a worker is given ahead: the page hands them out between frames, and a frame of the page
-/// can take longer than a band, so each worker has the next ones queued.
-const AHEAD: usize = 4;
+const BAND: u32 = 8;
+/// Bands a worker holds at a time: the one it traces and the next, so that it starts the next
+/// without waiting for the page's thread to answer. A new job then finds at most this many bands
+/// of the old one before its own.
+const AHEAD: usize = 2;
 
 /// A band traced: the job's key, its first row and its pixels.
 pub(super) struct Band {
@@ -31,6 +35,8 @@ struct Inbox {
     bands: Vec<Band>,
     /// A worker's index for each band it may be given now (up to [`AHEAD`] a worker).
     idle: Vec<usize>,
+    /// The current job's bands not yet given to a worker: its key and rows.
+    pending: VecDeque<(u64, u32, u32)>,
     /// A worker's error: the pool is then given up and the page's thread traces.
     failed: Option<String>,
 }
@@ -69,14 +75,17 @@ impl Pool {
         let (mut workers, mut listeners) = (Vec::new(), Vec::new());
         for index in 0..cores.min(16) {
             let worker = web_sys::Worker::new_with_options(WORKER, &options).ok()?;
-            let shared = inbox.clone();
+            let (shared, answered) = (inbox.clone(), worker.clone());
             let listener = Closure::<dyn FnMut(web_sys::MessageEvent)>::new(move |event: web_sys::MessageEvent| {
                 let mut inbox = shared.borrow_mut();
                 match band(&event.data()) {
                     Ok(band) => inbox.bands.push(band),
                     Err(error) => inbox.failed = Some(error),
                 }
-                inbox.idle.push(index);
+                match inbox.pending.pop_front() {
+                    Some((key, first, end)) => ask(&answered, key, first, end),
+                    None => inbox.idle.push(index),
+                }
             });
             worker.set_onmessage(Some(listener.as_ref().unchecked_ref()));
             worker.set_onerror(Some(on_error.as_ref().unchecked_ref()));
@@ -89,8 +98,9 @@ impl Pool {
 
     /// Gives every worker the job `key` (JSON of [`super::SceneRecipe`]) and the files the
     /// person opened that it has not been given yet (the same bytes are sent once, not with every
-    /// request); the bands asked for next are of this job.
-    pub fn job(&self, key: u64, job: &str, files: &[(String, Rc<[u8]>)]) {
+    /// request), then the image's `height` rows in bands: as many as the workers may hold now, the
+    /// rest as they answer. The previous job's bands not yet given are dropped.
+    pub fn job(&self, key: u64, job: &str, files: &[(String, Rc<[u8]>)], height: u32) {
         let list = js_sys::Array::new();
         let mut sent = self.sent.borrow_mut();
         for (name, bytes) in files {
@@ -106,15 +116,22 @@ impl Pool {
             set(&message, "files", &list);
             let _ = worker.post_message(&message);
         }
+        let mut inbox = self.inbox.borrow_mut();
+        inbox.pending =
+            (0..height).step_by(BAND as usize).map(|first| (key, first, (first + BAND).min(height))).collect();
+        while let Some(index) = inbox.idle.pop() {
+            let Some((key, first, end)) = inbox.pending.pop_front() else {
+                inbox.idle.push(index);
+                break;
+            };
+            ask(&self.workers[index], key, first, end);
+        }
     }
 
-    /// Asks an idle worker, if there is one, for rows `first..end` of job `key`.
-    pub fn ask(&self, key: u64, first: u32, end: u32) -> bool {
-        let Some(index) = self.inbox.borrow_mut().idle.pop() else { return false };
-        let message = message(key);
-        set(&message, "rows", &js_sys::Array::of2(&first.into(), &end.into()));
-        let _ = self.workers[index].post_message(&message);
-        true
+    /// Drops the bands not yet given: the job was stopped or replaced. The workers finish only
+    /// the ones they hold.
+    pub fn cancel(&self) {
+        self.inbox.borrow_mut().pending.clear();
     }
 
     /// The bands that came back since the last call.
@@ -134,6 +151,13 @@ impl Drop for Pool {
             worker.terminate();
         }
     }
+}
+
+/// Asks `worker` for rows `first..end` of job `key`.
+fn ask(worker: &web_sys::Worker, key: u64, first: u32, end: u32) {
+    let message = message(key);
+    set(&message, "rows", &js_sys::Array::of2(&first.into(), &end.into()));
+    let _ = worker.post_message(&message);
 }
 
 fn message(key: u64) -> js_sys::Object {

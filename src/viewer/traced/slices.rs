@@ -12,7 +12,7 @@ use image::RgbaImage;
 use web_time::Instant;
 
 use super::SceneRecipe;
-use super::pool::{BAND, Pool};
+use super::pool::Pool;
 use super::{DifferenceFrame, LAST_BLOCK, START_BLOCK, TracedFrame, Update, compare_ready};
 use crate::output::OutputTransform;
 use crate::trace::{Progressive, RadianceImage, Tracer};
@@ -55,7 +55,7 @@ struct Full {
     below: u32,
     /// How many rows were received.
     received: u32,
-    /// The first row not yet handed out (or traced).
+    /// The first row not yet traced, where the page's thread traces them.
     next: u32,
     /// Whether the workers were given the job.
     given: bool,
@@ -100,6 +100,9 @@ impl TracedWorker {
             OwnedTracer::new(Box::new((scene.clone(), settings.clone())), |owned| Tracer::new(&owned.0, &owned.1));
         let progressive = tracer.with_dependent(|_, tracer| Progressive::new(tracer, START_BLOCK));
         // The workers start with the first request, and load while the progressive levels run.
+        if let Some(pool) = &self.pool {
+            pool.cancel();
+        }
         if !self.pool_tried {
             self.pool_tried = true;
             self.pool = Pool::start();
@@ -112,6 +115,9 @@ impl TracedWorker {
     /// Stops the current request (the view no longer shows traced images).
     pub fn stop(&mut self) {
         self.job = None;
+        if let Some(pool) = &self.pool {
+            pool.cancel();
+        }
     }
 
     /// Whether the raster image of request `key` was already handed over for comparison.
@@ -157,7 +163,7 @@ impl TracedWorker {
         let Some(job) = &mut self.job else { return false };
         let transform = OutputTransform::of(&job.tracer.borrow_owner().1);
         let (width, height) = (job.progressive.image().width, job.progressive.image().height);
-        let Some(full) = &mut job.full else {
+        if job.full.is_none() {
             let progressive = &mut job.progressive;
             let block = job.tracer.with_dependent(|_, tracer| progressive.refine(tracer)).unwrap_or(1);
             let image = progressive.image().to_rgba8(transform);
@@ -167,24 +173,28 @@ impl TracedWorker {
                 let pixels = progressive.image().pixels.clone();
                 job.full = Some(Full { pixels, below: block, received: 0, next: 0, given: false });
             }
-            return false;
-        };
+            // With workers, they are given the job in this same step: the page's next frame can be
+            // a second away (on SwiftShader the browser gave none for 1.1 s once the first level
+            // was shown), and they would wait for it idle.
+            if self.pool.is_none() {
+                return false;
+            }
+        }
+        let Some(full) = &mut job.full else { return false };
         let row = |y: u32| (y * width) as usize;
         let by_workers = match &self.pool {
             Some(pool) => {
                 if !full.given {
                     let (scene, settings) = job.tracer.borrow_owner().as_ref();
                     let recipe = SceneRecipe::of(scene, &job.overrides, settings);
-                    pool.job(job.key, &serde_json::to_string(&recipe).unwrap_or_default(), &crate::files::opened());
+                    let text = serde_json::to_string(&recipe).unwrap_or_default();
+                    pool.job(job.key, &text, &crate::files::opened(), height);
                     full.given = true;
                 }
                 for band in pool.bands().into_iter().filter(|band| band.key == job.key) {
                     let start = row(band.first);
                     full.pixels[start..start + band.pixels.len()].copy_from_slice(&band.pixels);
                     full.received += band.pixels.len() as u32 / width.max(1);
-                }
-                while full.next < height && pool.ask(job.key, full.next, (full.next + BAND).min(height)) {
-                    full.next = (full.next + BAND).min(height);
                 }
                 if let Some(error) = pool.failed() {
                     // Traced on this thread instead, from the top.
