@@ -89,10 +89,20 @@ pub fn to_srgb8(radiance: Vec3, exposure: f32) -> [u8; 3] {
 /// A whole image of linear radiance, row-major from the top, to an RGBA8 image.
 pub fn encode_image(width: u32, height: u32, radiance: &[Vec3], transform: OutputTransform) -> image::RgbaImage {
     assert_eq!(radiance.len(), (width * height) as usize, "one radiance value per pixel");
+    // A pixel equal to the one before it is encoded once: the progressive levels fill blocks of
+    // up to 16 × 16 pixels with one value, and the page encodes them on its only thread.
+    let mut last: Option<(Vec3, [u8; 3])> = None;
     let bytes = radiance
         .iter()
         .flat_map(|&c| {
-            let [r, g, b] = transform.to_srgb8(c);
+            let [r, g, b] = match last {
+                Some((previous, encoded)) if previous == c => encoded,
+                _ => {
+                    let encoded = transform.to_srgb8(c);
+                    last = Some((c, encoded));
+                    encoded
+                }
+            };
             [r, g, b, 255]
         })
         .collect();
@@ -132,6 +142,18 @@ mod tests {
         for i in 0..=255 {
             let encoded = i as f32 / 255.0;
             assert!((srgb_encode(srgb_decode(encoded)) - encoded).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn an_image_encodes_each_pixel_as_on_its_own_runs_of_equal_pixels_included() {
+        let (a, b) = (Vec3::new(0.2, 0.5, 0.9), Vec3::new(0.9, 0.1, 0.0));
+        let radiance = [a, a, b, b, a, Vec3::NAN, Vec3::NAN, b, a];
+        let transform = OutputTransform::clamp(1.0);
+        let image = encode_image(3, 3, &radiance, transform);
+        for (pixel, &c) in image.pixels().zip(&radiance) {
+            let [r, g, b] = transform.to_srgb8(c);
+            assert_eq!(pixel.0, [r, g, b, 255]);
         }
     }
 

@@ -51,7 +51,7 @@ for api in webgpu webgl2; do
         exit 1
     fi
     echo "$api: $(grep -ao "adapter: [^\"]*profile" "$work/browser.log" | tail -1)"
-    grep -ao "first frame [0-9]* ms after the page started loading\|traced [0-9]*×[0-9]* in [0-9.]* s ([a-z ]*)" "$work/browser.log" || true
+    grep -ao "first frame [0-9]* ms after the page started loading\|traced [0-9]*×[0-9]* in [0-9.]* s ([^)\"]*)" "$work/browser.log" || true
     MIRADOR_WEB_CAPTURE="$capture" cargo test --locked --test web_page -- --ignored --nocapture
     echo "the page's screenshots ($api): $capture"
 done

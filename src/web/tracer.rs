@@ -5,12 +5,14 @@
 //! in the module; the files the person opened come with the job) with the same overrides, then
 //! takes what the viewer changes in place: the camera, the lights, the materials and the
 //! settings. The rows it returns are the ones `Tracer::render_rows` returns on the page's thread,
-//! to the bit (web/test.sh checks the finished image against `mirador trace`).
+//! encoded as the page would encode them, to the bit (web/test.sh checks the finished image
+//! against `mirador trace`).
 
 use std::cell::RefCell;
 
 use wasm_bindgen::prelude::*;
 
+use crate::output::{OutputTransform, encode_image};
 use crate::trace::Tracer;
 use crate::viewer::traced::{OwnedTracer, SceneRecipe};
 
@@ -31,13 +33,17 @@ pub fn tracer_job(job: &str) -> Result<(), JsError> {
     Ok(())
 }
 
-/// Rows `first..end` of the full image, radiance as `r, g, b` a pixel, row by row.
+/// Rows `first..end` of the full image as the page shows them: RGBA, 8 bits a channel, row by
+/// row, through the job's exposure, tone curve and sRGB encoding (here, so that the page's thread
+/// only copies them).
 #[wasm_bindgen]
-pub fn trace_rows(first: u32, end: u32) -> Result<Vec<f32>, JsError> {
+pub fn trace_rows(first: u32, end: u32) -> Result<Vec<u8>, JsError> {
     TRACER.with(|t| {
         let tracer = t.borrow();
         let tracer = tracer.as_ref().ok_or_else(|| JsError::new("rows asked before a tracer job"))?;
+        let transform = OutputTransform::of(&tracer.borrow_owner().1);
         let (rows, _) = tracer.with_dependent(|_, tracer| tracer.render_rows(first..end));
-        Ok(rows.iter().flat_map(|p| p.to_array()).collect())
+        let width = rows.len() as u32 / (end - first).max(1);
+        Ok(encode_image(width, end - first, &rows, transform).into_raw())
     })
 }

@@ -1,6 +1,7 @@
 //! Web Workers for the page's traced image, one a core (web/tracer.js, `crate::web::tracer`):
 //! each is given the job (the scene as the page has it) and then rows of the full image, one band
-//! at a time, and posts back their radiance. A worker's answer is followed at once by its next
+//! at a time, and posts back their pixels encoded for display (sRGB, 8 bits), as the page shows
+//! them. A worker's answer is followed at once by its next
 //! band, from the job's queue, in the answer's message handler: the workers never wait for the
 //! page's next frame, which on a page drawn on the CPU can take a second. The page's thread
 //! assembles the bands between frames; no memory is shared, so the page needs no special headers
@@ -10,9 +11,9 @@ use std::cell::RefCell;
 use std::collections::{HashMap, VecDeque};
 use std::rc::Rc;
 
-use glam::Vec3;
 use wasm_bindgen::JsCast;
 use wasm_bindgen::prelude::*;
+use web_time::Instant;
 
 /// The rows a worker traces at a time: small enough to share the image evenly, large enough that
 /// messages cost little beside the tracing.
@@ -22,11 +23,13 @@ const BAND: u32 = 8;
 /// of the old one before its own.
 const AHEAD: usize = 2;
 
-/// A band traced: the job's key, its first row and its pixels.
+/// A band traced: the job's key, its first row and its pixels (RGBA, 8 bits a channel).
 pub(super) struct Band {
     pub key: u64,
     pub first: u32,
-    pub pixels: Vec<Vec3>,
+    pub rgba: Vec<u8>,
+    /// When its message reached the page.
+    pub arrived: Instant,
 }
 
 /// What the workers' messages leave for the page's thread.
@@ -171,7 +174,7 @@ fn set(object: &js_sys::Object, name: &str, value: &JsValue) {
     let _ = js_sys::Reflect::set(object, &name.into(), value);
 }
 
-/// A worker's answer: `{key, first, pixels}` (a `Float32Array` of r, g, b), or `{error}`.
+/// A worker's answer: `{key, first, pixels}` (a `Uint8Array` of r, g, b, a), or `{error}`.
 fn band(data: &JsValue) -> Result<Band, String> {
     let get = |name: &str| js_sys::Reflect::get(data, &name.into()).unwrap_or(JsValue::UNDEFINED);
     if let Some(error) = get("error").as_string() {
@@ -179,7 +182,6 @@ fn band(data: &JsValue) -> Result<Band, String> {
     }
     let key = get("key").as_string().and_then(|k| k.parse().ok()).ok_or("a band without its job's key")?;
     let first = get("first").as_f64().ok_or("a band without its first row")? as u32;
-    let pixels = js_sys::Float32Array::new(&get("pixels")).to_vec();
-    let pixels = pixels.chunks_exact(3).map(|p| Vec3::new(p[0], p[1], p[2])).collect();
-    Ok(Band { key, first, pixels })
+    let rgba = js_sys::Uint8Array::new(&get("pixels")).to_vec();
+    Ok(Band { key, first, rgba, arrived: Instant::now() })
 }

@@ -4,18 +4,21 @@
 //! last progressive level: in bands handed to Web Workers, one a core ([`super::pool`]), or where
 //! the browser gives none, a few rows a slice on the page's thread. The window asks for the next
 //! frame while [`TracedWorker::busy`].
+//!
+//! With workers, they are given the job with the request, before the page's thread draws one
+//! coarse level to show meanwhile, and they return their rows encoded for display: the page's
+//! thread, which also draws the page (on a computer without a GPU, on the CPU), only copies them.
 
 use std::time::Duration;
 
-use glam::Vec3;
 use image::RgbaImage;
 use web_time::Instant;
 
 use super::SceneRecipe;
 use super::pool::Pool;
 use super::{DifferenceFrame, LAST_BLOCK, START_BLOCK, TracedFrame, Update, compare_ready};
-use crate::output::OutputTransform;
-use crate::trace::{Progressive, RadianceImage, Tracer};
+use crate::output::{OutputTransform, encode_image};
+use crate::trace::{Progressive, Tracer};
 use crate::{RenderSettings, Scene};
 
 /// How long one frame lends the tracer: a page at 60 Hz has 16 ms a frame, so this keeps the page
@@ -38,8 +41,6 @@ self_cell::self_cell!(
 struct Job {
     key: u64,
     tracer: OwnedTracer,
-    /// The values set over the scene file's, for the workers' [`SceneRecipe`].
-    overrides: Vec<String>,
     progressive: Progressive,
     /// The full image in progress (`None` while progressive levels remain).
     full: Option<Full>,
@@ -49,16 +50,16 @@ struct Job {
 
 /// The full image in progress.
 struct Full {
-    /// The rows received so far over the last progressive level.
-    pixels: Vec<Vec3>,
+    /// The rows received so far over the last progressive level, encoded for display.
+    image: RgbaImage,
     /// That level's block size.
     below: u32,
     /// How many rows were received.
     received: u32,
     /// The first row not yet traced, where the page's thread traces them.
     next: u32,
-    /// Whether the workers were given the job.
-    given: bool,
+    /// When the last band so far came from a worker.
+    arrived: Option<Instant>,
 }
 
 /// The window's handle on the tracer: the same calls as the native worker thread's.
@@ -99,17 +100,19 @@ impl TracedWorker {
         let tracer =
             OwnedTracer::new(Box::new((scene.clone(), settings.clone())), |owned| Tracer::new(&owned.0, &owned.1));
         let progressive = tracer.with_dependent(|_, tracer| Progressive::new(tracer, START_BLOCK));
-        // The workers start with the first request, and load while the progressive levels run.
-        if let Some(pool) = &self.pool {
-            pool.cancel();
-        }
+        // The workers start with the first request, and are given each request's job at once: the
+        // page's next frame can be a second away on a page drawn on the CPU.
         if !self.pool_tried {
             self.pool_tried = true;
             self.pool = Pool::start();
         }
-        let overrides = overrides.to_vec();
+        if let Some(pool) = &self.pool {
+            let recipe = SceneRecipe::of(scene, overrides, settings);
+            let text = serde_json::to_string(&recipe).unwrap_or_default();
+            pool.job(key, &text, &crate::files::opened(), progressive.image().height);
+        }
         let now = Instant::now();
-        self.job = Some(Job { key, tracer, overrides, progressive, full: None, started: now, shown: now });
+        self.job = Some(Job { key, tracer, progressive, full: None, started: now, shown: now });
     }
 
     /// Stops the current request (the view no longer shows traced images).
@@ -167,34 +170,25 @@ impl TracedWorker {
             let progressive = &mut job.progressive;
             let block = job.tracer.with_dependent(|_, tracer| progressive.refine(tracer)).unwrap_or(1);
             let image = progressive.image().to_rgba8(transform);
-            self.updates.push(Update::Traced(frame(job.key, image, block, job.started)));
             // With workers the full image comes soon: one coarse level to show meanwhile.
             if block <= LAST_BLOCK || self.pool.is_some() {
-                let pixels = progressive.image().pixels.clone();
-                job.full = Some(Full { pixels, below: block, received: 0, next: 0, given: false });
+                job.full = Some(Full { image: image.clone(), below: block, received: 0, next: 0, arrived: None });
             }
-            // With workers, they are given the job in this same step: the page's next frame can be
-            // a second away (on SwiftShader the browser gave none for 1.1 s once the first level
-            // was shown), and they would wait for it idle.
+            self.updates.push(Update::Traced(frame(job.key, image, block, job.started)));
             if self.pool.is_none() {
                 return false;
             }
         }
         let Some(full) = &mut job.full else { return false };
-        let row = |y: u32| (y * width) as usize;
+        // A row's first byte in the RGBA image.
+        let row = |y: u32| (y * width * 4) as usize;
         let by_workers = match &self.pool {
             Some(pool) => {
-                if !full.given {
-                    let (scene, settings) = job.tracer.borrow_owner().as_ref();
-                    let recipe = SceneRecipe::of(scene, &job.overrides, settings);
-                    let text = serde_json::to_string(&recipe).unwrap_or_default();
-                    pool.job(job.key, &text, &crate::files::opened(), height);
-                    full.given = true;
-                }
                 for band in pool.bands().into_iter().filter(|band| band.key == job.key) {
                     let start = row(band.first);
-                    full.pixels[start..start + band.pixels.len()].copy_from_slice(&band.pixels);
-                    full.received += band.pixels.len() as u32 / width.max(1);
+                    full.image.as_mut()[start..start + band.rgba.len()].copy_from_slice(&band.rgba);
+                    full.received += band.rgba.len() as u32 / row(1).max(1) as u32;
+                    full.arrived = full.arrived.max(Some(band.arrived));
                 }
                 if let Some(error) = pool.failed() {
                     // Traced on this thread instead, from the top.
@@ -207,28 +201,29 @@ impl TracedWorker {
             None => {
                 let next = (full.next + 4).min(height);
                 let rows = job.tracer.with_dependent(|_, tracer| tracer.render_rows(full.next..next).0);
-                full.pixels[row(full.next)..row(next)].copy_from_slice(&rows);
+                let rows = encode_image(width, next - full.next, &rows, transform);
+                full.image.as_mut()[row(full.next)..row(next)].copy_from_slice(&rows);
                 full.received += next - full.next;
                 full.next = next;
                 false
             }
         };
         if full.received >= height {
-            let radiance = RadianceImage { width, height, pixels: std::mem::take(&mut full.pixels) };
-            let image = radiance.to_rgba8(transform);
-            // In the page's console, where web/test.sh reads it.
-            log::info!(
-                "traced {width}×{height} in {:.2} s ({})",
-                job.started.elapsed().as_secs_f64(),
-                if by_workers { "workers" } else { "the page's thread" }
-            );
+            let image = std::mem::take(&mut full.image);
+            // In the page's console, where web/test.sh reads it. With workers, also when their
+            // last band reached the page: the rest is the wait for the page's next frame (on a
+            // page drawn on the CPU, as long as the browser takes to draw the last one).
+            let by = match full.arrived.filter(|_| by_workers) {
+                Some(at) => format!("workers; every row in at {:.2} s", (at - job.started).as_secs_f64()),
+                None => "the page's thread".to_string(),
+            };
+            log::info!("traced {width}×{height} in {:.2} s ({by})", job.started.elapsed().as_secs_f64());
             self.updates.push(Update::Traced(frame(job.key, image.clone(), 1, job.started)));
             self.finished = Some((job.key, image));
             self.job = None;
         } else if job.shown.elapsed() >= SHOW_EVERY {
             // The rows traced so far over the last progressive level.
-            let image = RadianceImage { width, height, pixels: full.pixels.clone() }.to_rgba8(transform);
-            self.updates.push(Update::Traced(frame(job.key, image, full.below, job.started)));
+            self.updates.push(Update::Traced(frame(job.key, full.image.clone(), full.below, job.started)));
             job.shown = Instant::now();
         }
         by_workers
