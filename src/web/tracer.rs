@@ -43,7 +43,8 @@ pub fn trace_rows(first: u32, end: u32) -> Result<Vec<u8>, JsError> {
         let tracer = tracer.as_ref().ok_or_else(|| JsError::new("rows asked before a tracer job"))?;
         let transform = OutputTransform::of(&tracer.borrow_owner().1);
         let (rows, _) = tracer.with_dependent(|_, tracer| tracer.render_rows(first..end));
-        let width = rows.len() as u32 / (end - first).max(1);
-        Ok(encode_image(width, end - first, &rows, transform).into_raw())
+        let height = end.saturating_sub(first);
+        let width = rows.len() as u32 / height.max(1);
+        Ok(encode_image(width, height, &rows, transform).into_raw())
     })
 }

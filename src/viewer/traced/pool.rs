@@ -1,11 +1,10 @@
 //! Web Workers for the page's traced image, one a core (web/tracer.js, `crate::web::tracer`):
 //! each is given the job (the scene as the page has it) and then rows of the full image, one band
 //! at a time, and posts back their pixels encoded for display (sRGB, 8 bits), as the page shows
-//! them. A worker's answer is followed at once by its next
-//! band, from the job's queue, in the answer's message handler: the workers never wait for the
-//! page's next frame, which on a page drawn on the CPU can take a second. The page's thread
-//! assembles the bands between frames; no memory is shared, so the page needs no special headers
-//! from its server.
+//! them. A worker's answer is followed at once by its next band, from the job's queue, in the
+//! answer's message handler: the workers never wait for the page's next frame, which on a page
+//! drawn on the CPU can take a second. The page's thread assembles the bands between frames; no
+//! memory is shared, so the page needs no special headers from its server.
 
 use std::cell::RefCell;
 use std::collections::{HashMap, VecDeque};
