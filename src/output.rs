@@ -3,6 +3,13 @@
 //! runs it in `shaders/present.wgsl` (the curve in the shader, the encoding by the
 //! `Rgba8UnormSrgb` target); the ray tracer runs it here. `tests/output_transform.rs` checks that
 //! both give the same bytes for every curve.
+//!
+//! The 8-bit encoding is exact: a display value's level is the one its true sRGB value rounds
+//! to, found in a table of where each level starts ([`Levels`]), computed once in double
+//! precision. So every platform encodes alike, whatever its `powf` rounds, and an image encodes
+//! several times faster than by a `powf` a channel.
+
+use std::sync::OnceLock;
 
 use glam::Vec3;
 
@@ -12,6 +19,63 @@ use crate::settings::ToneMap;
 /// The sRGB transfer function (IEC 61966-2-1) of a linear value in [0, 1].
 pub fn srgb_encode(linear: f32) -> f32 {
     if linear <= 0.003_130_8 { 12.92 * linear } else { 1.055 * linear.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// [`srgb_encode`] in double precision, of the same single-precision input (the linear segment
+/// chosen by the same comparison): what [`Levels`] rounds.
+fn srgb_encode_f64(linear: f32) -> f64 {
+    let x = linear as f64;
+    if linear <= 0.003_130_8 { 12.92 * x } else { 1.055 * x.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// Buckets of [`Levels::first`]: a power of two, so that `c × BUCKETS` rounds nothing.
+const BUCKETS: usize = 4096;
+
+/// Where each 8-bit sRGB level starts. Level `k` (1 to 255) is the encoding of display value
+/// `c` when `255 · sRGB(c) ≥ k − ½` and not `≥ k + ½`: rounding to the nearest level, halves up.
+struct Levels {
+    /// `starts[k − 1]`: the smallest `f32` that encodes to level `k` or above.
+    starts: [f32; 255],
+    /// `first[b]`: the level of `b / BUCKETS`, where the search for a value at or above it
+    /// starts (at most a few levels lie in one bucket, the most near black).
+    first: [u8; BUCKETS + 1],
+}
+
+impl Levels {
+    fn get() -> &'static Levels {
+        static LEVELS: OnceLock<Levels> = OnceLock::new();
+        LEVELS.get_or_init(Levels::new)
+    }
+
+    fn new() -> Levels {
+        let starts = std::array::from_fn(|i| {
+            // Non-negative floats order as their bits do: a binary search over the bits of
+            // [0, 1] for the first value whose sRGB value × 255 reaches the level's lower half.
+            let reaches = |bits: u32| 255.0 * srgb_encode_f64(f32::from_bits(bits)) >= i as f64 + 0.5;
+            let (mut low, mut high) = (0u32, 1.0f32.to_bits());
+            while low < high {
+                let middle = low + (high - low) / 2;
+                if reaches(middle) { high = middle } else { low = middle + 1 }
+            }
+            f32::from_bits(low)
+        });
+        let first = std::array::from_fn(|b| {
+            let c = b as f32 / BUCKETS as f32;
+            starts.partition_point(|&start| start <= c) as u8
+        });
+        Levels { starts, first }
+    }
+
+    /// The 8-bit level of display value `c` (0 below, NaN included; 255 from 1 up).
+    fn level(&self, c: f32) -> u8 {
+        // `c × BUCKETS` is exact, so the bucket's start is at or below `c` (NaN: bucket 0).
+        let bucket = ((c * BUCKETS as f32) as usize).min(BUCKETS);
+        let mut level = self.first[bucket] as usize;
+        while level < 255 && self.starts[level] <= c {
+            level += 1;
+        }
+        level as u8
+    }
 }
 
 /// The inverse of [`srgb_encode`].
@@ -42,9 +106,10 @@ impl OutputTransform {
         tone_map(Vec3::from(c), self.tone_map)
     }
 
-    /// One pixel, encoded.
+    /// One pixel, encoded: each channel's sRGB value × 255 rounded to the nearest level.
     pub fn to_srgb8(&self, radiance: Vec3) -> [u8; 3] {
-        self.display(radiance).to_array().map(|c| (srgb_encode(c) * 255.0).round() as u8)
+        let levels = Levels::get();
+        self.display(radiance).to_array().map(|c| levels.level(c))
     }
 }
 
@@ -134,6 +199,44 @@ pub fn write_atomically(bytes: &[u8], path: &std::path::Path) -> std::io::Result
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every `step`-th float of [0, 1], by bits (and 1 itself).
+    fn floats_to_one(step: u32) -> impl Iterator<Item = f32> {
+        (0..1.0f32.to_bits()).step_by(step as usize).map(f32::from_bits).chain([1.0])
+    }
+
+    #[test]
+    fn each_level_starts_where_the_true_srgb_value_rounds_up_to_it() {
+        let levels = Levels::get();
+        let mut closest = f64::INFINITY;
+        for (i, &start) in levels.starts.iter().enumerate() {
+            let half = i as f64 + 0.5;
+            let (at, below) = (255.0 * srgb_encode_f64(start), 255.0 * srgb_encode_f64(start.next_down()));
+            assert!(at >= half && below < half, "level {}: starts at {start}", i + 1);
+            closest = closest.min(at - half).min(half - below);
+        }
+        // No float lies within a double's rounding of a level's edge, so a `powf` in double
+        // precision a few units in the last place off on another platform finds the same starts.
+        assert!(closest > 1e-10, "a float lies {closest:e} from a level's edge");
+        assert!(levels.starts.windows(2).all(|w| w[0] < w[1]), "the levels start in order");
+    }
+
+    #[test]
+    fn a_level_is_the_true_srgb_value_rounded_and_powf_in_single_precision_agrees_but_at_edges() {
+        let levels = Levels::get();
+        let (mut checked, mut single_differs) = (0, 0);
+        for c in floats_to_one(997) {
+            let exact = (255.0 * srgb_encode_f64(c)).round() as u8;
+            assert_eq!(levels.level(c), exact, "{c}");
+            let single = (srgb_encode(c) * 255.0).round() as u8;
+            assert!(single.abs_diff(exact) <= 1, "{c}: {single} in single precision, {exact} exactly");
+            single_differs += (single != exact) as u32;
+            checked += 1;
+        }
+        // Single precision misses only values within its rounding of a level's edge.
+        assert!(single_differs * 10_000 < checked, "{single_differs} of {checked} differ in single precision");
+        assert_eq!([levels.level(-0.5), levels.level(f32::NAN), levels.level(7.0)], [0, 0, 255]);
+    }
 
     #[test]
     fn srgb_round_trips_and_hits_known_values() {
