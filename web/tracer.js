@@ -1,6 +1,7 @@
 // The page's tracer worker (src/web/tracer.rs, src/viewer/traced/pool.rs): the module the page
 // loaded (`?module=`), without a window. It is given a job (the scene as the page has it, and the
-// files the person opened), then rows of the full image, and posts back their pixels, encoded for display.
+// files the person opened), then rows of the full image, and posts back their pixels, encoded for
+// display.
 import { fetchAssets } from "./files.js";
 
 const module = new URL(self.location.href).searchParams.get("module") ?? "mirador.js";
