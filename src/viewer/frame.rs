@@ -213,6 +213,36 @@ impl Viewer {
             && self.screenshot.is_none()
     }
 
+    /// Starts the page's tracer workers, so that they are ready before the first traced view.
+    #[cfg(target_arch = "wasm32")]
+    pub fn start_tracer_workers(&mut self) {
+        self.traced.worker.start_workers();
+    }
+
+    /// When the script needs its next frame (the page asks for no more than that): at once while
+    /// steps or waited frames are left, a screenshot is due or a lab's check runs; at a timed
+    /// wait's end; for `wait traced`, at once when it ends or fails at the next frame or the
+    /// difference view still needs its raster image read back, else at its timeout (the tracer
+    /// wakes the window sooner); `None` once the script is done.
+    pub fn script_next(&self, now: Instant) -> Option<Instant> {
+        let script = &self.script;
+        if self.script_done() {
+            return None;
+        }
+        if self.screenshot.is_some() || script.wait_frames > 0 || script.wait_checked_since.is_some() {
+            return Some(now);
+        }
+        if let Some(until) = script.wait_until {
+            return Some(until.max(now));
+        }
+        if let Some(since) = script.wait_traced_since {
+            let reading = self.view.mode == ViewMode::Difference && !self.traced.worker.compared(self.key);
+            let at_once = self.traced_waited() || !self.view.mode.needs_traced() || reading;
+            return Some(if at_once { now } else { since + TRACE_TIMEOUT });
+        }
+        Some(now)
+    }
+
     /// Queues more steps, run one a frame after those already queued (the browser's page sends
     /// them, `src/web/`).
     pub fn push_steps(&mut self, steps: impl IntoIterator<Item = Step>) {
@@ -597,8 +627,8 @@ impl Viewer {
 
     /// When the next frame is due: at once while the camera moves or the volume probe or the
     /// lat–long marker is behind the cursor; at the end of the settling time after a frame drawn below full scale (full
-    /// scale again); when egui animates; soon after a frame the surface was not ready for; else
-    /// only when something happens.
+    /// scale again); when egui animates; soon after a frame the surface was not ready for; when
+    /// the page's tracer workers' rows are next shown; else only when something happens.
     fn next_frame(
         &self,
         screen: &Screen,
@@ -617,11 +647,13 @@ impl Viewer {
             || self.raster.refining()
             || screen.screenshots_pending();
         let working = busy.then_some(now);
+        // The page's tracer workers: their rows so far are shown now and then.
+        let traced = self.traced.worker.due();
         let at = self.probe_at();
         let behind = !self.probe.is_current(&self.scene, &self.settings, at)
             || !self.seen.is_current(&self.scene, &self.settings, at.map(|at| (at.pixel, at.size)));
         let at_once = (moved || behind).then_some(now);
-        [at_once, settle, animation, retry, working].into_iter().flatten().min()
+        [at_once, settle, animation, retry, working, traced].into_iter().flatten().min()
     }
 
     /// The screenshot to write this frame: the one asked for, unless egui is animating (a window
@@ -853,8 +885,7 @@ impl Viewer {
             }
         }
         if let Some(since) = self.script.wait_traced_since {
-            let difference = self.view.mode == ViewMode::Difference;
-            if self.request.is_some() && self.traced.complete(self.key, difference) {
+            if self.traced_waited() {
                 self.script.wait_traced_since = None;
             } else if since.elapsed() > TRACE_TIMEOUT {
                 bail!("`wait traced`: the traced image was not complete after {} s", TRACE_TIMEOUT.as_secs());
@@ -865,6 +896,13 @@ impl Viewer {
             }
         }
         Ok(false)
+    }
+
+    /// Whether what `wait traced` waits for is there: the traced image of the current request,
+    /// complete, and in the difference view its FLIP map.
+    fn traced_waited(&self) -> bool {
+        let difference = self.view.mode == ViewMode::Difference;
+        self.request.is_some() && self.traced.complete(self.key, difference)
     }
 
     /// Runs the next scripted step, or goes on waiting.

@@ -7,8 +7,9 @@
 //!   opens its canvas, and the viewer starts when the device arrives ([`App::user_event`]).
 //! - Readbacks arrive a frame or two later ([`crate::gpu::readback::Pending`]): the difference
 //!   view's raster image and screenshots.
-//! - The tracer works in slices between frames on the page's one thread
-//!   (`crate::viewer::traced`).
+//! - The tracer works in Web Workers, one a core, started after the first frame, with a coarse
+//!   level in slices between frames on the page's thread, and every row there where workers
+//!   cannot run (`crate::viewer::traced`).
 //! - Files come from memory ([`crate::files`]): the built-in assets, and the files the page hands
 //!   over ([`page`]). The difference view shows FLIP, as natively (`flip-rs`, pure Rust).
 //! - No configuration file is remembered, and the scene is not watched for changes.
@@ -40,6 +41,8 @@ enum Wake {
     Device,
     /// The page queued steps ([`page::step`]).
     Steps,
+    /// The tracer's workers have the traced image, or failed (`crate::viewer::traced`).
+    Traced,
 }
 
 /// The device and the canvas's surface, or why there is none, once the browser answers.
@@ -106,7 +109,8 @@ impl App {
         let mut screen = Screen::new(window, gpu, surface, true)?;
         screen.screenshot_sink = Some(Box::new(page::screenshot_taken));
         let scene = self.scene.take().ok_or_else(|| anyhow::anyhow!("the viewer starts once"))?;
-        let viewer = Viewer::new(&mut screen, scene, &ViewerConfig::default(), Vec::new(), || {}, None);
+        let wake = || page::wake(Wake::Traced);
+        let viewer = Viewer::new(&mut screen, scene, &ViewerConfig::default(), Vec::new(), wake, None);
         log::info!("adapter: {}, {:?} profile", screen.gpu.describe(), screen.gpu.profile());
         screen.window.request_redraw();
         self.running = Some((screen, viewer));
@@ -127,15 +131,19 @@ impl App {
         }
         match viewer.frame(screen) {
             Ok(end) => {
-                // The next frame asked for, or the look at the lab's text after a pause in the
-                // typing, whichever first (the page watches no scene file).
+                // The next frame asked for, the look at the lab's text after a pause in the
+                // typing, or the next scripted step's, whichever first (the page watches no scene
+                // file). A scripted wait draws no frames: on a page drawn on the CPU they take the
+                // cores the tracer's workers use.
                 let lab = viewer.lab.as_ref().map(crate::viewer::lab::LabMode::next_poll);
-                self.next_frame = [end.next, lab].into_iter().flatten().min();
+                let script = viewer.script_next(Instant::now());
+                self.next_frame = [end.next, lab, script].into_iter().flatten().min();
                 if !self.first_frame_shown {
                     self.first_frame_shown = true;
                     // From the start of the page's load: what a cold visit waits (web/README.md).
                     let since_start = web_sys::window().and_then(|w| w.performance()).map_or(0.0, |p| p.now());
                     log::info!("first frame {since_start:.0} ms after the page started loading");
+                    viewer.start_tracer_workers();
                 }
             }
             Err(e) => {
@@ -147,10 +155,6 @@ impl App {
         page::remember_lab_file(viewer.lab_file());
         if let Some(json) = viewer.lab_results.take() {
             page::lab_checked(json);
-        }
-        // Steps run one a frame, as a scripted native run does.
-        if !viewer.script_done() {
-            screen.window.request_redraw();
         }
     }
 }

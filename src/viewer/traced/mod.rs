@@ -15,7 +15,8 @@
 //!   keeps the rasterizer and the UI responsive), cancelled within a tile.
 //! - [`slices`] (the browser, which gives a page one thread): the progressive levels in slices of
 //!   a few milliseconds between frames; the full image in rows handed to [`pool`]'s Web Workers,
-//!   one a core, or in slices where there are none. The page asks for frames while work is left.
+//!   one a core, or in slices where there are none. The page asks for frames at once while its
+//!   own thread has work, and only now and then while the workers trace.
 
 #[cfg(target_arch = "wasm32")]
 mod pool;

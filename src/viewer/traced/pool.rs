@@ -5,6 +5,14 @@
 //! answer's message handler: the workers never wait for the page's next frame, which on a page
 //! drawn on the CPU can take a second. The page's thread assembles the bands between frames; no
 //! memory is shared, so the page needs no special headers from its server.
+//!
+//! The page draws few frames while the workers trace: a frame drawn on the CPU takes the cores
+//! they trace on. The handler wakes the page when the job's last band is in (or a worker failed);
+//! the progress between is shown once a second ([`super::slices`]).
+//!
+//! Each job has a number of its own, sent with its bands and returned with them: a request asked
+//! again (the traced view left and opened again) is a new job, and a band of the old one, still
+//! in flight, is not counted as the new one's.
 
 use std::cell::RefCell;
 use std::collections::{HashMap, VecDeque};
@@ -22,9 +30,10 @@ const BAND: u32 = 8;
 /// of the old one before its own.
 const AHEAD: usize = 2;
 
-/// A band traced: the job's key, its first row and its pixels (RGBA, 8 bits a channel).
+/// A band traced: its job's number ([`Pool::job`]), its first row and its pixels (RGBA, 8 bits a
+/// channel).
 pub(super) struct Band {
-    pub key: u64,
+    pub job: u64,
     pub first: u32,
     pub rgba: Vec<u8>,
     /// When its message reached the page.
@@ -37,8 +46,12 @@ struct Inbox {
     bands: Vec<Band>,
     /// A worker's index for each band it may be given now (up to [`AHEAD`] a worker).
     idle: Vec<usize>,
-    /// The current job's bands not yet given to a worker: its key and rows.
+    /// The current job's bands not yet given to a worker: its number and rows.
     pending: VecDeque<(u64, u32, u32)>,
+    /// The current (or last) job's number, and how many of its bands have not come back (it
+    /// stays as it was when the job is cancelled; the next job sets both).
+    job: u64,
+    left: usize,
     /// A worker's error: the pool is then given up and the page's thread traces.
     failed: Option<String>,
 }
@@ -54,7 +67,8 @@ pub(super) struct Pool {
 
 impl Pool {
     /// One worker a core (at most 16), or `None` where the browser gives one core or no workers.
-    pub fn start() -> Option<Pool> {
+    /// `wake` wakes the page when a job's last band is in, or a worker failed.
+    pub fn start(wake: Rc<dyn Fn()>) -> Option<Pool> {
         // The workers load the module the page loaded (web/index.html), from the browser's cache.
         const WORKER: &str = if cfg!(feature = "webgl2") {
             "./tracer.js?module=mirador_webgl2.js"
@@ -70,23 +84,41 @@ impl Pool {
         options.set_type(web_sys::WorkerType::Module);
         // A worker that cannot start (web/tracer.js missing from the host, a module error) never
         // answers: the page's thread then traces, rather than wait for ever.
-        let shared = inbox.clone();
+        let (shared, woken) = (inbox.clone(), wake.clone());
         let on_error = Closure::<dyn FnMut(JsValue)>::new(move |_| {
             shared.borrow_mut().failed = Some("a tracer worker did not start (web/tracer.js)".into());
+            woken();
         });
         let (mut workers, mut listeners) = (Vec::new(), Vec::new());
         for index in 0..cores.min(16) {
-            let worker = web_sys::Worker::new_with_options(WORKER, &options).ok()?;
-            let (shared, answered) = (inbox.clone(), worker.clone());
+            let Ok(worker) = web_sys::Worker::new_with_options(WORKER, &options) else {
+                workers.iter().for_each(web_sys::Worker::terminate);
+                return None;
+            };
+            let (shared, answered, woken) = (inbox.clone(), worker.clone(), wake.clone());
             let listener = Closure::<dyn FnMut(web_sys::MessageEvent)>::new(move |event: web_sys::MessageEvent| {
                 let mut inbox = shared.borrow_mut();
-                match band(&event.data()) {
-                    Ok(band) => inbox.bands.push(band),
-                    Err(error) => inbox.failed = Some(error),
-                }
+                let done = match band(&event.data()) {
+                    Ok(band) => {
+                        let last = band.job == inbox.job && inbox.left == 1;
+                        if band.job == inbox.job {
+                            inbox.left = inbox.left.saturating_sub(1);
+                        }
+                        inbox.bands.push(band);
+                        last
+                    }
+                    Err(error) => {
+                        inbox.failed = Some(error);
+                        true
+                    }
+                };
                 match inbox.pending.pop_front() {
-                    Some((key, first, end)) => ask(&answered, key, first, end),
+                    Some((job, first, end)) => ask(&answered, job, first, end),
                     None => inbox.idle.push(index),
+                }
+                drop(inbox);
+                if done {
+                    woken();
                 }
             });
             worker.set_onmessage(Some(listener.as_ref().unchecked_ref()));
@@ -98,11 +130,12 @@ impl Pool {
         Some(Pool { workers, inbox, sent: RefCell::default(), _listeners: listeners, _on_error: on_error })
     }
 
-    /// Gives every worker the job `key` (JSON of [`super::SceneRecipe`]) and the files the
-    /// person opened that it has not been given yet (the same bytes are sent once, not with every
+    /// Gives every worker the job (JSON of [`super::SceneRecipe`]) and the files the person
+    /// opened that it has not been given yet (the same bytes are sent once, not with every
     /// request), then the image's `height` rows in bands: as many as the workers may hold now, the
-    /// rest as they answer. The previous job's bands not yet given are dropped.
-    pub fn job(&self, key: u64, job: &str, files: &[(String, Rc<[u8]>)], height: u32) {
+    /// rest as they answer. The previous job's bands not yet given are dropped. Returns the job's
+    /// number, which its [`Band`]s carry.
+    pub fn job(&self, job: &str, files: &[(String, Rc<[u8]>)], height: u32) -> u64 {
         let list = js_sys::Array::new();
         let mut sent = self.sent.borrow_mut();
         for (name, bytes) in files {
@@ -112,22 +145,25 @@ impl Pool {
             list.push(&js_sys::Array::of2(&name.into(), &js_sys::Uint8Array::from(&bytes[..])));
             sent.insert(name.clone(), bytes.clone());
         }
+        let mut inbox = self.inbox.borrow_mut();
+        let number = inbox.job + 1;
         for worker in &self.workers {
-            let message = message(key);
+            let message = message(number);
             set(&message, "job", &job.into());
             set(&message, "files", &list);
             let _ = worker.post_message(&message);
         }
-        let mut inbox = self.inbox.borrow_mut();
         inbox.pending =
-            (0..height).step_by(BAND as usize).map(|first| (key, first, (first + BAND).min(height))).collect();
+            (0..height).step_by(BAND as usize).map(|first| (number, first, (first + BAND).min(height))).collect();
+        (inbox.job, inbox.left) = (number, inbox.pending.len());
         while let Some(index) = inbox.idle.pop() {
-            let Some((key, first, end)) = inbox.pending.pop_front() else {
+            let Some((job, first, end)) = inbox.pending.pop_front() else {
                 inbox.idle.push(index);
                 break;
             };
-            ask(&self.workers[index], key, first, end);
+            ask(&self.workers[index], job, first, end);
         }
+        number
     }
 
     /// Drops the bands not yet given: the job was stopped or replaced. The workers finish only
@@ -155,17 +191,18 @@ impl Drop for Pool {
     }
 }
 
-/// Asks `worker` for rows `first..end` of job `key`.
-fn ask(worker: &web_sys::Worker, key: u64, first: u32, end: u32) {
-    let message = message(key);
+/// Asks `worker` for rows `first..end` of job number `job`.
+fn ask(worker: &web_sys::Worker, job: u64, first: u32, end: u32) {
+    let message = message(job);
     set(&message, "rows", &js_sys::Array::of2(&first.into(), &end.into()));
     let _ = worker.post_message(&message);
 }
 
-fn message(key: u64) -> js_sys::Object {
+/// A message about job number `job` (`key`, which the worker returns with the band).
+fn message(job: u64) -> js_sys::Object {
     let message = js_sys::Object::new();
     // As text: a u64 does not fit a JavaScript number.
-    set(&message, "key", &key.to_string().into());
+    set(&message, "key", &job.to_string().into());
     message
 }
 
@@ -179,8 +216,8 @@ fn band(data: &JsValue) -> Result<Band, String> {
     if let Some(error) = get("error").as_string() {
         return Err(error);
     }
-    let key = get("key").as_string().and_then(|k| k.parse().ok()).ok_or("a band without its job's key")?;
+    let job = get("key").as_string().and_then(|k| k.parse().ok()).ok_or("a band without its job's number")?;
     let first = get("first").as_f64().ok_or("a band without its first row")? as u32;
     let rgba = js_sys::Uint8Array::new(&get("pixels")).to_vec();
-    Ok(Band { key, first, rgba, arrived: Instant::now() })
+    Ok(Band { job, first, rgba, arrived: Instant::now() })
 }

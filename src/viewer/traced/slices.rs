@@ -3,12 +3,16 @@
 //! ([`Tracer::render_rows`], the rows `Tracer::render` would trace), shown as it goes over the
 //! last progressive level: in bands handed to Web Workers, one a core ([`super::pool`]), or where
 //! the browser gives none, a few rows a slice on the page's thread. The window asks for the next
-//! frame while [`TracedWorker::busy`].
+//! frame at once while [`TracedWorker::busy`] (work is left for the page's thread), and at
+//! [`TracedWorker::due`] while the workers trace: to show their rows so far every [`SHOW_WORKERS`],
+//! or when the pool wakes the page with the last band. A page drawn on the CPU (no GPU, or none
+//! the browser uses) draws each frame on the cores the workers trace on, so it draws few.
 //!
 //! With workers, they are given the job with the request, before the page's thread draws one
 //! coarse level to show meanwhile, and they return their rows encoded for display: the page's
 //! thread, which also draws the page (on a computer without a GPU, on the CPU), only copies them.
 
+use std::rc::Rc;
 use std::time::Duration;
 
 use image::RgbaImage;
@@ -24,8 +28,12 @@ use crate::{RenderSettings, Scene};
 /// How long one frame lends the tracer: a page at 60 Hz has 16 ms a frame, so this keeps the page
 /// answering at about 20 frames a second while the tracer works.
 const SLICE: Duration = Duration::from_millis(30);
-/// How often the image in progress is shown while the full image is traced.
+/// How often the image in progress is shown while the page's thread traces the full image.
 const SHOW_EVERY: Duration = Duration::from_millis(300);
+/// How often the workers' rows so far are shown. Seldom: each frame the page draws on the CPU
+/// (SwiftShader, about 0.1 s for the split view at 950×624) takes the cores the workers trace on,
+/// and the showcase's rows are all in within a second.
+const SHOW_WORKERS: Duration = Duration::from_secs(1);
 
 self_cell::self_cell!(
     /// A tracer and the scene and settings it reads, kept together between slices (and in the
@@ -40,6 +48,8 @@ self_cell::self_cell!(
 /// The request being traced.
 struct Job {
     key: u64,
+    /// Its number in the workers' pool (0 without workers).
+    number: u64,
     tracer: OwnedTracer,
     progressive: Progressive,
     /// The full image in progress (`None` while progressive levels remain).
@@ -65,10 +75,14 @@ struct Full {
 /// The window's handle on the tracer: the same calls as the native worker thread's.
 pub struct TracedWorker {
     job: Option<Job>,
-    /// The workers, from the first request on; `None` after they fail, or where the browser gives
-    /// none.
+    /// The workers, started after the page's first frame ([`TracedWorker::start_workers`]) so
+    /// that they are ready (their module loaded and compiled, the files fetched) when the first
+    /// traced view is asked for, or at that request if it comes first; `None` before, after they
+    /// fail, or where the browser gives none.
     pool: Option<Pool>,
     pool_tried: bool,
+    /// Wakes the page's event loop (the pool does, when a job's last band is in).
+    wake: Rc<dyn Fn()>,
     updates: Vec<Update>,
     compared: Option<u64>,
     raster: Option<(u64, RgbaImage)>,
@@ -76,13 +90,14 @@ pub struct TracedWorker {
 }
 
 impl TracedWorker {
-    /// Nothing runs beside the page: `wake` is not needed, frames are asked for while
-    /// [`TracedWorker::busy`].
-    pub fn start(_wake: impl Fn() + Send + 'static) -> TracedWorker {
+    /// `wake` wakes the page's event loop: the workers' pool calls it when a job's last band is
+    /// in.
+    pub fn start(wake: impl Fn() + Send + 'static) -> TracedWorker {
         TracedWorker {
             job: None,
             pool: None,
             pool_tried: false,
+            wake: Rc::new(wake),
             updates: Vec::new(),
             compared: None,
             raster: None,
@@ -100,19 +115,25 @@ impl TracedWorker {
         let tracer =
             OwnedTracer::new(Box::new((scene.clone(), settings.clone())), |owned| Tracer::new(&owned.0, &owned.1));
         let progressive = tracer.with_dependent(|_, tracer| Progressive::new(tracer, START_BLOCK));
-        // The workers start with the first request, and are given each request's job at once: the
-        // page's next frame can be a second away on a page drawn on the CPU.
-        if !self.pool_tried {
-            self.pool_tried = true;
-            self.pool = Pool::start();
-        }
-        if let Some(pool) = &self.pool {
+        // The workers are given each request's job at once: the page's next frame can be a second
+        // away on a page drawn on the CPU.
+        self.start_workers();
+        let number = self.pool.as_ref().map_or(0, |pool| {
             let recipe = SceneRecipe::of(scene, overrides, settings);
             let text = serde_json::to_string(&recipe).unwrap_or_default();
-            pool.job(key, &text, &crate::files::opened(), progressive.image().height);
-        }
+            pool.job(&text, &crate::files::opened(), progressive.image().height)
+        });
         let now = Instant::now();
-        self.job = Some(Job { key, tracer, progressive, full: None, started: now, shown: now });
+        self.job = Some(Job { key, number, tracer, progressive, full: None, started: now, shown: now });
+    }
+
+    /// Starts the workers, once (the page calls it after its first frame: started with the page,
+    /// they made that frame about 0.1 s later on two cores).
+    pub fn start_workers(&mut self) {
+        if !self.pool_tried {
+            self.pool_tried = true;
+            self.pool = Pool::start(self.wake.clone());
+        }
     }
 
     /// Stops the current request (the view no longer shows traced images).
@@ -134,10 +155,19 @@ impl TracedWorker {
         self.compared = Some(key);
     }
 
-    /// Whether work is left: the window asks for the next frame at once.
+    /// Whether work is left for the page's thread (a progressive level, rows where there are no
+    /// workers, the comparison): the window asks for the next frame at once.
     pub fn busy(&self) -> bool {
         let comparable = matches!((&self.raster, &self.finished), (Some((a, _)), Some((b, _))) if a == b);
-        self.job.is_some() || comparable
+        let on_this_thread = self.job.as_ref().is_some_and(|job| job.full.is_none() || self.pool.is_none());
+        on_this_thread || comparable
+    }
+
+    /// While the workers trace: when the rows they returned are next shown. The pool wakes the
+    /// page sooner when the last band is in.
+    pub fn due(&self) -> Option<Instant> {
+        let job = self.job.as_ref().filter(|job| job.full.is_some() && self.pool.is_some())?;
+        Some(job.shown + SHOW_WORKERS)
     }
 
     /// Works for one slice, then returns the newest traced image and difference made since the
@@ -184,7 +214,7 @@ impl TracedWorker {
         let row = |y: u32| (y * width * 4) as usize;
         let by_workers = match &self.pool {
             Some(pool) => {
-                for band in pool.bands().into_iter().filter(|band| band.key == job.key) {
+                for band in pool.bands().into_iter().filter(|band| band.job == job.number) {
                     let start = row(band.first);
                     full.image.as_mut()[start..start + band.rgba.len()].copy_from_slice(&band.rgba);
                     full.received += band.rgba.len() as u32 / row(1).max(1) as u32;
@@ -221,7 +251,7 @@ impl TracedWorker {
             self.updates.push(Update::Traced(frame(job.key, image.clone(), 1, job.started)));
             self.finished = Some((job.key, image));
             self.job = None;
-        } else if job.shown.elapsed() >= SHOW_EVERY {
+        } else if job.shown.elapsed() >= if by_workers { SHOW_WORKERS } else { SHOW_EVERY } {
             // The rows traced so far over the last progressive level.
             self.updates.push(Update::Traced(frame(job.key, full.image.clone(), full.below, job.started)));
             job.shown = Instant::now();

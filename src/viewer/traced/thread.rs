@@ -77,6 +77,11 @@ impl TracedWorker {
         false
     }
 
+    /// Never: the thread wakes the window when it has an image.
+    pub fn due(&self) -> Option<Instant> {
+        None
+    }
+
     /// Whether the raster image of request `key` was already handed over for comparison.
     pub fn compared(&self, key: u64) -> bool {
         self.compared == Some(key)
