@@ -28,9 +28,8 @@ command -v chromium >/dev/null && command -v xvfb-run >/dev/null || {
 . web/browser.sh
 for run in $(seq "$runs"); do
     work=$(mktemp -d)
-    cp -r "$dist" "$work/dist"
-    cp web/time.js "$work/dist/test.js"
-    serve_page "$work/dist" "$work" "$port"
+    serve_page "$dist" "$work" "$port"
+    cp web/time.js "$work/site/course/mirador/test.js"
     open_page "$work" "$port" "$api"
     kill "$server" 2>/dev/null || true
     wait "$server" 2>/dev/null || true
