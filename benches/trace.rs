@@ -5,12 +5,14 @@
 //! Scene: a displaced UV sphere of 1024 × 512 quads (1 046 528 triangles after the pole fans).
 //! Rays: 512 × 512 primary rays from a pinhole camera that sees the whole sphere, and one shadow
 //! ray toward a point light from every primary hit (the same rays, from Mirador's hits, for
-//! every library). Each throughput is the best of [`REPEATS`] passes, on one thread and on all
+//! every library). Each throughput is the best of [`repeats`] passes, on one thread and on all
 //! of rayon's threads; builds are single-threaded for all three (obvhs without its `parallel`
 //! feature, `bvh` with `Bvh::build`). Single-threaded work (builds, 1T passes) is timed by the
-//! thread's CPU time where Linux reports it, so that other programs sharing the cores count
-//! less; multi-threaded passes by the wall clock. Run with `cargo bench --bench trace` (about
-//! 30 s on two cores); `cargo bench --bench trace -- obvhs` runs Mirador and the named peers only.
+//! thread's CPU time where the system has that clock, so that other programs sharing the cores
+//! count less; multi-threaded passes by the wall clock. Run with `cargo bench --bench trace` (about
+//! 30 s on two cores); `cargo bench --bench trace -- obvhs` runs Mirador and the named peers only,
+//! `-- none` Mirador alone, and `--repeats=9` takes the best of nine passes rather than three (runs
+//! of three vary by about 10 % on the project's machine).
 //!
 //! The peers use their own idioms: obvhs its two-sided Möller–Trumbore `Triangle::intersect`
 //! with the triangles reordered into leaf order (as its examples recommend) and its
@@ -34,6 +36,7 @@ const SLICES: u32 = 1024;
 const STACKS: u32 = 512;
 const WIDTH: u32 = 512;
 const HEIGHT: u32 = 512;
+/// Passes per figure unless `--repeats=N` says otherwise.
 const REPEATS: usize = 3;
 const SHADOW_T_MIN: f32 = 1e-4;
 
@@ -94,11 +97,20 @@ fn primary_rays() -> Vec<Query> {
         .collect()
 }
 
-/// CPU time this thread has run, from Linux's `/proc/thread-self/schedstat` (nanoseconds);
-/// `None` elsewhere.
+/// CPU time this thread has run (`CLOCK_THREAD_CPUTIME_ID`); `None` where there is no such
+/// clock. (Linux's `/proc/thread-self/schedstat` counts whole scheduler ticks, 4 ms on the
+/// project's machine: a tenth of a primary-ray pass, which made the figures jump by 10 %.)
+#[cfg(unix)]
 fn thread_cpu_time() -> Option<Duration> {
-    let stat = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    Some(Duration::from_nanos(stat.split_whitespace().next()?.parse().ok()?))
+    let mut now = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `now` is a valid `timespec` for the call to write.
+    let status = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut now) };
+    (status == 0).then(|| Duration::new(now.tv_sec as u64, now.tv_nsec as u32))
+}
+
+#[cfg(not(unix))]
+fn thread_cpu_time() -> Option<Duration> {
+    None
 }
 
 /// How long `run` takes: by this thread's CPU time if `on_this_thread` and the system reports
@@ -114,9 +126,20 @@ fn timed<R>(on_this_thread: bool, run: impl FnOnce() -> R) -> (Duration, R) {
     (time, result)
 }
 
-/// The best of [`REPEATS`] passes of `run`, which returns a count to check.
+/// Passes per figure: `--repeats=N`, else [`REPEATS`].
+fn repeats() -> usize {
+    static REPEATS_ASKED: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *REPEATS_ASKED.get_or_init(|| {
+        std::env::args()
+            .find_map(|a| a.strip_prefix("--repeats=").map(|n| n.parse().expect("--repeats=N takes a whole number")))
+            .unwrap_or(REPEATS)
+            .max(1)
+    })
+}
+
+/// The best of [`repeats`] passes of `run`, which returns a count to check.
 fn best_of(on_this_thread: bool, run: impl Fn() -> usize) -> (Duration, usize) {
-    (0..REPEATS).map(|_| timed(on_this_thread, &run)).min_by_key(|(time, _)| *time).expect("at least one pass")
+    (0..repeats()).map(|_| timed(on_this_thread, &run)).min_by_key(|(time, _)| *time).expect("at least one pass")
 }
 
 /// Rays per second through `hit` on one thread and on all threads, and how many hit.
@@ -293,10 +316,11 @@ fn main() {
     let threads = rayon::current_num_threads();
     println!(
         "mesh: displaced sphere, {} triangles; {} primary rays ({WIDTH}×{HEIGHT}), {} shadow rays; \
-         best of {REPEATS}; {threads} threads",
+         best of {}; {threads} threads",
         tris.len(),
         primary.len(),
-        shadow.len()
+        shadow.len(),
+        repeats()
     );
 
     // `cargo bench --bench trace -- obvhs` runs Mirador and the peers whose names contain "obvhs".

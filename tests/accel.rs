@@ -329,7 +329,9 @@ fn accelerators_agree_with_brute_force_on_the_built_in_scenes() {
 /// The wide BVH, both ways of testing its boxes, against the binary BVH: identical hits.
 fn assert_wide_matches_binary(name: &str, prims: &[Primitive], queries: &[(Ray, f32, f32)]) {
     let binary = Bvh::build(prims);
-    for (way, wide) in [("AVX where present", Wide::build(prims)), ("four lanes", Wide::build_without_avx(prims))] {
+    for (way, wide) in
+        [("AVX where present", Wide::build(prims)), ("two halves of four lanes", Wide::build_without_avx(prims))]
+    {
         for (r, t0, t1) in queries {
             let (got, want) = (wide.closest(prims, r, *t0, *t1), binary.closest(prims, r, *t0, *t1));
             // Two primitives hit at the same distance (a shared vertex or edge), or a few units in

@@ -204,7 +204,7 @@ impl PreparedRay {
     /// `None` for a ray that cannot hit anything: a NaN or infinite origin or direction, or a
     /// zero direction.
     pub fn new(ray: &Ray) -> Option<PreparedRay> {
-        let (origin, direction) = (Vec3A::from(ray.origin), Vec3A::from(ray.direction));
+        let (origin, direction) = (load_apart(&ray.origin), load_apart(&ray.direction));
         if !origin.is_finite() || !direction.is_finite() || direction == Vec3A::ZERO {
             return None;
         }
@@ -233,6 +233,21 @@ impl PreparedRay {
         let [kx, ky, kz] = self.axes;
         Vec3A::new(a[kx] - self.shear.x * a[kz], a[ky] - self.shear.y * a[kz], self.shear.z * a[kz])
     }
+}
+
+/// `v`, read one coordinate at a time.
+///
+/// A caller usually has just written the ray, a coordinate or two at a time. Left to itself the
+/// compiler reads `origin` as one 16-byte load that spans three of those writes (and `direction`
+/// across two), and a CPU cannot forward a load from several pending writes: it waits until they
+/// reach the cache, about 20 cycles, once for every ray. Volatile reads are never merged.
+/// (`cargo bench --bench trace`: a ray that misses the mesh's box took 29.5 ns, now 23.0; primary
+/// rays 12 % faster through the wide BVH, 4 % through the binary one.)
+#[inline(always)]
+fn load_apart(v: &Vec3) -> Vec3A {
+    // SAFETY: each pointer comes from a reference to an `f32`, valid and aligned for the read.
+    let read = |x: &f32| unsafe { std::ptr::read_volatile(x) };
+    Vec3A::new(read(&v.x), read(&v.y), read(&v.z))
 }
 
 /// Woop–Benthin–Wald: `(U, V, W, det, T)` with the hit at `t = T/det` and barycentric weights

@@ -17,16 +17,21 @@
 //!   box. A ray enters a box through the planes its direction faces, chosen once per ray, so the
 //!   slab test needs no `min`/`max` per plane.
 //! - **Leaves as packets.** A subtree of at most eight triangles becomes one leaf (a binary leaf
-//!   made at the depth limit may hold more; an analytic primitive keeps a leaf of its own), and a leaf's
-//!   triangles are stored in packets of four, coordinates lane by lane, tested together by the
-//!   watertight test (Woop et al.) that the binary BVH runs on one. Every lane does the same
-//!   operations in the same order, so each hit distance is the same to the last bit.
+//!   made at the depth limit may hold more; an analytic primitive keeps a leaf of its own), and a
+//!   leaf's triangles are stored as one packet of eight, coordinates lane by lane, tested
+//!   together by the watertight test (Woop et al.) that the binary BVH runs on one. Every lane
+//!   does the same operations in the same order, so each hit distance is the same to the last
+//!   bit.
 //! - **Nearest first.** The children a ray enters are sorted by entry distance, the nearest
 //!   visited next and the others pushed, so the first hits found are near ones and shrink the
 //!   ray's far bound early. Shadow rays (`occluded`) stop at any hit and skip the sort.
-//! - **Dispatch at run time.** The eight-box test runs as one AVX operation per step on a CPU
-//!   that has AVX (checked once, when the tree is built), else as two four-wide halves (SSE2 on
-//!   every x86-64, `simd128` in the page, NEON on ARM).
+//! - **Dispatch at run time.** Both tests are written once, over eight lanes (`wide/lanes.rs`): one
+//!   AVX register a step on a CPU that has AVX (checked once, when the tree is built), else two
+//!   four-wide halves (SSE2 on every x86-64, `simd128` in the page, NEON on ARM).
+//! - **Short steps from node to node.** A ray's walk is a chain: each node's address comes from
+//!   the last node's test. So an inner child is stored as its node's byte offset (no
+//!   multiplication before the next load), and the exit distances' safety factor is folded into
+//!   the ray's constants (one multiplication fewer a node).
 //!
 //! Both BVHs return the nearest hit, and their box tests are conservative (Ize's bound), so they
 //! draw the same image; `tests/accel.rs` checks their hits on random rays and `tests/trace.rs`
@@ -39,17 +44,22 @@
 //! binary tree made at its depth limit becomes a leaf of as many packets as it needs.
 //!
 //! **What it buys** (`cargo bench --bench trace`, a million triangles, one thread): primary rays
-//! 1.65× and shadow rays 2.6× as fast as the binary BVH. The walk from the root to a leaf
-//! shortens from 24 levels to 9. Each node costs more than a binary one, and not in arithmetic:
-//! the AVX test gains nothing on primary rays over two four-lane halves (11 % on shadow rays).
-//! The cost is in the bookkeeping of which children were entered and in what order
-//! (docs/performance.md has the experiments).
+//! about 2.1× and shadow rays about 3× as fast as the binary BVH. The walk from the root to a
+//! leaf shortens from 24 levels to 9. Each node costs more than a binary one, and not in
+//! arithmetic: the AVX box test gains little on primary rays over two four-lane halves. AVX pays
+//! in the leaves, where eight triangles are tested at once (docs/performance.md has the
+//! experiments).
+
+mod lanes;
 
 use std::mem::MaybeUninit;
 
-use glam::{BVec4A, Vec3A, Vec4};
+use glam::{Vec3A, Vec4};
 use web_time::Instant;
 
+#[cfg(target_arch = "x86_64")]
+use self::lanes::Octet;
+use self::lanes::{Halves, LANES, Lanes};
 use super::bvh::{ANALYTIC, Bvh, ROBUST_EXIT};
 use super::{AccelStats, Accelerator, Hit, offer};
 use crate::base::Ray;
@@ -57,14 +67,20 @@ use crate::trace::geometry::{PreparedRay, Primitive, intersect_triangle};
 
 /// Children per node.
 pub const WIDTH: usize = 8;
-/// Triangles tested together.
-pub const PACKET: usize = 4;
-/// The most primitives a subtree may hold to become one leaf: two packets. One packet a leaf
-/// made a tree of 92 000 nodes for the benchmark's million triangles, two made 53 000, and
-/// shadow rays 7 % faster (primary rays the same).
-pub const LEAF_SIZE: usize = 2 * PACKET;
+/// Triangles tested together: a packet's lanes, one per triangle.
+pub const PACKET: usize = LANES;
+/// The most primitives a subtree may hold to become one leaf: one packet. For the benchmark's
+/// million triangles, leaves of up to four made a tree of 92 000 nodes and up to eight 53 000,
+/// with shadow rays 7 % faster (primary rays the same); up to sixteen (34 000 nodes) gained
+/// nothing more.
+pub const LEAF_SIZE: usize = PACKET;
 /// Marks a child that is a leaf: the rest of the `u32` is its first packet.
 const LEAF: u32 = 1 << 31;
+/// An inner child is stored as its node's byte offset in the tree's nodes, so that the walk
+/// finds the next node's address by one addition, without a multiplication by the node's size
+/// on the path from one node's test to the next node's load. It caps a tree at
+/// `LEAF / NODE_BYTES`, 9.5 million nodes (about 190 million triangles).
+const NODE_BYTES: usize = size_of::<Node>();
 /// Traversal stacks: the small one serves every tree whose traversal can hold at most this many
 /// entries ([`stack_bound`]; the million-triangle benchmark mesh needs 68); deeper trees use
 /// [`LARGE_STACK`].
@@ -80,17 +96,18 @@ struct Node {
     /// `min.x, min.y, min.z, max.x, max.y, max.z` of the eight boxes, as two halves of four.
     /// An unused slot has an empty box (min +∞, max −∞), which no ray enters.
     planes: [[Vec4; 2]; 6],
-    /// An inner child's node index, or [`LEAF`] and the leaf's first packet.
+    /// An inner child's byte offset in the tree's nodes ([`NODE_BYTES`] times its index), or
+    /// [`LEAF`] and the leaf's first packet.
     child: [u32; WIDTH],
 }
 
-/// Up to four primitives of one leaf; triangles are tested four at a time.
+/// Up to eight primitives of one leaf; triangles are tested eight at a time. 352 bytes.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(16))]
+#[repr(C, align(32))]
 struct Packet {
-    /// `vertices[i][axis]`: vertex `i` of the four triangles, one per lane; NaN in lanes that
-    /// hold no triangle (no NaN passes the test's comparisons).
-    vertices: [[Vec4; 3]; 3],
+    /// `vertices[i][axis]`: vertex `i` of the eight triangles, one per lane, as two halves of
+    /// four; NaN in lanes that hold no triangle (no NaN passes the test's comparisons).
+    vertices: [[[Vec4; 2]; 3]; 3],
     /// The primitives' indices in the scene's slice.
     primitives: [u32; PACKET],
     /// Bit `i`: lane `i` holds a triangle.
@@ -101,10 +118,14 @@ struct Packet {
     more: bool,
 }
 
-/// The box test's per-ray constants, each splat across four lanes.
+/// The box test's per-ray constants.
 struct BoxRay {
-    origin: [Vec4; 3],
-    inv_direction: [Vec4; 3],
+    origin: [f32; 3],
+    inv_direction: [f32; 3],
+    /// `inv_direction` times Ize's `1 + 2γ₃` ([`ROBUST_EXIT`]), for the exit distances: one
+    /// multiplication a plane fewer between a node's load and its answer than scaling each exit
+    /// (the same four roundings, so the same bound).
+    exit_inv_direction: [f32; 3],
     /// Per axis, the plane the ray enters a slab through (`0..3`: min, `3..6`: max) and the
     /// plane it leaves through.
     near: [usize; 3],
@@ -116,104 +137,81 @@ impl BoxRay {
         let axis = |k: usize| ray.inv_direction[k].is_sign_negative() as usize * 3 + k;
         let near = [axis(0), axis(1), axis(2)];
         BoxRay {
-            origin: [0, 1, 2].map(|k| Vec4::splat(ray.origin[k])),
-            inv_direction: [0, 1, 2].map(|k| Vec4::splat(ray.inv_direction[k])),
+            origin: ray.origin.to_array(),
+            inv_direction: ray.inv_direction.to_array(),
+            exit_inv_direction: (ray.inv_direction * ROBUST_EXIT).to_array(),
             near,
             far: near.map(|p| (p + 3) % 6),
         }
     }
 }
 
-/// Which of a node's eight boxes a ray enters within `(t_min, t_max)`, and where.
-trait BoxTest {
-    /// Bit `i` set where the ray enters child `i`'s box, and the entry distances.
-    ///
-    /// # Safety
-    /// The CPU must have the instructions the implementation uses ([`Avx`]: AVX).
-    unsafe fn enter<const CAREFUL: bool>(node: &Node, ray: &BoxRay, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]);
-}
-
-/// The eight boxes as two halves of four: SSE2 on x86-64, `simd128` in the page.
-struct Halves;
-
-impl BoxTest for Halves {
-    #[inline(always)]
-    unsafe fn enter<const CAREFUL: bool>(node: &Node, ray: &BoxRay, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
-        let mut entries = [0.0; WIDTH];
-        let mut mask = 0;
-        for half in 0..2 {
-            let (mut enter, mut exit) = (Vec4::splat(t_min), Vec4::splat(t_max));
-            for k in 0..3 {
-                let mut near = (node.planes[ray.near[k]][half] - ray.origin[k]) * ray.inv_direction[k];
-                let mut far = (node.planes[ray.far[k]][half] - ray.origin[k]) * ray.inv_direction[k];
-                if CAREFUL {
-                    // 0·∞ where the origin lies on the plane of a slab the ray runs along: that
-                    // slab does not bound the ray (the binary BVH's rule too).
-                    near = Vec4::select(near.is_nan_mask(), Vec4::NEG_INFINITY, near);
-                    far = Vec4::select(far.is_nan_mask(), Vec4::INFINITY, far);
-                }
-                enter = enter.max(near);
-                exit = exit.min(far * ROBUST_EXIT);
+/// Which of a node's eight boxes a ray enters within `(t_min, t_max)`: bit `i` set where it
+/// enters child `i`'s box, and the entry distances.
+///
+/// # Safety
+/// The CPU must have the instructions `L` uses.
+#[inline(always)]
+unsafe fn enter<L: Lanes, const CAREFUL: bool>(
+    node: &Node,
+    ray: &BoxRay,
+    t_min: f32,
+    t_max: f32,
+) -> (u32, [f32; WIDTH]) {
+    // SAFETY: the caller's promise about `L`.
+    unsafe {
+        let (mut enter, mut exit) = (L::splat(t_min), L::splat(t_max));
+        for k in 0..3 {
+            let origin = L::splat(ray.origin[k]);
+            let mut near = (L::load(&node.planes[ray.near[k]]) - origin) * L::splat(ray.inv_direction[k]);
+            let mut far = (L::load(&node.planes[ray.far[k]]) - origin) * L::splat(ray.exit_inv_direction[k]);
+            if CAREFUL {
+                // 0·∞ where the origin lies on the plane of a slab the ray runs along: that
+                // slab does not bound the ray (the binary BVH's rule too).
+                near = near.nan_to(f32::NEG_INFINITY);
+                far = far.nan_to(f32::INFINITY);
             }
-            enter.write_to_slice(&mut entries[4 * half..4 * half + 4]);
-            mask |= enter.cmple(exit).bitmask() << (4 * half);
+            enter = enter.max(near);
+            exit = exit.min(far);
         }
-        (mask, entries)
+        (enter.le(exit), enter.to_array())
     }
 }
 
-/// The eight boxes in one AVX register per plane.
-#[cfg(target_arch = "x86_64")]
-struct Avx;
-
-#[cfg(target_arch = "x86_64")]
-impl BoxTest for Avx {
-    #[inline(always)]
-    unsafe fn enter<const CAREFUL: bool>(node: &Node, ray: &BoxRay, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
-        use std::arch::x86_64::*;
-        // SAFETY: the caller's promise, that the CPU has AVX.
-        unsafe {
-            let lanes = |v: [Vec4; 2]| bytemuck::cast::<[Vec4; 2], __m256>(v);
-            let splat = |v: Vec4| _mm256_set1_ps(v.x);
-            let (mut enter, mut exit) = (_mm256_set1_ps(t_min), _mm256_set1_ps(t_max));
-            for k in 0..3 {
-                let (o, inv) = (splat(ray.origin[k]), splat(ray.inv_direction[k]));
-                let mut near = _mm256_mul_ps(_mm256_sub_ps(lanes(node.planes[ray.near[k]]), o), inv);
-                let mut far = _mm256_mul_ps(_mm256_sub_ps(lanes(node.planes[ray.far[k]]), o), inv);
-                if CAREFUL {
-                    let nan = |v| _mm256_cmp_ps::<_CMP_UNORD_Q>(v, v);
-                    near = _mm256_blendv_ps(near, _mm256_set1_ps(f32::NEG_INFINITY), nan(near));
-                    far = _mm256_blendv_ps(far, _mm256_set1_ps(f32::INFINITY), nan(far));
-                }
-                enter = _mm256_max_ps(enter, near);
-                exit = _mm256_min_ps(exit, _mm256_mul_ps(far, _mm256_set1_ps(ROBUST_EXIT)));
-            }
-            let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(enter, exit)) as u32;
-            (mask, bytemuck::cast::<__m256, [f32; WIDTH]>(enter))
-        }
-    }
-}
-
-/// The triangle test's per-ray constants: the watertight test's axes and shear, splat.
+/// The triangle test's per-ray constants: the watertight test's axes and shear.
 struct PacketRay {
-    origin: [Vec4; 3],
+    origin: [f32; 3],
     axes: [usize; 3],
-    shear: [Vec4; 3],
+    shear: [f32; 3],
 }
 
 impl PacketRay {
     fn new(ray: &PreparedRay) -> PacketRay {
-        PacketRay {
-            origin: [0, 1, 2].map(|k| Vec4::splat(ray.origin[k])),
-            axes: ray.axes,
-            shear: [0, 1, 2].map(|k| Vec4::splat(ray.shear[k])),
+        PacketRay { origin: ray.origin.to_array(), axes: ray.axes, shear: ray.shear.to_array() }
+    }
+
+    /// Eight vertices in the ray's sheared frame: `A[kx] − Sx·A[kz]`, `A[ky] − Sy·A[kz]`,
+    /// `Sz·A[kz]`, with `A = v − origin`. (No closures here: a closure is compiled without AVX and
+    /// its [`Octet`] operations would not inline.)
+    ///
+    /// # Safety
+    /// The CPU must have the instructions `L` uses.
+    #[inline(always)]
+    unsafe fn local<L: Lanes>(&self, vertex: &[[Vec4; 2]; 3]) -> (L, L, L) {
+        let [kx, ky, kz] = self.axes;
+        // SAFETY: the caller's promise about `L`.
+        unsafe {
+            let dx = L::load(&vertex[kx]) - L::splat(self.origin[kx]);
+            let dy = L::load(&vertex[ky]) - L::splat(self.origin[ky]);
+            let dz = L::load(&vertex[kz]) - L::splat(self.origin[kz]);
+            (dx - L::splat(self.shear[0]) * dz, dy - L::splat(self.shear[1]) * dz, L::splat(self.shear[2]) * dz)
         }
     }
 }
 
 impl Packet {
     const EMPTY: Packet = Packet {
-        vertices: [[Vec4::NAN; 3]; 3],
+        vertices: [[[Vec4::NAN; 2]; 3]; 3],
         primitives: [u32::MAX; PACKET],
         triangles: 0,
         analytic: 0,
@@ -236,38 +234,38 @@ impl Packet {
 
     /// Lane `lane`'s triangle.
     fn triangle(&self, lane: usize) -> [Vec3A; 3] {
-        self.vertices.map(|v| Vec3A::new(v[0][lane], v[1][lane], v[2][lane]))
+        self.vertices.map(|v| Vec3A::new(v[0][lane / 4][lane % 4], v[1][lane / 4][lane % 4], v[2][lane / 4][lane % 4]))
     }
 
-    /// The watertight test on the four lanes at once: the lanes hit in `(t_min, t_max)` and
+    /// The watertight test on the eight lanes at once: the lanes hit in `(t_min, t_max)` and
     /// their distances, and the lanes whose edge functions round to zero, which the scalar test
     /// settles in double precision.
     ///
     /// Each line is [`crate::trace::geometry`]'s `watertight` with a lane per triangle: the
     /// sheared frame `A[kx] − Sx·A[kz]`, the three edge functions, their signs, `det` and `T`,
     /// each computed in the same order.
+    ///
+    /// # Safety
+    /// The CPU must have the instructions `L` uses.
     #[inline(always)]
-    fn hits(&self, ray: &PacketRay, t_min: f32, t_max: f32) -> (u32, Vec4, u32) {
-        let [kx, ky, kz] = ray.axes;
-        let [sx, sy, sz] = ray.shear;
-        let local = |v: &[Vec4; 3]| {
-            let (dx, dy, dz) = (v[kx] - ray.origin[kx], v[ky] - ray.origin[ky], v[kz] - ray.origin[kz]);
-            (dx - sx * dz, dy - sy * dz, sz * dz)
-        };
-        let (a, b, c) = (local(&self.vertices[0]), local(&self.vertices[1]), local(&self.vertices[2]));
-        let u = c.0 * b.1 - c.1 * b.0;
-        let v = a.0 * c.1 - a.1 * c.0;
-        let w = b.0 * a.1 - b.1 * a.0;
-        let zero = Vec4::ZERO;
-        let rounded_to_zero = (u.cmpeq(zero) | v.cmpeq(zero) | w.cmpeq(zero)).bitmask();
-        let mixed_signs =
-            (u.cmplt(zero) | v.cmplt(zero) | w.cmplt(zero)) & (u.cmpgt(zero) | v.cmpgt(zero) | w.cmpgt(zero));
-        let det = u + v + w;
-        let t = (u * a.2 + v * b.2 + w * c.2) / det;
-        let inside: BVec4A = t.cmpgt(Vec4::splat(t_min)) & t.cmplt(Vec4::splat(t_max)) & det.cmpne(zero);
-        let triangles = self.triangles as u32;
-        let hit = (inside.bitmask() & !mixed_signs.bitmask()) & triangles & !rounded_to_zero;
-        (hit, t, rounded_to_zero & triangles)
+    unsafe fn hits<L: Lanes>(&self, ray: &PacketRay, t_min: f32, t_max: f32) -> (u32, [f32; PACKET], u32) {
+        // SAFETY: the caller's promise about `L`.
+        unsafe {
+            let (a, b, c) =
+                (ray.local::<L>(&self.vertices[0]), ray.local(&self.vertices[1]), ray.local(&self.vertices[2]));
+            let u = c.0 * b.1 - c.1 * b.0;
+            let v = a.0 * c.1 - a.1 * c.0;
+            let w = b.0 * a.1 - b.1 * a.0;
+            let zero = L::splat(0.0);
+            let rounded_to_zero = u.eq(zero) | v.eq(zero) | w.eq(zero);
+            let mixed_signs = (u.lt(zero) | v.lt(zero) | w.lt(zero)) & (u.gt(zero) | v.gt(zero) | w.gt(zero));
+            let det = u + v + w;
+            let t = (u * a.2 + v * b.2 + w * c.2) / det;
+            let inside = t.gt(L::splat(t_min)) & t.lt(L::splat(t_max)) & det.ne(zero);
+            let triangles = self.triangles as u32;
+            let hit = inside & !mixed_signs & triangles & !rounded_to_zero;
+            (hit, t.to_array(), rounded_to_zero & triangles)
+        }
     }
 }
 
@@ -387,7 +385,12 @@ impl Wide {
                     let (first, end) = collapse.ranges[child];
                     push_packets(&mut packets, &bvh, first as usize..end as usize);
                 } else {
-                    node.child[slot] = nodes.len() as u32;
+                    assert!(
+                        (nodes.len() + 1) * NODE_BYTES <= LEAF as usize,
+                        "a wide BVH of more than {} nodes",
+                        LEAF as usize / NODE_BYTES
+                    );
+                    node.child[slot] = (nodes.len() * NODE_BYTES) as u32;
                     nodes.push(Node::EMPTY);
                     used.push(0);
                     work.push((nodes.len() - 1, child, level + 1));
@@ -441,17 +444,17 @@ impl Wide {
         }
     }
 
-    /// The traversal compiled with AVX enabled, so that [`Avx`]'s box test inlines into it.
+    /// The traversal compiled with AVX enabled, so that [`Octet`]'s operations inline into it.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
     fn run_avx<const ANY: bool>(&self, query: &Query, careful: bool, small: bool) -> Option<Hit> {
         // SAFETY: this function runs only where the CPU has AVX (its callers check).
         unsafe {
             match (careful, small) {
-                (false, true) => self.traverse::<Avx, ANY, false, SMALL_STACK>(query),
-                (true, true) => self.traverse::<Avx, ANY, true, SMALL_STACK>(query),
-                (false, false) => self.traverse::<Avx, ANY, false, LARGE_STACK>(query),
-                (true, false) => self.traverse::<Avx, ANY, true, LARGE_STACK>(query),
+                (false, true) => self.traverse::<Octet, ANY, false, SMALL_STACK>(query),
+                (true, true) => self.traverse::<Octet, ANY, true, SMALL_STACK>(query),
+                (false, false) => self.traverse::<Octet, ANY, false, LARGE_STACK>(query),
+                (true, false) => self.traverse::<Octet, ANY, true, LARGE_STACK>(query),
             }
         }
     }
@@ -459,9 +462,9 @@ impl Wide {
     /// Nearest-first traversal with an explicit stack of (child, entry distance).
     ///
     /// # Safety
-    /// The CPU must have what `B`'s box test uses.
+    /// The CPU must have the instructions `L` uses.
     #[inline(always)]
-    unsafe fn traverse<B: BoxTest, const ANY: bool, const CAREFUL: bool, const STACK: usize>(
+    unsafe fn traverse<L: Lanes, const ANY: bool, const CAREFUL: bool, const STACK: usize>(
         &self,
         query: &Query,
     ) -> Option<Hit> {
@@ -473,9 +476,9 @@ impl Wide {
         let mut current = 0u32;
         loop {
             if current & LEAF == 0 {
-                let node = &self.nodes[current as usize];
-                // SAFETY: the caller's promise about `B`.
-                let (mut mask, entries) = unsafe { B::enter::<CAREFUL>(node, &box_ray, t_min, t_max) };
+                let node = self.node(current);
+                // SAFETY: the caller's promise about `L`.
+                let (mut mask, entries) = unsafe { enter::<L, CAREFUL>(node, &box_ray, t_min, t_max) };
                 let child = |i: usize| (node.child[i], entries[i]);
                 if mask != 0 {
                     let first = mask.trailing_zeros() as usize;
@@ -506,7 +509,10 @@ impl Wide {
                     current = stack.pop().expect("three children were just pushed").0;
                     continue;
                 }
-            } else if let Some(hit) = self.leaf::<ANY>(current & !LEAF, query, &packet_ray, &mut best, &mut t_max) {
+            } else if let Some(hit) =
+                // SAFETY: the caller's promise about `L`.
+                unsafe { self.leaf::<L, ANY>(current & !LEAF, query, &packet_ray, &mut best, &mut t_max) }
+            {
                 return Some(hit);
             }
             // Next: the nearest pending child that still starts before the nearest hit.
@@ -520,9 +526,22 @@ impl Wide {
         }
     }
 
-    /// Tests the leaf's packets, offering each hit; with `ANY`, returns the first.
+    /// The inner node at byte offset `offset` ([`Node::child`]).
     #[inline(always)]
-    fn leaf<const ANY: bool>(
+    fn node(&self, offset: u32) -> &Node {
+        let offset = offset as usize;
+        debug_assert!(offset.is_multiple_of(NODE_BYTES) && offset / NODE_BYTES < self.nodes.len());
+        // SAFETY: offsets are made only by `build_with`, each `NODE_BYTES` times the index of a
+        // node it pushed, and the root's is 0 (the walk starts only where there are nodes).
+        unsafe { &*self.nodes.as_ptr().byte_add(offset) }
+    }
+
+    /// Tests the leaf's packets, offering each hit; with `ANY`, returns the first.
+    ///
+    /// # Safety
+    /// The CPU must have the instructions `L` uses.
+    #[inline(always)]
+    unsafe fn leaf<L: Lanes, const ANY: bool>(
         &self,
         first: u32,
         query: &Query,
@@ -532,9 +551,13 @@ impl Wide {
     ) -> Option<Hit> {
         let Query { prims, ray, prepared, t_min, .. } = *query;
         for packet in self.packets[first as usize..].iter() {
-            let (mut hits, t, mut one_by_one) =
-                if packet.triangles != 0 { packet.hits(packet_ray, t_min, *t_max) } else { (0, Vec4::ZERO, 0) };
-            // Edge functions that rounded to zero (bits 0–3), then analytic primitives (4–7).
+            let (mut hits, t, mut one_by_one) = if packet.triangles != 0 {
+                // SAFETY: the caller's promise about `L`.
+                unsafe { packet.hits::<L>(packet_ray, t_min, *t_max) }
+            } else {
+                (0, [0.0; PACKET], 0)
+            };
+            // Edge functions that rounded to zero (bits 0–7), then analytic primitives (8–15).
             one_by_one |= (packet.analytic as u32) << PACKET;
             while hits != 0 {
                 let lane = hits.trailing_zeros() as usize;
@@ -660,7 +683,7 @@ fn push_packets(packets: &mut Vec<Packet>, bvh: &Bvh, range: std::ops::Range<usi
                 packet.triangles |= 1 << lane;
                 for (i, vertex) in bvh.triangles[k].iter().enumerate() {
                     for axis in 0..3 {
-                        packet.vertices[i][axis][lane] = vertex[axis];
+                        packet.vertices[i][axis][lane / 4][lane % 4] = vertex[axis];
                     }
                 }
             }
@@ -682,7 +705,10 @@ fn stack_bound(nodes: &[Node], used: &[usize]) -> usize {
     let mut need = vec![0usize; nodes.len()];
     for i in (0..nodes.len()).rev() {
         let node = &nodes[i];
-        let deepest = (0..used[i]).filter(|&s| node.child[s] & LEAF == 0).map(|s| need[node.child[s] as usize]).max();
+        let deepest = (0..used[i])
+            .filter(|&s| node.child[s] & LEAF == 0)
+            .map(|s| need[node.child[s] as usize / NODE_BYTES])
+            .max();
         need[i] = used[i].saturating_sub(1) + deepest.unwrap_or(0).max(1);
     }
     need.first().copied().unwrap_or(0)
@@ -744,7 +770,7 @@ mod tests {
                 if let Some(popped) = current {
                     stack.push(popped);
                 }
-                let node = &wide.nodes[child as usize];
+                let node = wide.node(child);
                 let mut children = node.child[..used(node)].to_vec();
                 for i in (1..children.len()).rev() {
                     children.swap(i, random(i + 1));
