@@ -1,5 +1,5 @@
 //! BVH benchmark: Mirador's two BVHs, the wide one (the tracer's default, with and without its
-//! AVX box test) and the binary one the course builds, against the `bvh` (0.13) and `obvhs` (0.4)
+//! AVX tests) and the binary one the course builds, against the `bvh` (0.13) and `obvhs` (0.4)
 //! crates. Ratios are given against the binary BVH, which was the default until the wide one.
 //!
 //! Scene: a displaced UV sphere of 1024 × 512 quads (1 046 528 triangles after the pole fans).
@@ -100,7 +100,7 @@ fn primary_rays() -> Vec<Query> {
 /// CPU time this thread has run (`CLOCK_THREAD_CPUTIME_ID`); `None` where there is no such
 /// clock. (Linux's `/proc/thread-self/schedstat` counts whole scheduler ticks, 4 ms on the
 /// project's machine: a tenth of a primary-ray pass, which made the figures jump by 10 %.)
-#[cfg(unix)]
+#[cfg(any(target_os = "linux", target_os = "macos", target_os = "freebsd"))]
 fn thread_cpu_time() -> Option<Duration> {
     let mut now = libc::timespec { tv_sec: 0, tv_nsec: 0 };
     // SAFETY: `now` is a valid `timespec` for the call to write.
@@ -108,7 +108,7 @@ fn thread_cpu_time() -> Option<Duration> {
     (status == 0).then(|| Duration::new(now.tv_sec as u64, now.tv_nsec as u32))
 }
 
-#[cfg(not(unix))]
+#[cfg(not(any(target_os = "linux", target_os = "macos", target_os = "freebsd")))]
 fn thread_cpu_time() -> Option<Duration> {
     None
 }
@@ -126,14 +126,29 @@ fn timed<R>(on_this_thread: bool, run: impl FnOnce() -> R) -> (Duration, R) {
     (time, result)
 }
 
-/// Passes per figure: `--repeats=N`, else [`REPEATS`].
+/// Passes per figure: `--repeats=N`, else [`REPEATS`]. Exits with a message for `--repeats`
+/// without `=N` (its number would be taken as a peer's name) or with an `N` that is not a whole
+/// number from 1.
 fn repeats() -> usize {
     static REPEATS_ASKED: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
     *REPEATS_ASKED.get_or_init(|| {
-        std::env::args()
-            .find_map(|a| a.strip_prefix("--repeats=").map(|n| n.parse().expect("--repeats=N takes a whole number")))
-            .unwrap_or(REPEATS)
-            .max(1)
+        let mut asked = REPEATS;
+        for arg in std::env::args().skip(1) {
+            if arg == "--repeats" {
+                eprintln!("trace bench: write --repeats=N (with '='), e.g. --repeats=9");
+                std::process::exit(2);
+            }
+            if let Some(n) = arg.strip_prefix("--repeats=") {
+                match n.parse() {
+                    Ok(n) if n >= 1 => asked = n,
+                    _ => {
+                        eprintln!("trace bench: --repeats={n}: expected a whole number from 1");
+                        std::process::exit(2);
+                    }
+                }
+            }
+        }
+        asked
     })
 }
 
@@ -289,6 +304,8 @@ fn bvh_crate_row(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Row
 }
 
 fn main() {
+    // Read `--repeats` first, so that a mistyped flag stops the run before the mesh is made.
+    let _ = repeats();
     let total = Instant::now();
     let tris = displaced_sphere();
     let primary = primary_rays();

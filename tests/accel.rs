@@ -1,8 +1,9 @@
 //! The ray tracer's geometry and accelerators.
 //!
 //! - The wide BVH returns the binary BVH's hits (the same primitive at the same `t`, or a tie:
-//!   another primitive hit within 8 ulps), through its AVX box test and its four-wide one, including rays
-//!   parallel to a box's planes from on them and rays through triangle edges and vertices.
+//!   another primitive hit within 8 ulps), through its AVX tests and its two halves of four,
+//!   including rays parallel to a box's planes from on them and rays through triangle edges and
+//!   vertices; and its two ways return exactly the same hits as each other.
 //! - Every accelerator (BVHs, grid, octree) returns the nearest hit brute force returns, on
 //!   thousands of seeded random rays through a triangle soup, a tessellated height field, a
 //!   sphere mesh, a scene of every analytic shape under rotations and non-uniform scales, and the
@@ -326,9 +327,24 @@ fn accelerators_agree_with_brute_force_on_the_built_in_scenes() {
     }
 }
 
-/// The wide BVH, both ways of testing its boxes, against the binary BVH: identical hits.
+/// The wide BVH, both ways of testing its boxes and triangles, against the binary BVH: identical
+/// hits; and the two ways against each other: exactly the same answers, since every lane does the
+/// same operations in the same order either way.
 fn assert_wide_matches_binary(name: &str, prims: &[Primitive], queries: &[(Ray, f32, f32)]) {
     let binary = Bvh::build(prims);
+    let (avx, halves) = (Wide::build(prims), Wide::build_without_avx(prims));
+    for (r, t0, t1) in queries {
+        assert_eq!(
+            avx.closest(prims, r, *t0, *t1),
+            halves.closest(prims, r, *t0, *t1),
+            "{name}: the wide BVH's two ways differ on {r:?} in ({t0}, {t1})"
+        );
+        assert_eq!(
+            avx.occluded(prims, r, *t0, *t1),
+            halves.occluded(prims, r, *t0, *t1),
+            "{name}: the wide BVH's two ways differ on occlusion for {r:?} in ({t0}, {t1})"
+        );
+    }
     for (way, wide) in
         [("AVX where present", Wide::build(prims)), ("two halves of four lanes", Wide::build_without_avx(prims))]
     {

@@ -79,7 +79,7 @@ const LEAF: u32 = 1 << 31;
 /// An inner child is stored as its node's byte offset in the tree's nodes, so that the walk
 /// finds the next node's address by one addition, without a multiplication by the node's size
 /// on the path from one node's test to the next node's load. It caps a tree at
-/// `LEAF / NODE_BYTES`, 9.5 million nodes (about 190 million triangles).
+/// `LEAF / NODE_BYTES`, 9.6 million nodes (about 190 million triangles).
 const NODE_BYTES: usize = size_of::<Node>();
 /// Traversal stacks: the small one serves every tree whose traversal can hold at most this many
 /// entries ([`stack_bound`]; the million-triangle benchmark mesh needs 68); deeper trees use
@@ -106,7 +106,8 @@ struct Node {
 #[repr(C, align(32))]
 struct Packet {
     /// `vertices[i][axis]`: vertex `i` of the eight triangles, one per lane, as two halves of
-    /// four; NaN in lanes that hold no triangle (no NaN passes the test's comparisons).
+    /// four; NaN in lanes that hold no triangle (their `t` is NaN and fails the test's range
+    /// comparisons, and the `triangles` mask drops them besides).
     vertices: [[[Vec4; 2]; 3]; 3],
     /// The primitives' indices in the scene's slice.
     primitives: [u32; PACKET],
@@ -124,7 +125,8 @@ struct BoxRay {
     inv_direction: [f32; 3],
     /// `inv_direction` times Ize's `1 + 2γ₃` ([`ROBUST_EXIT`]), for the exit distances: one
     /// multiplication a plane fewer between a node's load and its answer than scaling each exit
-    /// (the same four roundings, so the same bound).
+    /// (the same four roundings, so the same bound; the exits are not the binary BVH's bits,
+    /// but both are conservative, so the hits are the same).
     exit_inv_direction: [f32; 3],
     /// Per axis, the plane the ray enters a slab through (`0..3`: min, `3..6`: max) and the
     /// plane it leaves through.
@@ -275,7 +277,7 @@ pub struct Wide {
     packets: Vec<Packet>,
     /// The most entries a traversal can push on its stack.
     stack_bound: usize,
-    /// Whether the box test may use AVX (the CPU has it); always false off x86-64.
+    /// Whether the box and triangle tests may use AVX (the CPU has it); always false off x86-64.
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     avx: bool,
     stats: AccelStats,
@@ -325,12 +327,13 @@ impl Collapse<'_> {
 }
 
 impl Wide {
-    /// Builds the tree; its boxes are tested with AVX where the CPU has it.
+    /// Builds the tree; its boxes and triangles are tested with AVX where the CPU has it.
     pub fn build(prims: &[Primitive]) -> Wide {
         Wide::build_with(prims, true)
     }
 
-    /// The same tree with its boxes always tested as two halves of four, as on a CPU without
+    /// The same tree with its boxes and triangles always tested as two halves of four, as on a CPU
+    /// without
     /// AVX (for tests and benchmarks of that path).
     pub fn build_without_avx(prims: &[Primitive]) -> Wide {
         Wide::build_with(prims, false)
@@ -381,6 +384,7 @@ impl Wide {
                 node.set_box(slot, min, max);
                 if collapse.is_leaf(child) {
                     leaves += 1;
+                    assert!(packets.len() < LEAF as usize, "a wide BVH of more than {LEAF} packets");
                     node.child[slot] = LEAF | packets.len() as u32;
                     let (first, end) = collapse.ranges[child];
                     push_packets(&mut packets, &bvh, first as usize..end as usize);
@@ -417,8 +421,8 @@ impl Wide {
         Wide { nodes, packets, stack_bound, avx, stats }
     }
 
-    /// The nearest hit, or with `ANY` the first found, choosing the stack's size and the box
-    /// test's instructions for this tree and CPU.
+    /// The nearest hit, or with `ANY` the first found, choosing the stack's size and the tests'
+    /// instructions for this tree and CPU.
     #[inline(always)]
     fn query<const ANY: bool>(&self, prims: &[Primitive], ray: &Ray, t_min: f32, t_max: f32) -> Option<Hit> {
         let prepared = PreparedRay::new(ray)?;
@@ -476,7 +480,9 @@ impl Wide {
         let mut current = 0u32;
         loop {
             if current & LEAF == 0 {
-                let node = self.node(current);
+                // SAFETY: `current` is 0 (the walk starts only in a tree with nodes) or an inner
+                // child's entry of a node.
+                let node = unsafe { self.node(current) };
                 // SAFETY: the caller's promise about `L`.
                 let (mut mask, entries) = unsafe { enter::<L, CAREFUL>(node, &box_ray, t_min, t_max) };
                 let child = |i: usize| (node.child[i], entries[i]);
@@ -527,12 +533,17 @@ impl Wide {
     }
 
     /// The inner node at byte offset `offset` ([`Node::child`]).
+    ///
+    /// # Safety
+    /// `offset` must be an inner child's entry of one of this tree's nodes, or 0 in a tree with
+    /// nodes: `NODE_BYTES` times the index of a node.
     #[inline(always)]
-    fn node(&self, offset: u32) -> &Node {
+    unsafe fn node(&self, offset: u32) -> &Node {
         let offset = offset as usize;
         debug_assert!(offset.is_multiple_of(NODE_BYTES) && offset / NODE_BYTES < self.nodes.len());
-        // SAFETY: offsets are made only by `build_with`, each `NODE_BYTES` times the index of a
-        // node it pushed, and the root's is 0 (the walk starts only where there are nodes).
+        // SAFETY: the caller's promise. `build_with` makes each inner child's entry
+        // `NODE_BYTES` times the index of a node it pushed, and an unused slot holds 0, the root
+        // (an empty box, which no ray enters).
         unsafe { &*self.nodes.as_ptr().byte_add(offset) }
     }
 
@@ -770,7 +781,8 @@ mod tests {
                 if let Some(popped) = current {
                     stack.push(popped);
                 }
-                let node = wide.node(child);
+                // SAFETY: `child` is 0 (the tree has nodes) or an inner child's entry.
+                let node = unsafe { wide.node(child) };
                 let mut children = node.child[..used(node)].to_vec();
                 for i in (1..children.len()).rev() {
                     children.swap(i, random(i + 1));

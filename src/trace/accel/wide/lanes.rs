@@ -138,6 +138,10 @@ impl Lanes for Halves {
 
 /// The eight lanes in one AVX register. Its operations inline only into code compiled with AVX
 /// enabled (`#[target_feature(enable = "avx")]`), where they become one instruction each.
+///
+/// Its safe operations rely on this: an `Octet` is made only by [`Lanes::load`] and
+/// [`Lanes::splat`], whose callers promise AVX. Give it no safe constructor (no `Default`, no
+/// `From`, no `Pod`).
 #[cfg(target_arch = "x86_64")]
 #[derive(Clone, Copy)]
 pub(super) struct Octet(__m256);
