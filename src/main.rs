@@ -171,6 +171,10 @@ enum LabCommand {
     /// when every test passed, 1 otherwise.
     Check {
         dir: PathBuf,
+        /// The lab to grade, as the teacher names it. The folder's own lab.toml (the student's to
+        /// edit) is then not read: neither which lab it is nor its points.
+        #[arg(long, value_name = "NAME")]
+        lab: Option<String>,
         /// A folder of hidden tests (`*.toml`, the lab's own format) run after the lab's own.
         #[arg(long, value_name = "DIR")]
         tests: Option<PathBuf>,
@@ -181,6 +185,54 @@ enum LabCommand {
         /// after it are not run.
         #[arg(long, value_name = "SECONDS", default_value_t = 30.0)]
         time_limit: f64,
+        /// Also write the results to this file, in --format's form: written even when the
+        /// submission cannot be checked at all (a score of 0 that says why).
+        #[arg(long, value_name = "FILE.json")]
+        results: Option<PathBuf>,
+        /// The form of --results: a grading service's.
+        #[arg(long, value_enum, default_value_t = mirador::lab::report::Format::Gradescope, requires = "results")]
+        format: mirador::lab::report::Format,
+    },
+    /// Write what a grading service needs to grade a lab (setup and run scripts, the lab's
+    /// points and hidden tests): Gradescope's autograder, PrairieLearn's external grader, or a
+    /// GitHub Classroom workflow (docs/course/labs.md, "Grading a class").
+    Autograder {
+        /// The lab's name (`mirador lab list`).
+        lab: String,
+        /// The folder to write.
+        dir: PathBuf,
+        /// The service.
+        #[arg(long = "for", value_enum)]
+        service: mirador::lab::autograder::Service,
+        /// A folder of hidden tests (`*.toml`, the lab's own format).
+        #[arg(long, value_name = "DIR")]
+        tests: Option<PathBuf>,
+        /// A points file (`"test name" = points`) over the lab's own.
+        #[arg(long, value_name = "FILE.toml")]
+        points: Option<PathBuf>,
+        /// The Mirador binary to put in the folder (default: this one).
+        #[arg(long, value_name = "FILE")]
+        binary: Option<PathBuf>,
+        /// The most seconds one test may take.
+        #[arg(long, value_name = "SECONDS", default_value_t = 60.0)]
+        time_limit: f64,
+    },
+    /// A class's results at a glance: reads every results.json under the paths given (files or
+    /// folders) and writes summary.html and summary.md: the score histogram, each test's pass
+    /// rate and discrimination, the known mistakes matched most, the submissions that did not
+    /// compile, the slowest checks.
+    Summary {
+        #[arg(required = true)]
+        results: Vec<PathBuf>,
+        /// The folder to write the page into.
+        #[arg(short, long, value_name = "DIR")]
+        out: PathBuf,
+    },
+    /// Exits 0 when test N (from 0, in the order of its `tests`) of a results.json passed: one
+    /// test as a GitHub Classroom step.
+    Passed {
+        results: PathBuf,
+        index: usize,
     },
     /// Runs a lab's tests from one on, a JSON line each (what `check` runs under its time limit).
     #[command(hide = true)]
@@ -190,6 +242,15 @@ enum LabCommand {
         from: usize,
         #[arg(long)]
         tests: Option<PathBuf>,
+        #[arg(long)]
+        lab: Option<String>,
+        /// The student's file, where it is not the lab's file in DIR.
+        #[arg(long)]
+        file: Option<PathBuf>,
+        /// Run the answer key instead of the folder's file (a teacher's hidden tests are checked
+        /// with it first).
+        #[arg(long)]
+        key: bool,
     },
 }
 
@@ -351,7 +412,7 @@ fn copy(scene: &Path, dir: &Path) -> anyhow::Result<()> {
 
 /// `mirador lab …`: its own exit status (`check` fails when a test does).
 fn lab(command: LabCommand) -> ExitCode {
-    use mirador::lab::{self, check, folder, report, run};
+    use mirador::lab::{self, autograder, check, folder, report, run, summary};
     let outcome = match command {
         LabCommand::List => {
             for lab in lab::catalog() {
@@ -366,21 +427,82 @@ fn lab(command: LabCommand) -> ExitCode {
             }
             Ok(true)
         }),
-        LabCommand::Check { dir, tests, points, time_limit } => {
+        LabCommand::Check { dir, lab, tests, points, time_limit, results, format } => {
             let time_limit =
                 std::time::Duration::try_from_secs_f64(time_limit).unwrap_or(std::time::Duration::from_secs(30));
-            check::check(&check::Options { dir: dir.clone(), hidden: tests, points, time_limit }).map(|report| {
+            let options = check::Options {
+                dir: dir.clone(),
+                lab,
+                hidden: tests,
+                points,
+                time_limit,
+                results: results.clone().map(|path| (path, format)),
+            };
+            let checked = check::check(&options);
+            if let (Err(why), Some(path)) = (&checked, &results) {
+                // Every submission gets a result file, saying why it could not be checked.
+                let json = report::failure_json(format, why);
+                if let Err(e) = output::write_atomically(json.as_bytes(), path) {
+                    eprintln!("error: {}: {e}", path.display());
+                }
+            }
+            checked.map(|report| {
                 print!("{}", report::text(&report));
                 println!("(written: {} and {})", dir.join("results.json").display(), dir.join("report.md").display());
                 report.passed()
             })
         }
-        LabCommand::Run { dir, from, tests } => check::LabFolder::read(&dir).and_then(|folder| {
-            let lab = lab::find(&folder.lab)?;
-            let text = std::fs::read_to_string(dir.join(&lab.file)).map_err(|e| format!("{}: {e}", lab.file))?;
-            let tests = run::tests(&lab, tests.as_deref())?;
-            run::run(&lab, &text, &tests, from, &dir).map(|()| true)
+        LabCommand::Autograder { lab, dir, service, tests, points, binary, time_limit } => lab::find(&lab)
+            .and_then(|lab| {
+                let binary = match binary {
+                    Some(binary) => binary,
+                    None => std::env::current_exe().map_err(|e| format!("the running binary: {e}"))?,
+                };
+                let options = autograder::Options { dir, service, hidden: tests, points, binary, time_limit };
+                for path in autograder::write(&lab, &options)? {
+                    println!("wrote {}", path.display());
+                }
+                Ok(true)
+            }),
+        LabCommand::Summary { results, out } => summary::read(&results).and_then(|submissions| {
+            let summary = summary::summarise(submissions);
+            std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
+            for (name, text) in [("summary.html", summary::html(&summary)), ("summary.md", summary::markdown(&summary))] {
+                let path = out.join(name);
+                output::write_atomically(text.as_bytes(), &path).map_err(|e| format!("{}: {e}", path.display()))?;
+                println!("wrote {}", path.display());
+            }
+            println!("{} submissions", summary.submissions.len());
+            Ok(true)
         }),
+        LabCommand::Passed { results, index } => std::fs::read_to_string(&results)
+            .map_err(|e| format!("{}: {e}", results.display()))
+            .and_then(|text| {
+                let json: serde_json::Value =
+                    serde_json::from_str(&text).map_err(|e| format!("{}: {e}", results.display()))?;
+                let test = json["tests"]
+                    .get(index)
+                    .ok_or_else(|| format!("{}: there is no test {index}", results.display()))?;
+                println!("{}: {}", test["name"].as_str().unwrap_or("?"), test["output"].as_str().unwrap_or(""));
+                Ok(test["status"] == "passed")
+            }),
+        LabCommand::Run { dir, from, tests, lab: name, file, key } => {
+            let name = match name {
+                Some(name) => Ok(name),
+                None => check::LabFolder::read(&dir).map(|folder| folder.lab),
+            };
+            name.and_then(|name| {
+                let lab = lab::find(&name)?;
+                let text = if key {
+                    lab.solution()
+                } else {
+                    let path = file.unwrap_or_else(|| dir.join(&lab.file));
+                    std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?
+                };
+                let tests = run::tests(&lab, tests.as_deref())?;
+                run::run(&lab, &text, &tests, from, &dir, !key).map(|()| true)
+            })
+        }
     };
     match outcome {
         Ok(true) => ExitCode::SUCCESS,

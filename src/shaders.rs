@@ -115,6 +115,9 @@ pub struct Wgsl {
     code: String,
     /// The device profile the text is composed for; [`Wgsl::module`] takes the device's own.
     profile: Profile,
+    /// A WGSL expression, true when the appended code's loops were cut off in this invocation
+    /// (the lab's loop guard, src/lab/isolate.rs).
+    tripped: Option<String>,
 }
 
 impl Wgsl {
@@ -125,7 +128,18 @@ impl Wgsl {
 
     /// Mirador's WGSL with the declarations named `replaced` left out and `code` appended.
     pub fn replacing(replaced: Vec<String>, code: String) -> Wgsl {
-        Wgsl { replaced, code, profile: Profile::Standard }
+        Wgsl { replaced, code, profile: Profile::Standard, tripped: None }
+    }
+
+    /// The same WGSL, its appended code's loops guarded: `tripped` is a WGSL expression that is
+    /// true where the guard cut them off.
+    pub fn with_tripped(self, tripped: String) -> Wgsl {
+        Wgsl { tripped: Some(tripped), ..self }
+    }
+
+    /// The expression that says the appended code's loops were cut off, where they are guarded.
+    pub fn tripped(&self) -> Option<&str> {
+        self.tripped.as_deref()
     }
 
     /// The same WGSL composed for a device of `profile`.

@@ -96,6 +96,34 @@ pub fn obj(data: &[u8]) {
     }
 }
 
+/// A student's lab file: the first byte picks the lab (of Mirador's eight), the rest is the file,
+/// as `mirador lab check` reads it. What must hold: no panic in the student's names put apart,
+/// loops guarded, signatures compared, and naga's checks of every module; each problem placed on
+/// one of the file's own lines; the isolated text maps every offset back inside the file. Seeds:
+/// every lab's stub and answer key (`corpus/lab_source/`), which the dictionary's WGSL tokens
+/// mutate by dropping, swapping and repeating.
+pub fn lab_source(data: &[u8]) {
+    let Some((&choice, rest)) = data.split_first() else { return };
+    let Ok(text) = std::str::from_utf8(rest) else { return };
+    let labs = mirador::lab::catalog();
+    let lab = &labs[choice as usize % labs.len()];
+    let lines = text.lines().count().max(1) as u32;
+    for problem in mirador::lab::source::problems(lab, text) {
+        assert!(!problem.message.is_empty(), "a problem without a message");
+        if let Some(line) = problem.line {
+            assert!(line >= 1 && line <= lines + 1, "problem on line {line} of a {lines}-line file");
+        }
+        let _ = problem.display(&lab.file);
+    }
+    let isolated = mirador::lab::source::isolated(lab, text);
+    for offset in 0..isolated.text.len() {
+        if let Some(original) = isolated.original(offset) {
+            assert!(original <= text.len() && text.is_char_boundary(original), "offset {offset} maps to {original}");
+        }
+    }
+    let _ = mirador::lab::source::untouched_slots(lab, text);
+}
+
 /// A PLY file, ASCII or binary.
 pub fn ply(data: &[u8]) {
     let path = fixtures().join("models/fuzz.ply");

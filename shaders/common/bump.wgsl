@@ -39,8 +39,11 @@ fn mip_lod(duv_dx: vec2f, duv_dy: vec2f, size: vec2f, bias: f32) -> f32 {
 }
 
 // Texel (x, y) of level `level`, its coordinates wrapped into the level (the repeat address mode).
+// The level's size is level 0's halved `level` times, as WGSL defines it: lavapipe answers
+// textureDimensions(t, level) with one fragment's level for a whole group of fragments whose
+// levels differ, and a wrap by the wrong size read black (out of range) or the wrong square.
 fn texel_repeat(t: texture_2d<f32>, texel: vec2i, level: i32) -> vec4f {
-    let size = vec2i(textureDimensions(t, level));
+    let size = max(vec2i(textureDimensions(t)) >> vec2u(u32(level)), vec2i(1));
     return textureLoad(t, ((texel % size) + size) % size, level);
 }
 

@@ -18,31 +18,37 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// A test of a lab: the lab's own, or a teacher's hidden one (from `folder`).
+/// A test of a lab: the lab's own, or a teacher's hidden one (from the folder it names).
 #[derive(Clone, Debug)]
 pub enum Test {
-    Known(KnownAnswer),
+    Known(KnownAnswer, Option<PathBuf>),
     Image(ImageTest, Option<PathBuf>),
 }
 
 impl Test {
     pub fn name(&self) -> &str {
         match self {
-            Test::Known(test) => &test.name,
+            Test::Known(test, _) => &test.name,
             Test::Image(test, _) => &test.name,
         }
     }
 
     pub fn points(&self) -> f32 {
         match self {
-            Test::Known(test) => test.points,
+            Test::Known(test, _) => test.points,
             Test::Image(test, _) => test.points,
         }
     }
 
+    /// Whether it is a teacher's hidden test: its details are not shown to the student before the
+    /// grades are published.
+    pub fn hidden(&self) -> bool {
+        matches!(self, Test::Known(_, Some(_)) | Test::Image(_, Some(_)))
+    }
+
     /// The lab's own tests: its known answers, then its image tests.
     pub fn of(lab: &Lab) -> Vec<Test> {
-        let mut tests: Vec<Test> = lab.known_answers.iter().cloned().map(Test::Known).collect();
+        let mut tests: Vec<Test> = lab.known_answers.iter().cloned().map(|t| Test::Known(t, None)).collect();
         tests.extend(lab.images.iter().cloned().map(|t| Test::Image(t, None)));
         tests
     }
@@ -60,8 +66,28 @@ impl Test {
             max_score,
             output,
             mistake: finding.mistake.map(|(name, _)| name),
+            status: if finding.passed { "passed" } else { "failed" },
+            visibility: if self.hidden() { "after_published" } else { "visible" },
             passed: finding.passed,
+            counted: true,
             images: finding.images,
+        }
+    }
+
+    /// The result of a teacher's hidden test that the answer key itself fails (`why`): the
+    /// teacher's error, which costs the student nothing and is never shown to them.
+    pub fn teachers_error(&self, why: &str) -> TestResult {
+        TestResult {
+            name: self.name().to_owned(),
+            score: 0.0,
+            max_score: 0.0,
+            output: format!("Not graded: the lab's answer key fails this hidden test, so the test is in error, not the student. The key's result: {why}"),
+            mistake: None,
+            status: "failed",
+            visibility: "hidden",
+            passed: false,
+            counted: false,
+            images: None,
         }
     }
 }
@@ -99,17 +125,40 @@ pub struct Checker {
     student: Wgsl,
     reference: Wgsl,
     mistakes: Vec<(Mistake, Wgsl)>,
+    /// The other right answers the lab accepts, compiled.
+    alternatives: Vec<(Mistake, Wgsl)>,
+    /// The lab's own known-answer tests, which a known mistake must match on every one before a
+    /// failing test names it.
+    known: Vec<KnownAnswer>,
+    /// The slots the student left as the stub wrote them.
+    untouched: Vec<String>,
+    /// The student's values on [`Self::known`], and each mistake's agreement with them, found
+    /// when first needed.
+    agreement: std::cell::RefCell<BTreeMap<usize, bool>>,
+    student_values: std::cell::RefCell<Option<Vec<Option<[f32; 4]>>>>,
+    /// Whether a known-answer test found the student's loops cut off by the guard: the images
+    /// of a shader that would hang a GPU are not graded.
+    tripped: std::cell::Cell<bool>,
 }
 
 impl Checker {
     /// The checker of `text` (the student's file) for `lab`, on `gpu`.
     pub fn new(gpu: Gpu, lab: &Lab, text: &str) -> Checker {
-        let mistakes = lab.mistakes.iter().map(|m| (m.clone(), source::student(lab, &lab.mistaken(m)))).collect();
+        let compiled = |list: &[Mistake]| -> Vec<(Mistake, Wgsl)> {
+            list.iter().map(|m| (m.clone(), source::student(lab, &lab.mistaken(m)))).collect()
+        };
+        let (mistakes, alternatives) = (compiled(&lab.mistakes), compiled(&lab.alternatives));
         Checker {
             harness: Harness::new(&gpu),
             student: source::student(lab, text),
             reference: source::reference(lab),
             mistakes,
+            alternatives,
+            known: lab.known_answers.clone(),
+            untouched: source::untouched_slots(lab, text),
+            agreement: Default::default(),
+            student_values: Default::default(),
+            tripped: Default::default(),
             gpu,
         }
     }
@@ -118,34 +167,107 @@ impl Checker {
     /// when the test came from there (a teacher's hidden tests).
     pub async fn run(&self, test: &Test, index: usize) -> Checked {
         match test {
-            Test::Known(known) => Checked { finding: self.known_answer(known, index).await, pictures: None },
+            Test::Known(known, _) => Checked { finding: self.known_answer(known, index).await, pictures: None },
             Test::Image(image, folder) => self.image_test(image, folder.as_deref(), index).await,
         }
     }
 
     async fn known_answer(&self, test: &KnownAnswer, index: usize) -> Finding {
-        let value = match self.harness.call(&self.gpu, &self.student, &test.call).await {
-            Ok(value) => value,
+        let call = match self.harness.call(&self.gpu, &self.student, &test.call).await {
+            Ok(call) => call,
             Err(error) => return Finding { index, passed: false, output: error, mistake: None, images: None },
         };
+        let value = call.value;
         let (passed, wanted) = judge_value(test, value);
         let shown = |v: [f32; 4]| format!("({}, {}, {}, {})", v[0], v[1], v[2], v[3]);
-        let output = format!("{} = {}; {wanted}", test.call, shown(value));
-        let mut mistake = None;
-        if !passed {
-            // The mistake whose own value is this one (and is wrong).
-            let tolerance = test.tolerance.max(1e-5);
-            for (m, wgsl) in &self.mistakes {
-                let Ok(theirs) = self.harness.call(&self.gpu, wgsl, &test.call).await else { continue };
-                let same =
-                    theirs.iter().zip(value).all(|(a, b)| (a - b).abs() <= tolerance || (a.is_nan() && b.is_nan()));
-                if same && !judge_value(test, theirs).0 {
-                    mistake = Some((m.name.clone(), m.sentence.clone()));
-                    break;
-                }
+        let mut output = format!("{} = {}; {wanted}", test.call, shown(value));
+        if call.tripped {
+            self.tripped.set(true);
+            output = format!(
+                "{}: your loops ran past {} iterations in this one call, and the checker stopped them. On a GPU a loop that does not end hangs it: give every loop a bound it is sure to reach.\n{output}",
+                test.call,
+                super::isolate::ITERATIONS
+            );
+            return Finding { index, passed: false, output, mistake: None, images: None };
+        }
+        if let Some(name) = not_finite(value) {
+            output.push_str(&format!("\nThe result has {name}: a division by zero, or the root or logarithm of a negative number?"));
+        }
+        if passed {
+            return Finding { index, passed, output, mistake: None, images: None };
+        }
+        if let Some(said) = self.stub_said() {
+            output.push_str(&said);
+            return Finding { index, passed, output, mistake: None, images: None };
+        }
+        // The mistakes whose own value is this one (and is wrong) …
+        let tolerance = test.tolerance.max(1e-5);
+        let mut candidates = Vec::new();
+        for (at, (_, wgsl)) in self.mistakes.iter().enumerate() {
+            let Ok(theirs) = self.harness.call(&self.gpu, wgsl, &test.call).await else { continue };
+            if same_value(theirs.value, value, tolerance) && !judge_value(test, theirs.value).0 {
+                candidates.push(at);
             }
         }
+        // … and that give the student's value on every known-answer test.
+        let mistake = self.named(candidates).await;
         Finding { index, passed, output, mistake, images: None }
+    }
+
+    /// What to tell a student whose every slot is still the stub's, when a test fails.
+    fn stub_said(&self) -> Option<String> {
+        (!self.untouched.is_empty()).then(|| {
+            format!(
+                "\n`{}` is still the stub's neutral body: write it (TASK.md says what it computes).",
+                self.untouched.join("`, `")
+            )
+        })
+    }
+
+    /// The known mistake to name among `candidates` (indices of mistakes whose output on a failing
+    /// test is the student's): those that also give the student's value on every one of the lab's
+    /// known-answer tests. Several that the tests cannot tell apart are named together.
+    async fn named(&self, candidates: Vec<usize>) -> Option<(String, String)> {
+        let mut agreeing = Vec::new();
+        for at in candidates {
+            if self.agrees(at).await {
+                agreeing.push(&self.mistakes[at].0);
+            }
+        }
+        match agreeing.as_slice() {
+            [] => None,
+            [one] => Some((one.name.clone(), one.sentence.clone())),
+            several => Some((
+                several.iter().map(|m| m.name.as_str()).collect::<Vec<_>>().join(" or "),
+                several.iter().map(|m| format!("{}: {}", m.name, m.sentence)).collect::<Vec<_>>().join(" Or "),
+            )),
+        }
+    }
+
+    /// Whether mistake `at` gives the student's value on every one of the lab's known-answer tests.
+    async fn agrees(&self, at: usize) -> bool {
+        if let Some(known) = self.agreement.borrow().get(&at) {
+            return *known;
+        }
+        if self.student_values.borrow().is_none() {
+            let mut values = Vec::new();
+            for test in &self.known {
+                values.push(self.harness.call(&self.gpu, &self.student, &test.call).await.ok().map(|c| c.value));
+            }
+            *self.student_values.borrow_mut() = Some(values);
+        }
+        let students = self.student_values.borrow().clone().unwrap_or_default();
+        let mut agrees = true;
+        for (test, student) in self.known.iter().zip(students) {
+            let theirs = self.harness.call(&self.gpu, &self.mistakes[at].1, &test.call).await.ok().map(|c| c.value);
+            let tolerance = test.tolerance.max(1e-5);
+            if !matches!((theirs, student), (Some(a), Some(b)) if same_value(a, b, tolerance)) {
+                agrees = false;
+                break;
+            }
+        }
+        self.agreement.borrow_mut().insert(at, agrees);
+        agrees
     }
 
     async fn image_test(&self, test: &ImageTest, folder: Option<&Path>, index: usize) -> Checked {
@@ -153,6 +275,12 @@ impl Checker {
             finding: Finding { index, passed: false, output, mistake: None, images: None },
             pictures: None,
         };
+        if self.tripped.get() {
+            return fail(format!(
+                "not graded: your loops ran past {} iterations in a known-answer test (see above). On a GPU this shader would hang, so its images are not graded.",
+                super::isolate::ITERATIONS
+            ));
+        }
         let gpu = &self.gpu;
         let scene = match images::scene(test, folder) {
             Ok(scene) => scene,
@@ -166,24 +294,36 @@ impl Checker {
             Ok(image) => image,
             Err(error) => return fail(format!("drawing with Mirador's functions: {error}")),
         };
-        let (correct, outcome) = match test.against {
-            Against::Reference => (mirador.clone(), images::judge(test, &mirador, &yours, None)),
-            Against::Tracer => {
-                let traced = images::traced(&scene);
-                let outcome = images::judge(test, &traced, &yours, Some(&mirador));
-                (traced, outcome)
+        let (correct, mut outcome) = self.judged(test, &scene, &mirador, &yours);
+        // Another right answer draws another image: within the test's bounds of it is right too.
+        for (alternative, wgsl) in &self.alternatives {
+            if outcome.passed {
+                break;
             }
-        };
-        let Outcome { passed, error_map, output, .. } = outcome;
+            let Ok(theirs) = images::drawn(gpu, &scene, wgsl).await else { continue };
+            let (_, judged) = self.judged(test, &scene, &theirs, &yours);
+            if judged.passed {
+                outcome = images::Outcome {
+                    output: format!("{}\n(as the lab's other right answer, {}: {})", judged.output, alternative.name, alternative.sentence),
+                    ..judged
+                };
+            }
+        }
+        let Outcome { passed, error_map, mut output, .. } = outcome;
         let mut mistake = None;
         if !passed {
-            for (m, wgsl) in &self.mistakes {
-                let Ok(theirs) = images::drawn(gpu, &scene, wgsl).await else { continue };
-                let (same, _) = images::figures(&theirs, &yours);
-                if same.mean <= 0.002 && same.worst_region <= 0.02 {
-                    mistake = Some((m.name.clone(), m.sentence.clone()));
-                    break;
+            if let Some(said) = self.stub_said() {
+                output.push_str(&said);
+            } else {
+                let mut candidates = Vec::new();
+                for (at, (_, wgsl)) in self.mistakes.iter().enumerate() {
+                    let Ok(theirs) = images::drawn(gpu, &scene, wgsl).await else { continue };
+                    let (same, _) = images::figures(&theirs, &yours);
+                    if same.mean <= 0.002 && same.worst_region <= 0.02 {
+                        candidates.push(at);
+                    }
                 }
+                mistake = self.named(candidates).await;
             }
         }
         Checked {
@@ -191,6 +331,36 @@ impl Checker {
             pictures: Some([correct, yours, error_map]),
         }
     }
+}
+
+impl Checker {
+    /// `yours` judged against `mirador` (a right answer's image) or, for a test against the
+    /// tracer, against the traced image with `mirador`'s own error as the baseline: the image
+    /// shown as correct, and the outcome.
+    fn judged(&self, test: &ImageTest, scene: &crate::scene::Scene, mirador: &RgbaImage, yours: &RgbaImage) -> (RgbaImage, Outcome) {
+        match test.against {
+            Against::Reference => (mirador.clone(), images::judge(test, mirador, yours, None)),
+            Against::Tracer => {
+                let traced = images::traced(scene);
+                let outcome = images::judge(test, &traced, yours, Some(mirador));
+                (traced, outcome)
+            }
+        }
+    }
+}
+
+/// Two values equal within `tolerance` in every component, NaN equal to NaN.
+fn same_value(a: [f32; 4], b: [f32; 4], tolerance: f32) -> bool {
+    a.iter().zip(b).all(|(a, b)| (a - b).abs() <= tolerance || (a.is_nan() && b.is_nan()) || a == &b)
+}
+
+/// What is not a number in `value`, named: "NaN in component 2".
+fn not_finite(value: [f32; 4]) -> Option<String> {
+    let bad: Vec<String> = (0..4)
+        .filter(|&i| !value[i].is_finite())
+        .map(|i| format!("{} in component {}", if value[i].is_nan() { "NaN" } else { "an infinity" }, i + 1))
+        .collect();
+    (!bad.is_empty()).then(|| bad.join(" and "))
 }
 
 /// Whether `value` is right, and what was wanted.

@@ -1,6 +1,7 @@
 //! Known-answer tests: one call of a student's function on tiny inputs, run in a fragment shader
 //! with the shared WGSL (and the student's functions in place of Mirador's), its value written
-//! bit for bit into a 1×1 `Rgba32Uint` target and read back. A fragment shader rather than a
+//! bit for bit into a 2×1 `Rgba32Uint` target (beside it, whether the loop guard cut the
+//! student's loops off: [`ENTRY`]) and read back. A fragment shader rather than a
 //! compute one: WebGL2 has none, and the page's lab runs its checks there too. Inputs a texture
 //! function needs are two tiny textures made here, whose every texel is known (the values a
 //! test expects are worked out by hand from these):
@@ -13,6 +14,7 @@
 
 use crate::gpu::readback::Pending;
 use crate::gpu::{Gpu, layout};
+use crate::shaders::Wgsl;
 use wgpu::util::DeviceExt;
 
 /// The harness's bindings, declared before the entry points.
@@ -20,6 +22,33 @@ pub const BINDINGS: &str = "
 @group(0) @binding(0) var lab_texture: texture_2d<f32>;
 @group(0) @binding(1) var lab_depth: texture_depth_2d_array;
 ";
+
+/// The known-answer test's entry points, `{call}` and `{tripped}` filled in: pixel 0 gets the
+/// value's bits, pixel 1 whether the loop guard cut the student's loops off while computing it
+/// (each pixel computes the call, the same way). Chosen by integer arithmetic, not by a branch:
+/// lavapipe wrote the sign bit of pixel 0's first component into pixel 1 when each returned
+/// from its own branch (measured: a value of −1 gave pixel 1 0x80000000).
+pub const ENTRY: &str = "
+@vertex
+fn lab_vertex(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {
+    return vec4f(f32(i / 2u) * 4.0 - 1.0, f32(i % 2u) * 4.0 - 1.0, 0.0, 1.0);
+}
+
+@fragment
+fn lab_main(@builtin(position) lab_pixel: vec4f) -> @location(0) vec4u {
+    let lab_value: vec4f = {call};
+    let lab_first = u32(lab_pixel.x < 1.0);
+    return bitcast<vec4u>(lab_value) * lab_first + vec4u(u32({tripped}), 0u, 0u, 0u) * (1u - lab_first);
+}
+";
+
+/// What a known-answer call gave.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Call {
+    pub value: [f32; 4],
+    /// The student's loops ran past the guard's bound ([`super::isolate::ITERATIONS`]).
+    pub tripped: bool,
+}
 
 const SIDE: u32 = 4;
 
@@ -70,7 +99,7 @@ impl Harness {
         });
         let target = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("lab::harness::target"),
-            size: wgpu::Extent3d { width: 1, height: 1, depth_or_array_layers: 1 },
+            size: wgpu::Extent3d { width: 2, height: 1, depth_or_array_layers: 1 },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
@@ -82,28 +111,17 @@ impl Harness {
     }
 
     /// The module that computes `call` (a `vec4f` expression) in the shared WGSL as `wgsl`
-    /// composes it, for `wgsl`'s profile: `lab_main` writes the value's bits.
-    pub fn module(wgsl: &crate::shaders::Wgsl, call: &str) -> String {
-        let entry = format!(
-            "{BINDINGS}
-@vertex
-fn lab_vertex(@builtin(vertex_index) i: u32) -> @builtin(position) vec4f {{
-    return vec4f(f32(i / 2u) * 4.0 - 1.0, f32(i % 2u) * 4.0 - 1.0, 0.0, 1.0);
-}}
-
-@fragment
-fn lab_main() -> @location(0) vec4u {{
-    let lab_value: vec4f = {call};
-    return bitcast<vec4u>(lab_value);
-}}
-"
-        );
-        wgsl.compose_common(&entry)
+    /// composes it, for `wgsl`'s profile: `lab_main` writes the value's bits at pixel 0, and at
+    /// pixel 1 whether the student's loops were cut off ([`Wgsl::tripped`]).
+    pub fn module(wgsl: &Wgsl, call: &str) -> String {
+        let tripped = wgsl.tripped().unwrap_or("false");
+        let entry = ENTRY.replace("{call}", call).replace("{tripped}", tripped);
+        wgsl.compose_common(&format!("{BINDINGS}{entry}"))
     }
 
     /// The value of `call` (a `vec4f` expression) in a module of the shared WGSL as `wgsl`
     /// composes it; a GPU error is the error's text.
-    pub async fn call(&self, gpu: &Gpu, wgsl: &crate::shaders::Wgsl, call: &str) -> Result<[f32; 4], String> {
+    pub async fn call(&self, gpu: &Gpu, wgsl: &Wgsl, call: &str) -> Result<Call, String> {
         // Composed for the device's profile, as the passes are: WebGL2 has no cube arrays.
         let source = Harness::module(&wgsl.for_profile(gpu.profile()), call);
         if let Err(error) = naga::front::wgsl::parse_str(&source) {
@@ -111,8 +129,9 @@ fn lab_main() -> @location(0) vec4u {{
         }
         let readback = gpu.checked_later(|| self.draw(gpu, source)).await.map_err(|e| e.to_string())?;
         let bytes = readback.map_err(|e| e.to_string())?.texels(&gpu.device).await.map_err(|e| e.to_string())?;
-        let word = |i: usize| f32::from_bits(u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]));
-        Ok([word(0), word(4), word(8), word(12)])
+        let word = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+        let value = [0, 4, 8, 12].map(|i| f32::from_bits(word(i)));
+        Ok(Call { value, tripped: word(16) == 1 })
     }
 
     /// Draws the one pixel of `source`'s `lab_main` and starts reading it back.

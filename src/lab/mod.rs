@@ -28,16 +28,21 @@
 
 // What runs the checks natively: processes and folders, which the page has not.
 #[cfg(not(target_arch = "wasm32"))]
+pub mod autograder;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod check;
 pub mod checks;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod folder;
 pub mod harness;
 pub mod images;
+pub mod isolate;
 pub mod report;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod run;
 pub mod source;
+#[cfg(not(target_arch = "wasm32"))]
+pub mod summary;
 
 use serde::Deserialize;
 
@@ -72,6 +77,11 @@ pub struct Lab {
     pub images: Vec<ImageTest>,
     #[serde(default)]
     pub mistakes: Vec<Mistake>,
+    /// Other right answers: the solution written another way that the lab accepts (the level of
+    /// detail from the footprint's largest component). An image test also passes within its
+    /// bounds of an alternative's image; every alternative scores full marks (tests/labs.rs).
+    #[serde(default)]
+    pub alternatives: Vec<Mistake>,
     /// Why the lab cannot run on a device of the WebGL2 profile (the page where the browser has
     /// no WebGPU), when its routes need what WebGL2's shading language lacks. Kept true by
     /// `tests/webgl2.rs`, which compiles every lab for WebGL2.
@@ -153,7 +163,8 @@ pub enum Against {
     Tracer,
 }
 
-/// A typical mistake: the solution with one slip made, and what to tell a student who made it.
+/// A typical mistake: the solution with one slip made, and what to tell a student who made it. (An
+/// alternative has the same form: the solution with one right change, and why it is right.)
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Mistake {

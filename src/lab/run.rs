@@ -36,15 +36,16 @@ pub fn tests(lab: &Lab, hidden: Option<&Path>) -> Result<Vec<Test>, String> {
     for path in files {
         let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
         let file: TestFile = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-        tests.extend(file.known.into_iter().map(Test::Known));
+        tests.extend(file.known.into_iter().map(|t| Test::Known(t, Some(folder.to_path_buf()))));
         tests.extend(file.image.into_iter().map(|t| Test::Image(t, Some(folder.to_path_buf()))));
     }
     Ok(tests)
 }
 
 /// Runs `tests[from..]` with the student's file `text`, writing each finding as a line to
-/// standard output and each image test's pictures into `folder/report/`.
-pub fn run(lab: &Lab, text: &str, tests: &[Test], from: usize, folder: &Path) -> Result<(), String> {
+/// standard output and, unless `pictures` is false, each image test's pictures into
+/// `folder/report/`.
+pub fn run(lab: &Lab, text: &str, tests: &[Test], from: usize, folder: &Path, pictures: bool) -> Result<(), String> {
     let gpu = Gpu::headless().map_err(|e| e.to_string())?;
     if let Some(reason) = lab.refusal(gpu.profile()) {
         return Err(format!(
@@ -56,8 +57,8 @@ pub fn run(lab: &Lab, text: &str, tests: &[Test], from: usize, folder: &Path) ->
     let checker = Checker::new(gpu, lab, text);
     let mut out = std::io::stdout().lock();
     for (index, test) in tests.iter().enumerate().skip(from) {
-        let Checked { mut finding, pictures } = block_on(&checker.gpu.device, checker.run(test, index));
-        finding.images = pictures.and_then(|pictures| save(folder, test.name(), &pictures));
+        let Checked { mut finding, pictures: drawn } = block_on(&checker.gpu.device, checker.run(test, index));
+        finding.images = drawn.filter(|_| pictures).and_then(|drawn| save(folder, test.name(), &drawn));
         let line = serde_json::to_string(&finding).expect("a finding serialises");
         writeln!(out, "{line}").and_then(|_| out.flush()).map_err(|e| e.to_string())?;
     }

@@ -5,6 +5,7 @@
 //! `file:line:column`.
 
 use super::Lab;
+use super::isolate::Isolated;
 use crate::shaders::{self, Profile, Wgsl};
 
 /// A problem with the student's file, where it is.
@@ -57,23 +58,58 @@ pub fn builtin_declaration(name: &str) -> Option<(String, String)> {
     None
 }
 
-/// The WGSL the reference image is drawn with: Mirador's own functions, routed as the lab routes
-/// them.
+/// The WGSL the reference image is drawn with: Mirador's own functions (the answer key), routed as
+/// the lab routes them, and compiled as a student's file is ([`student`]), so that the reference
+/// and the student meet the same device.
 pub fn reference(lab: &Lab) -> Wgsl {
-    Wgsl::replacing(lab.route_names(), lab.routes.join("\n"))
+    student(lab, &lab.solution())
 }
 
-/// The WGSL the student's image is drawn with: the slots from `student`, the lab's routes after
-/// them. The student's text comes first in what is appended, so its offsets map back to its own.
+/// The WGSL the student's image is drawn with: the slots from `student` (its helpers' names put
+/// apart from Mirador's and its loops bounded: [`isolated`]), the lab's routes after them. The
+/// student's text comes first in what is appended, so its offsets map back to its own.
 pub fn student(lab: &Lab, student: &str) -> Wgsl {
+    let isolated = isolated(lab, student);
     let mut replaced: Vec<String> = lab.slots.iter().map(|slot| slot.name.clone()).collect();
     replaced.extend(lab.route_names());
-    let mut code = student.to_owned();
-    if !code.ends_with('\n') {
-        code.push('\n');
-    }
+    let mut code = isolated.text.clone();
     code.push_str(&lab.routes.join("\n"));
-    Wgsl::replacing(replaced, code)
+    Wgsl::replacing(replaced, code).with_tripped(isolated.tripped())
+}
+
+/// The student's text as every module compiles it: its own names renamed apart from every text
+/// it is composed with, its loops guarded ([`super::isolate`]).
+pub fn isolated(lab: &Lab, student: &str) -> Isolated {
+    let slots: Vec<String> = lab.slots.iter().map(|slot| slot.name.clone()).collect();
+    let passes = [shaders::SCENE, shaders::TRANSPARENCY, shaders::REFRACTION, shaders::VOLUME];
+    let profiles = [Profile::Standard.wgsl().1, Profile::WebGl2.wgsl().1];
+    let routes = lab.routes.join("\n");
+    let others: Vec<&str> = shaders::COMMON
+        .iter()
+        .chain(shaders::SURFACE)
+        .map(|(_, text)| *text)
+        .chain(passes)
+        .chain(profiles)
+        .chain([super::harness::BINDINGS, super::harness::ENTRY, routes.as_str()])
+        .collect();
+    Isolated::new(student, &slots, &others)
+}
+
+/// The slots whose body in `text` is still the stub's neutral one (comments and spacing aside).
+pub fn untouched_slots(lab: &Lab, text: &str) -> Vec<String> {
+    let stub = lab.stub();
+    let body = |text: &str, name: &str| {
+        let range = shaders::declaration(text, name)?;
+        let declaration = &text[range];
+        let body = &declaration[declaration.find('{')?..];
+        let code: String = body.lines().map(|line| line.split("//").next().unwrap_or("")).collect();
+        Some(code.split_whitespace().collect::<String>())
+    };
+    lab.slots
+        .iter()
+        .filter(|slot| body(text, &slot.name).is_some_and(|theirs| Some(theirs) == body(&stub, &slot.name)))
+        .map(|slot| slot.name.clone())
+        .collect()
 }
 
 /// Everything wrong with the student's file, empty when every surface module compiles with it.
@@ -129,16 +165,18 @@ pub fn problems_on(lab: &Lab, text: &str, profile: Profile) -> Vec<Problem> {
 /// naga's first complaint about a surface module or the known-answer harness with `text` in.
 fn compile_problem(lab: &Lab, text: &str) -> Option<Problem> {
     let wgsl = student(lab, text);
+    let isolated = isolated(lab, text);
     let passes = [shaders::SCENE, shaders::TRANSPARENCY, shaders::REFRACTION, shaders::VOLUME];
     for pass in passes {
         let composed = wgsl.compose_surface(pass);
         let start = composed.len() - wgsl.code().len();
-        if let Some(problem) = naga_problem(&composed, start, text) {
+        if let Some(problem) = naga_problem(&composed, start, text, &isolated) {
             return Some(problem);
         }
     }
-    let harness = wgsl.compose_common(super::harness::BINDINGS);
-    naga_problem(&harness, harness.len() - wgsl.code().len(), text)
+    let harness = super::harness::Harness::module(&wgsl, "vec4f(0.0)");
+    let start = harness.len() - wgsl.code().len();
+    naga_problem(&harness, start, text, &isolated)
 }
 
 /// Each slot's signature against Mirador's: the parameter and result types, names aside.
@@ -225,8 +263,8 @@ fn canonical_type(ty: &str) -> String {
 }
 
 /// naga's first complaint about `composed`, located in the student's `text` when it falls in it
-/// (`text` begins at byte `start` of `composed`).
-fn naga_problem(composed: &str, start: usize, text: &str) -> Option<Problem> {
+/// (`isolated`, the text as compiled, begins at byte `start` of `composed`).
+fn naga_problem(composed: &str, start: usize, text: &str, isolated: &Isolated) -> Option<Problem> {
     let (message, offset) = match naga::front::wgsl::parse_str(composed) {
         Err(error) => (error.message().to_owned(), error.location(composed).map(|l| l.offset as usize)),
         Ok(module) => {
@@ -243,9 +281,11 @@ fn naga_problem(composed: &str, start: usize, text: &str) -> Option<Problem> {
             (message, error.location(composed).map(|l| l.offset as usize))
         }
     };
-    match offset {
-        Some(offset) if offset >= start && offset < start + text.len() => {
-            let within = offset - start;
+    let message = isolated.unprefixed(&message);
+    let within = offset.and_then(|offset| offset.checked_sub(start)).and_then(|within| isolated.original(within));
+    match (within, offset) {
+        (Some(within), _) => {
+            let within = within.min(text.len());
             let line = text[..within].matches('\n').count() as u32 + 1;
             let line_start = text[..within].rfind('\n').map_or(0, |n| n + 1);
             let column = text[line_start..within].chars().count() as u32 + 1;
@@ -256,7 +296,7 @@ fn naga_problem(composed: &str, start: usize, text: &str) -> Option<Problem> {
                 message,
             })
         }
-        Some(offset) => {
+        (None, Some(offset)) => {
             // In Mirador's code: say in which of its files, so a teacher can tell.
             let file = composed[..offset]
                 .rfind("// ---- ")
@@ -269,7 +309,7 @@ fn naga_problem(composed: &str, start: usize, text: &str) -> Option<Problem> {
                 message: format!("{message} (in Mirador's {place}, where it uses your functions)"),
             })
         }
-        None => Some(Problem { line: None, column: None, text: None, message }),
+        (None, None) => Some(Problem { line: None, column: None, text: None, message }),
     }
 }
 
