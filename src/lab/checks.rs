@@ -286,12 +286,12 @@ impl Checker {
             Ok(scene) => scene,
             Err(error) => return fail(format!("the test's scene: {error}")),
         };
-        let yours = match images::drawn(gpu, &scene, &self.student).await {
-            Ok(image) => image,
+        let (yours, your_nans) = match images::drawn_counted(gpu, &scene, &self.student).await {
+            Ok(drawn) => drawn,
             Err(error) => return fail(format!("drawing with your functions: {error}")),
         };
-        let mirador = match images::drawn(gpu, &scene, &self.reference).await {
-            Ok(image) => image,
+        let (mirador, mirador_nans) = match images::drawn_counted(gpu, &scene, &self.reference).await {
+            Ok(drawn) => drawn,
             Err(error) => return fail(format!("drawing with Mirador's functions: {error}")),
         };
         let (correct, mut outcome) = self.judged(test, &scene, &mirador, &yours);
@@ -309,7 +309,15 @@ impl Checker {
                 };
             }
         }
-        let Outcome { passed, error_map, mut output, .. } = outcome;
+        let Outcome { mut passed, error_map, mut output, .. } = outcome;
+        if your_nans > mirador_nans {
+            // A NaN shows as whatever the device makes of it: the same shader may pass here and
+            // fail on another GPU, so it fails everywhere.
+            passed = false;
+            output.push_str(&format!(
+                "\n{your_nans} of your image's pixels are NaN or infinite before the output transform ({mirador_nans} of Mirador's): a division by zero, or the root or logarithm of a negative number?"
+            ));
+        }
         let mut mistake = None;
         if !passed {
             if let Some(said) = self.stub_said() {
@@ -354,13 +362,19 @@ fn same_value(a: [f32; 4], b: [f32; 4], tolerance: f32) -> bool {
     a.iter().zip(b).all(|(a, b)| (a - b).abs() <= tolerance || (a.is_nan() && b.is_nan()) || a == &b)
 }
 
-/// What is not a number in `value`, named: "NaN in component 2".
+/// What is not a number in `value`, named: "NaN in components 1, 2".
 fn not_finite(value: [f32; 4]) -> Option<String> {
-    let bad: Vec<String> = (0..4)
-        .filter(|&i| !value[i].is_finite())
-        .map(|i| format!("{} in component {}", if value[i].is_nan() { "NaN" } else { "an infinity" }, i + 1))
-        .collect();
-    (!bad.is_empty()).then(|| bad.join(" and "))
+    let named = |what: &str, wanted: fn(f32) -> bool| {
+        let components: Vec<String> = (0..4).filter(|&i| wanted(value[i])).map(|i| (i + 1).to_string()).collect();
+        match components.len() {
+            0 => None,
+            1 => Some(format!("{what} in component {}", components[0])),
+            _ => Some(format!("{what} in components {}", components.join(", "))),
+        }
+    };
+    let found: Vec<String> =
+        [named("NaN", f32::is_nan), named("an infinity", f32::is_infinite)].into_iter().flatten().collect();
+    (!found.is_empty()).then(|| found.join(" and "))
 }
 
 /// Whether `value` is right, and what was wanted.

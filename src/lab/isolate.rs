@@ -68,29 +68,58 @@ impl Isolated {
             });
         let prefix = fresh_prefix("student", text, others);
         let guard_prefix = fresh_prefix("loop_guard", text, others);
+        let renamed = |token: &Token| {
+            let name = &text[token.range.clone()];
+            (token.kind == Kind::Identifier && token.renameable && declared.iter().any(|d| d == name))
+                .then(|| format!("{prefix}{name}"))
+        };
+        // The text of `range` with the student's names renamed in it.
+        let rewritten = |range: std::ops::Range<usize>| {
+            let (mut out, mut from) = (String::new(), range.start);
+            for token in tokens.iter().filter(|t| t.range.start >= range.start && t.range.end <= range.end) {
+                if let Some(name) = renamed(token) {
+                    out.push_str(&text[from..token.range.start]);
+                    out.push_str(&name);
+                    from = token.range.end;
+                }
+            }
+            out.push_str(&text[from..range.end]);
+            out
+        };
         let mut changes: Vec<(usize, usize, String)> = Vec::new();
         for (index, token) in tokens.iter().enumerate() {
-            if token.kind != Kind::Identifier {
-                continue;
+            if let Some(name) = renamed(token) {
+                changes.push((token.range.start, token.range.len(), name));
             }
             let name = &text[token.range.clone()];
-            if declared.iter().any(|d| d == name) && token.renameable {
-                changes.push((token.range.start, token.range.len(), format!("{prefix}{name}")));
+            if token.kind != Kind::Identifier || token.after_dot {
+                continue;
             }
-            if name == "textureDimensions" && !token.after_dot {
-                if let Some((end, [texture, level])) = two_arguments(text, &tokens, index) {
-                    let size = format!("textureDimensions({texture})");
-                    let with = format!("max({size} >> ({size} * 0u + u32({level})), {size} * 0u + 1u)");
+            if name == "textureDimensions" {
+                if let Some((end, [texture, level])) = two_arguments(&tokens, index) {
+                    let size = format!("textureDimensions({})", rewritten(texture).trim());
+                    let level = rewritten(level);
+                    let with = format!("max({size} >> ({size} * 0u + u32({})), {size} * 0u + 1u)", level.trim());
                     changes.push((token.range.start, end - token.range.start, with));
                 }
             }
-            if matches!(name, "loop" | "for" | "while") && !token.after_dot {
+            if matches!(name, "loop" | "for" | "while") {
                 if let Some(open) = loop_body(&tokens, index) {
                     changes.push((open + 1, 0, format!(" if {guard_prefix}step() {{ break; }}")));
                 }
             }
         }
-        changes.sort_by_key(|change| change.0);
+        // In order; a change inside an earlier one (a name in a rewritten call's arguments, a
+        // call inside another's) is already part of it.
+        changes.sort_by_key(|change| (change.0, std::cmp::Reverse(change.1)));
+        let mut end = 0;
+        changes.retain(|(at, len, _)| {
+            let keep = *at >= end;
+            if keep {
+                end = at + len;
+            }
+            keep
+        });
         let loops = changes.iter().filter(|c| c.1 == 0).count();
         let (mut out, mut edits, mut from) = (String::new(), Vec::new(), 0);
         for (at, len, with) in changes {
@@ -323,8 +352,8 @@ fn module_scope_names(text: &str, tokens: &[Token]) -> Vec<String> {
 }
 
 /// The call `name(a, b)` starting at `tokens[index]`: the offset after its `)`, and its two
-/// arguments' texts; `None` for any other number of arguments.
-fn two_arguments<'t>(text: &'t str, tokens: &[Token], index: usize) -> Option<(usize, [&'t str; 2])> {
+/// arguments' ranges; `None` for any other number of arguments.
+fn two_arguments(tokens: &[Token], index: usize) -> Option<(usize, [std::ops::Range<usize>; 2])> {
     let open = tokens.get(index + 1).filter(|t| t.kind == Kind::Punct('('))?;
     let (mut depth, mut commas) = (0i32, Vec::new());
     for token in &tokens[index + 1..] {
@@ -334,9 +363,7 @@ fn two_arguments<'t>(text: &'t str, tokens: &[Token], index: usize) -> Option<(u
                 depth -= 1;
                 if depth == 0 {
                     let [comma] = commas[..] else { return None };
-                    let first = text[open.range.end..comma].trim();
-                    let second = text[comma + 1..token.range.start].trim();
-                    return Some((token.range.end, [first, second]));
+                    return Some((token.range.end, [open.range.end..comma, comma + 1..token.range.start]));
                 }
             }
             Kind::Punct(',') if depth == 1 => commas.push(token.range.start),
@@ -398,6 +425,14 @@ mod tests {
         let text = "fn slot(t: texture_2d<f32>, l: i32) -> vec2f {\n    return vec2f(textureDimensions(t, l + 1)) + vec2f(textureDimensions(t));\n}\n";
         let isolated = Isolated::new(text, &["slot".to_owned()], &[]);
         assert!(isolated.text.contains("vec2f(max(textureDimensions(t) >> (textureDimensions(t) * 0u + u32(l + 1)), textureDimensions(t) * 0u + 1u)) + vec2f(textureDimensions(t))"), "{}", isolated.text);
+    }
+
+    #[test]
+    fn a_helper_inside_a_rewritten_call_is_renamed_once() {
+        let text = "fn lod(x: i32) -> i32 { return x; }\nfn slot(t: texture_2d<f32>) -> vec2u {\n    return textureDimensions(t, lod(textureDimensions(t, 1).x));\n}\n";
+        let isolated = Isolated::new(text, &["slot".to_owned()], &[]);
+        assert!(isolated.text.contains("u32(student_lod(textureDimensions(t, 1).x))"), "{}", isolated.text);
+        assert!(!isolated.text.contains("student_student_"));
     }
 
     #[test]

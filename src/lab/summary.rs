@@ -199,6 +199,27 @@ fn mean_score(summary: &Summary) -> f64 {
     fractions.iter().sum::<f64>() / fractions.len().max(1) as f64
 }
 
+/// The submissions that did not compile, grouped by their first error (most first).
+fn broken(summary: &Summary) -> Vec<(String, Vec<&str>)> {
+    let mut groups: Vec<(String, Vec<&str>)> = Vec::new();
+    for s in summary.submissions.iter().filter(|s| s.compile_error.is_some()) {
+        let first = s.compile_error.as_deref().unwrap_or("").lines().next().unwrap_or("").to_owned();
+        match groups.iter_mut().find(|(error, _)| *error == first) {
+            Some((_, names)) => names.push(&s.name),
+            None => groups.push((first, vec![&s.name])),
+        }
+    }
+    groups.sort_by(|a, b| b.1.len().cmp(&a.1.len()));
+    groups
+}
+
+/// "3 submissions: a, b, c", the first five named.
+fn names_of(names: &[&str]) -> String {
+    let shown = names.iter().take(5).copied().collect::<Vec<_>>().join(", ");
+    let more = if names.len() > 5 { format!(" and {} more", names.len() - 5) } else { String::new() };
+    format!("{} submission(s): {shown}{more}", names.len())
+}
+
 fn slowest(summary: &Summary) -> Vec<&Submission> {
     let mut by_time: Vec<&Submission> = summary.submissions.iter().collect();
     by_time.sort_by(|a, b| b.seconds.total_cmp(&a.seconds));
@@ -213,8 +234,12 @@ pub fn markdown(summary: &Summary) -> String {
         summary.submissions.len(),
         percent(mean_score(summary))
     );
-    for (bin, count) in histogram(&summary.submissions).iter().enumerate() {
-        let _ = writeln!(out, "| {} | {count} {} |", bin_label(bin), "█".repeat(*count));
+    let bins = histogram(&summary.submissions);
+    let most = bins.iter().copied().max().unwrap_or(1).max(1);
+    for (bin, count) in bins.iter().enumerate() {
+        // Bars of at most 40 blocks; any submission at all shows one.
+        let blocks = if *count == 0 { 0 } else { (count * 40).div_ceil(most) };
+        let _ = writeln!(out, "| {} | {count} {} |", bin_label(bin), "█".repeat(blocks));
     }
     out.push_str("\n## Tests\n\nDiscrimination: the correlation between passing the test and the score on the other tests (near 0: it does not separate strong from weak; below 0: look at the test).\n\n| test | passed by | discrimination |\n|---|---|---|\n");
     for test in &summary.tests {
@@ -234,13 +259,12 @@ pub fn markdown(summary: &Summary) -> String {
         let _ = writeln!(out, "- {mistake}: {count} submission(s)");
     }
     out.push_str("\n## Did not compile\n\n");
-    let broken: Vec<&Submission> = summary.submissions.iter().filter(|s| s.compile_error.is_some()).collect();
+    let broken = broken(summary);
     if broken.is_empty() {
         out.push_str("Every submission compiled.\n");
     }
-    for s in broken {
-        let first = s.compile_error.as_deref().unwrap_or("").lines().next().unwrap_or("");
-        let _ = writeln!(out, "- {}: `{}`", s.name, first.replace('`', "'"));
+    for (error, names) in broken {
+        let _ = writeln!(out, "- `{}`: {}", error.replace('`', "'"), names_of(&names));
     }
     out.push_str("\n## Slowest checks\n\n| submission | seconds |\n|---|---|\n");
     for s in slowest(summary) {
@@ -294,13 +318,12 @@ pub fn html(summary: &Summary) -> String {
         let _ = writeln!(out, "<li>{}: {count} submission(s)</li>", escape(mistake));
     }
     out.push_str("</ul>\n<h2>Did not compile</h2>\n<ul id=\"broken\">\n");
-    let broken: Vec<&Submission> = summary.submissions.iter().filter(|s| s.compile_error.is_some()).collect();
+    let broken = broken(summary);
     if broken.is_empty() {
         out.push_str("<li>Every submission compiled.</li>\n");
     }
-    for s in broken {
-        let first = s.compile_error.as_deref().unwrap_or("").lines().next().unwrap_or("");
-        let _ = writeln!(out, "<li>{}: <code>{}</code></li>", escape(&s.name), escape(first));
+    for (error, names) in broken {
+        let _ = writeln!(out, "<li><code>{}</code>: {}</li>", escape(&error), escape(&names_of(&names)));
     }
     out.push_str("</ul>\n<h2>Slowest checks</h2>\n<table id=\"slowest\"><tr><th>submission</th><th>seconds</th></tr>\n");
     for s in slowest(summary) {
