@@ -230,10 +230,7 @@ enum LabCommand {
     },
     /// Exits 0 when test N (from 0, in the order of its `tests`) of a results.json passed: one
     /// test as a GitHub Classroom step.
-    Passed {
-        results: PathBuf,
-        index: usize,
-    },
+    Passed { results: PathBuf, index: usize },
     /// Runs a lab's tests from one on, a JSON line each (what `check` runs under its time limit).
     #[command(hide = true)]
     Run {
@@ -412,7 +409,7 @@ fn copy(scene: &Path, dir: &Path) -> anyhow::Result<()> {
 
 /// `mirador lab …`: its own exit status (`check` fails when a test does).
 fn lab(command: LabCommand) -> ExitCode {
-    use mirador::lab::{self, autograder, check, folder, report, run, summary};
+    use mirador::lab::{self, autograder, check, folder, run, summary};
     let outcome = match command {
         LabCommand::List => {
             for lab in lab::catalog() {
@@ -430,30 +427,11 @@ fn lab(command: LabCommand) -> ExitCode {
         LabCommand::Check { dir, lab, tests, points, time_limit, results, format } => {
             let time_limit =
                 std::time::Duration::try_from_secs_f64(time_limit).unwrap_or(std::time::Duration::from_secs(30));
-            let options = check::Options {
-                dir: dir.clone(),
-                lab,
-                hidden: tests,
-                points,
-                time_limit,
-                results: results.clone().map(|path| (path, format)),
-            };
-            let checked = check::check(&options);
-            if let (Err(why), Some(path)) = (&checked, &results) {
-                // Every submission gets a result file, saying why it could not be checked.
-                let json = report::failure_json(format, why);
-                if let Err(e) = output::write_atomically(json.as_bytes(), path) {
-                    eprintln!("error: {}: {e}", path.display());
-                }
-            }
-            checked.map(|report| {
-                print!("{}", report::text(&report));
-                println!("(written: {} and {})", dir.join("results.json").display(), dir.join("report.md").display());
-                report.passed()
-            })
+            let results = results.map(|path| (path, format));
+            lab_check(check::Options { dir, lab, hidden: tests, points, time_limit, results })
         }
-        LabCommand::Autograder { lab, dir, service, tests, points, binary, time_limit } => lab::find(&lab)
-            .and_then(|lab| {
+        LabCommand::Autograder { lab, dir, service, tests, points, binary, time_limit } => {
+            lab::find(&lab).and_then(|lab| {
                 let binary = match binary {
                     Some(binary) => binary,
                     None => std::env::current_exe().map_err(|e| format!("the running binary: {e}"))?,
@@ -463,11 +441,13 @@ fn lab(command: LabCommand) -> ExitCode {
                     println!("wrote {}", path.display());
                 }
                 Ok(true)
-            }),
+            })
+        }
         LabCommand::Summary { results, out } => summary::read(&results).and_then(|submissions| {
             let summary = summary::summarise(submissions);
             std::fs::create_dir_all(&out).map_err(|e| format!("{}: {e}", out.display()))?;
-            for (name, text) in [("summary.html", summary::html(&summary)), ("summary.md", summary::markdown(&summary))] {
+            for (name, text) in [("summary.html", summary::html(&summary)), ("summary.md", summary::markdown(&summary))]
+            {
                 let path = out.join(name);
                 output::write_atomically(text.as_bytes(), &path).map_err(|e| format!("{}: {e}", path.display()))?;
                 println!("wrote {}", path.display());
@@ -475,9 +455,8 @@ fn lab(command: LabCommand) -> ExitCode {
             println!("{} submissions", summary.submissions.len());
             Ok(true)
         }),
-        LabCommand::Passed { results, index } => std::fs::read_to_string(&results)
-            .map_err(|e| format!("{}: {e}", results.display()))
-            .and_then(|text| {
+        LabCommand::Passed { results, index } => {
+            std::fs::read_to_string(&results).map_err(|e| format!("{}: {e}", results.display())).and_then(|text| {
                 let json: serde_json::Value =
                     serde_json::from_str(&text).map_err(|e| format!("{}: {e}", results.display()))?;
                 let test = json["tests"]
@@ -485,7 +464,8 @@ fn lab(command: LabCommand) -> ExitCode {
                     .ok_or_else(|| format!("{}: there is no test {index}", results.display()))?;
                 println!("{}: {}", test["name"].as_str().unwrap_or("?"), test["output"].as_str().unwrap_or(""));
                 Ok(test["status"] == "passed")
-            }),
+            })
+        }
         LabCommand::Run { dir, from, tests, lab: name, file, key } => {
             let name = match name {
                 Some(name) => Ok(name),
@@ -512,6 +492,25 @@ fn lab(command: LabCommand) -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// `mirador lab check`: the report printed, and with `--results` a result file written even when
+/// the submission cannot be checked at all (it says why). Whether every test passed.
+fn lab_check(options: mirador::lab::check::Options) -> Result<bool, String> {
+    use mirador::lab::{check, report};
+    let checked = check::check(&options);
+    if let (Err(why), Some((path, format))) = (&checked, &options.results) {
+        let json = report::failure_json(*format, why);
+        if let Err(e) = output::write_atomically(json.as_bytes(), path) {
+            eprintln!("error: {}: {e}", path.display());
+        }
+    }
+    checked.map(|report| {
+        let dir = &options.dir;
+        print!("{}", report::text(&report));
+        println!("(written: {} and {})", dir.join("results.json").display(), dir.join("report.md").display());
+        report.passed()
+    })
 }
 
 fn diff(reference: &Path, test: &Path, mask: Option<&Path>, json: Option<&Path>) -> anyhow::Result<()> {

@@ -77,9 +77,8 @@ fn every_lab_grades_on_gradescopes_contract_within_its_limits() {
         let output = command.output().expect("taskset and bash run the autograder");
         let seconds = start.elapsed().as_secs_f64();
         let results = autograder.join("results/results.json");
-        let text = std::fs::read_to_string(&results).unwrap_or_else(|e| {
-            panic!("{name}: no results.json ({e}): {}", String::from_utf8_lossy(&output.stderr))
-        });
+        let text = std::fs::read_to_string(&results)
+            .unwrap_or_else(|e| panic!("{name}: no results.json ({e}): {}", String::from_utf8_lossy(&output.stderr)));
         let json: serde_json::Value = serde_json::from_str(&text).unwrap();
         assert_eq!(json["score"], json["max_score"], "{name}: the answer key scores full marks:\n{text}");
         assert!(json["max_score"].as_f64().unwrap() > 0.0);

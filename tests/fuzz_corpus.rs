@@ -102,7 +102,6 @@ fn lab_source_corpus() {
     replay("lab_source", harness::lab_source);
 }
 
-
 #[test]
 fn the_harness_splits_side_files_and_catches_what_it_should() {
     assert_eq!(harness::split_side(b"a\n%%side%%\nb\n%%side%%\nc"), (&b"a"[..], &b"b\n%%side%%\nc"[..]));

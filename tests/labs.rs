@@ -226,7 +226,11 @@ fn a_loop_that_never_ends_is_found_and_named_not_timed_out() {
                 &format!("    var x = du;\n    loop {{\n{body}        if x > 5.0 {{ break; }}\n    }}\n    let su = tu - dot(tu, n) * n + vec3f(x * 1e-30);"),
             )
         },
-        &["your loops ran past 16384 iterations", "On a GPU a loop that does not end hangs it", "its images are not graded"],
+        &[
+            "your loops ran past 16384 iterations",
+            "On a GPU a loop that does not end hangs it",
+            "its images are not graded",
+        ],
         &["--time-limit", "60"],
     );
     assert!(!out.contains("did not finish within"), "the guard, not the clock, stops it: {out}");
@@ -242,8 +246,9 @@ fn a_loop_that_never_ends_is_found_and_named_not_timed_out() {
 fn a_helper_named_like_one_of_miradors_functions_scores_full_marks() {
     let dir = folder("bump", "helper", true);
     let path = dir.join("bump.wgsl");
-    let text = std::fs::read_to_string(&path).unwrap().replace("let su = tu - dot(tu, n) * n;", "let su = project(tu, n);")
-        + "\n// In n's plane.\nfn project(a: vec3f, n: vec3f) -> vec3f {\n    return a - dot(a, n) * n;\n}\n";
+    let text =
+        std::fs::read_to_string(&path).unwrap().replace("let su = tu - dot(tu, n) * n;", "let su = project(tu, n);")
+            + "\n// In n's plane.\nfn project(a: vec3f, n: vec3f) -> vec3f {\n    return a - dot(a, n) * n;\n}\n";
     std::fs::write(&path, text).unwrap();
     let (output, results) = check(&dir, &[]);
     let stdout = String::from_utf8_lossy(&output.stdout);
@@ -310,7 +315,13 @@ fn nan_pixels_in_an_image_are_named() {
     assert!(!images.is_empty());
     for test in images {
         assert_eq!(test["score"], 0.0, "{stdout}");
-        assert!(test["output"].as_str().unwrap().contains("pixels are NaN or infinite before the output transform (0 of Mirador's)"), "{stdout}");
+        assert!(
+            test["output"]
+                .as_str()
+                .unwrap()
+                .contains("pixels are NaN or infinite before the output transform (0 of Mirador's)"),
+            "{stdout}"
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -324,7 +335,10 @@ fn the_stub_is_told_it_is_the_stub_and_no_mistake_is_named_that_was_not_made() {
     let stdout = String::from_utf8_lossy(&output.stdout);
     for test in tests_of(&results) {
         assert!(test.get("mistake").is_none(), "{stdout}");
-        assert!(test["output"].as_str().unwrap().contains("`transparent_blend` is still the stub's neutral body"), "{stdout}");
+        assert!(
+            test["output"].as_str().unwrap().contains("`transparent_blend` is still the stub's neutral body"),
+            "{stdout}"
+        );
     }
     let _ = std::fs::remove_dir_all(&dir);
 
@@ -374,7 +388,8 @@ fn a_blend_right_only_at_half_transmission_loses_half_the_points() {
 fn a_teachers_lab_points_and_hidden_tests_are_the_teachers() {
     let dir = folder("transparency", "teacher", true);
     let path = dir.join("transparency.wgsl");
-    let text = std::fs::read_to_string(&path).unwrap().replace("return im + transmittance * behind;", "return im + behind;");
+    let text =
+        std::fs::read_to_string(&path).unwrap().replace("return im + transmittance * behind;", "return im + behind;");
     std::fs::write(&path, text).unwrap();
     // The student sets the failing tests' points to 0 in their own lab.toml.
     let mut own = String::from("lab = \"transparency\"\n[points]\n");
@@ -410,7 +425,15 @@ fn a_teachers_lab_points_and_hidden_tests_are_the_teachers() {
     // Points for a test that does not exist are the teacher's error, said before any grading.
     let points = dir.join("points.toml");
     std::fs::write(&points, "\"the three panes agianst Mirador's\" = 4\n").unwrap();
-    let output = mirador(&["lab", "check", &dir.display().to_string(), "--lab", "transparency", "--points", &points.display().to_string()]);
+    let output = mirador(&[
+        "lab",
+        "check",
+        &dir.display().to_string(),
+        "--lab",
+        "transparency",
+        "--points",
+        &points.display().to_string(),
+    ]);
     assert_eq!(output.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&output.stderr).contains("no test is named `the three panes agianst Mirador's`"));
     let _ = std::fs::remove_dir_all(&dir);
@@ -444,8 +467,11 @@ fn prairielearn_results_say_what_its_grader_reads() {
         (output, json)
     };
     let key = std::fs::read_to_string(&path).unwrap();
-    std::fs::write(&path, key.replace("return im + transmittance * behind;", "return im + (1.0 - transmittance) * behind;"))
-        .unwrap();
+    std::fs::write(
+        &path,
+        key.replace("return im + transmittance * behind;", "return im + (1.0 - transmittance) * behind;"),
+    )
+    .unwrap();
     let (_, json) = run(&dir);
     assert_eq!(json["gradable"], true);
     let score = json["score"].as_f64().unwrap();
@@ -454,7 +480,8 @@ fn prairielearn_results_say_what_its_grader_reads() {
     assert!(!images.is_empty() && images[0]["url"].as_str().unwrap().starts_with("data:image/png;base64,"));
     assert!(serde_json::to_string(&json).unwrap().len() < 1_000_000);
 
-    std::fs::write(&path, key.replace("return im + transmittance * behind;", "return im + transmittance * behind")).unwrap();
+    std::fs::write(&path, key.replace("return im + transmittance * behind;", "return im + transmittance * behind"))
+        .unwrap();
     let (_, json) = run(&dir);
     assert_eq!((json["gradable"].as_bool(), json["score"].as_f64()), (Some(false), Some(0.0)), "{json}");
     assert!(json["message"].as_str().unwrap().contains("transparency.wgsl:"), "{json}");
@@ -719,7 +746,11 @@ fn every_mutant_of_every_answer_key_fails_its_checks() {
             };
             lines.push_str(&format!("| `{}` | {} |\n", line.replace('|', "\\|"), verdict.replace('|', "\\|")));
         }
-        report.push_str(&format!("## {} ({} mutants)\n\n| mutated line | verdict |\n|---|---|\n{lines}\n", lab.name, mutants.len()));
+        report.push_str(&format!(
+            "## {} ({} mutants)\n\n| mutated line | verdict |\n|---|---|\n{lines}\n",
+            lab.name,
+            mutants.len()
+        ));
         report.push_str("| test | mutants it kills |\n|---|---|\n");
         for test in lab.known_answers.iter().map(|t| &t.name).chain(lab.images.iter().map(|t| &t.name)) {
             report.push_str(&format!("| {} | {} |\n", test.replace('|', "\\|"), kills.get(test).copied().unwrap_or(0)));
@@ -730,7 +761,12 @@ fn every_mutant_of_every_answer_key_fails_its_checks() {
     let path = std::env::var_os("MIRADOR_MUTATION_REPORT")
         .map_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("target/mutation-report.md"), PathBuf::from);
     std::fs::write(&path, &report).expect("writing the mutation report");
-    eprintln!("{count} mutants, {} survived, {} equivalent; the report: {}", survivors.len(), equivalents_seen.len(), path.display());
+    eprintln!(
+        "{count} mutants, {} survived, {} equivalent; the report: {}",
+        survivors.len(),
+        equivalents_seen.len(),
+        path.display()
+    );
     assert!(survivors.is_empty(), "mutants that pass every test:\n{}", survivors.join("\n"));
     // And the list of equivalent ones is not stale: each is still made, and still passes.
     let stale: Vec<String> = EQUIVALENT_MUTANTS
@@ -935,8 +971,7 @@ fn the_summary_page_opens_in_a_browser() {
     let tests = lab.known_answers.len() + lab.images.len();
     let rows = dom[dom.find("id=\"tests\"").unwrap()..].split("</table>").next().unwrap().matches("<tr>").count();
     assert_eq!(rows, tests + 1, "a header and a row per test: {dom}");
-    let shot = std::env::var_os("MIRADOR_SUMMARY_SCREENSHOT")
-        .map_or_else(|| class.join("summary.png"), PathBuf::from);
+    let shot = std::env::var_os("MIRADOR_SUMMARY_SCREENSHOT").map_or_else(|| class.join("summary.png"), PathBuf::from);
     let output = chromium(&["--window-size=1000,1400", &format!("--screenshot={}", shot.display())]);
     assert!(shot.is_file(), "{}", String::from_utf8_lossy(&output.stderr));
     let _ = std::fs::remove_dir_all(&class);

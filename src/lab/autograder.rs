@@ -73,7 +73,7 @@ pub fn write(lab: &Lab, options: &Options) -> Result<Vec<PathBuf>, String> {
     file(lab_dir.join("points.toml"), points_file(lab, &tests, &points).as_bytes(), false)?;
     std::fs::create_dir_all(lab_dir.join("hidden")).map_err(|e| format!("{}: {e}", lab_dir.display()))?;
     if let Some(hidden) = &options.hidden {
-        for path in toml_files(hidden)? {
+        for path in super::run::hidden_files(hidden)? {
             let text = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
             let name = path.file_name().expect("a listed file has a name");
             file(lab_dir.join("hidden").join(name), &text, false)?;
@@ -129,16 +129,6 @@ fn points_file(lab: &Lab, tests: &[Test], points: &BTreeMap<String, f32>) -> Str
     text
 }
 
-fn toml_files(folder: &Path) -> Result<Vec<PathBuf>, String> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
-        .map_err(|e| format!("{}: cannot read the hidden tests' folder: {e}", folder.display()))?
-        .filter_map(|entry| entry.ok().map(|e| e.path()))
-        .filter(|path| path.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
-    Ok(files)
-}
-
 fn copy_binary(from: &Path, to: &Path) -> Result<(), String> {
     let bytes = std::fs::read(from).map_err(|e| format!("{}: cannot read the Mirador binary: {e}", from.display()))?;
     write_atomically(&bytes, to).map_err(|e| format!("{}: {e}", to.display()))?;
@@ -148,7 +138,8 @@ fn copy_binary(from: &Path, to: &Path) -> Result<(), String> {
 #[cfg(unix)]
 fn executable_bit(path: &Path) -> Result<(), String> {
     use std::os::unix::fs::PermissionsExt;
-    std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o755)).map_err(|e| format!("{}: {e}", path.display()))
+    std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o755))
+        .map_err(|e| format!("{}: {e}", path.display()))
 }
 
 #[cfg(not(unix))]
@@ -188,31 +179,65 @@ mirador --version
     .to_owned()
 }
 
-fn gradescope_run(lab: &Lab, check: &CheckLine) -> String {
-    format!(
-        "#!/usr/bin/env bash
-# Gradescope runs this for each submission. Written by `mirador lab autograder` for lab `{name}`.
-# The lab, its points and its hidden tests come from this folder (source/lab/), never from the
-# student's files; the student's {file} is found anywhere in the submission.
-# AUTOGRADER_ROOT and MIRADOR stand in for /autograder and the installed binary in a test.
+/// What a service runs for each submission: the submission copied from `ROOT/SUBMISSION` (so the
+/// check's reports never write into it), the check, and a result written whatever happens.
+/// `head` is the script's first comment; `root` names the variable a test sets in place of the
+/// service's folder, and `fallback` is the result of a check that crashed (a `printf` format
+/// whose `%s` is the exit status).
+struct Runner<'a> {
+    head: String,
+    root: (&'a str, &'a str),
+    submission: &'a str,
+    lab_folder: &'a str,
+    format: &'a str,
+    fallback: &'a str,
+}
+
+impl Runner<'_> {
+    fn script(&self, check: &CheckLine) -> String {
+        let (variable, default) = self.root;
+        let results = "$root/results/results.json";
+        format!(
+            "#!/usr/bin/env bash
+{head}
 set -uo pipefail
-root=\"${{AUTOGRADER_ROOT:-/autograder}}\"
+root=\"${{{variable}:-{default}}}\"
 MIRADOR=\"${{MIRADOR:-mirador}}\"
 work=\"$(mktemp -d)\"
-cp -R \"$root/submission/.\" \"$work/\"
+cp -R \"$root/{submission}/.\" \"$work/\"
 mkdir -p \"$root/results\"
 {command}
 status=$?
 # 0: every test passed, 1: some failed, 2: not checked (why is in the results); each wrote the
 # results. Only a crash leaves none.
-if [ ! -s \"$root/results/results.json\" ]; then
-    printf '{{\"score\": 0, \"output\": \"The autograder could not grade this submission (mirador exited with %s). Your instructor has been told.\", \"tests\": []}}\\n' \"$status\" > \"$root/results/results.json\"
+if [ ! -s \"{results}\" ]; then
+    printf '{fallback}\\n' \"$status\" > \"{results}\"
 fi
 ",
-        name = lab.name,
-        file = lab.file,
-        command = check.command("$work", "$root/source/lab", "gradescope", "$root/results/results.json"),
-    )
+            head = self.head.trim_end(),
+            submission = self.submission,
+            command = check.command("$work", &format!("$root/{}", self.lab_folder), self.format, results),
+            fallback = self.fallback,
+        )
+    }
+}
+
+fn gradescope_run(lab: &Lab, check: &CheckLine) -> String {
+    Runner {
+        head: format!(
+            "# Gradescope runs this for each submission. Written by `mirador lab autograder` for lab `{}`.
+# The lab, its points and its hidden tests come from this folder (source/lab/), never from the
+# student's files; the student's {} is found anywhere in the submission.
+# AUTOGRADER_ROOT and MIRADOR stand in for /autograder and the installed binary in a test.",
+            lab.name, lab.file
+        ),
+        root: ("AUTOGRADER_ROOT", "/autograder"),
+        submission: "submission",
+        lab_folder: "source/lab",
+        format: "gradescope",
+        fallback: "{\"score\": 0, \"output\": \"The autograder could not grade this submission (mirador exited with %s). Your instructor has been told.\", \"tests\": []}",
+    }
+    .script(check)
 }
 
 fn gradescope_readme(lab: &Lab) -> String {
@@ -235,10 +260,10 @@ cd DIR && zip -r ../{name}-autograder.zip .
   `after_published`: their names and outputs show once you publish the grades). A hidden test
   that the answer key itself fails is reported to you and counts for nobody.
 
-The `mirador` binary here is the one that wrote the folder. It must start on Ubuntu 22.04: one
-built on a newer system may need a newer C library, and `setup.sh` then fails when Gradescope
-builds the image. Build one on Ubuntu 22.04 (for example in `docker run ubuntu:22.04`) and pass
-it with `--binary`.
+The `mirador` binary here is the one that wrote the folder. It must start on Ubuntu 22.04,
+whose C library is glibc 2.35 (`objdump -T mirador | grep GLIBC_` lists what it asks for);
+`setup.sh` fails when Gradescope builds the image if it does not. Then build one on Ubuntu 22.04
+(for example in `docker run ubuntu:22.04`) and pass it with `--binary`.
 
 Gradescope's default limits (one CPU, 768 MB of memory, 10 minutes) hold every lab with a wide
 margin: docs/performance.md, \"Grading a class\", has the figures.
@@ -249,28 +274,21 @@ margin: docs/performance.md, \"Grading a class\", has the figures.
 }
 
 fn prairielearn_run(lab: &Lab, check: &CheckLine) -> String {
-    format!(
-        "#!/usr/bin/env bash
-# PrairieLearn's external grader runs this in the image the Dockerfile builds. Written by
-# `mirador lab autograder` for lab `{name}`: the student's {file} from /grade/student, the lab's
+    Runner {
+        head: format!(
+            "# PrairieLearn's external grader runs this in the image the Dockerfile builds. Written by
+# `mirador lab autograder` for lab `{}`: the student's {} from /grade/student, the lab's
 # points and hidden tests from /grade/tests/lab (the question's tests/ folder), the results in
-# /grade/results/results.json. GRADE_ROOT and MIRADOR stand in for /grade and the binary in a test.
-set -uo pipefail
-root=\"${{GRADE_ROOT:-/grade}}\"
-MIRADOR=\"${{MIRADOR:-mirador}}\"
-work=\"$(mktemp -d)\"
-cp -R \"$root/student/.\" \"$work/\"
-mkdir -p \"$root/results\"
-{command}
-status=$?
-if [ ! -s \"$root/results/results.json\" ]; then
-    printf '{{\"gradable\": false, \"score\": 0, \"message\": \"The autograder could not grade this submission (mirador exited with %s).\"}}\\n' \"$status\" > \"$root/results/results.json\"
-fi
-",
-        name = lab.name,
-        file = lab.file,
-        command = check.command("$work", "$root/tests/lab", "prairielearn", "$root/results/results.json"),
-    )
+# /grade/results/results.json. GRADE_ROOT and MIRADOR stand in for /grade and the binary in a test.",
+            lab.name, lab.file
+        ),
+        root: ("GRADE_ROOT", "/grade"),
+        submission: "student",
+        lab_folder: "tests/lab",
+        format: "prairielearn",
+        fallback: "{\"gradable\": false, \"score\": 0, \"message\": \"The autograder could not grade this submission (mirador exited with %s).\"}",
+    }
+    .script(check)
 }
 
 fn prairielearn_dockerfile() -> String {
@@ -368,7 +386,10 @@ jobs:
         );
         ids.push(id);
     }
-    let _ = write!(out, "      - name: Autograding Reporter\n        uses: classroom-resources/autograding-grading-reporter@v1\n        env:\n");
+    let _ = write!(
+        out,
+        "      - name: Autograding Reporter\n        uses: classroom-resources/autograding-grading-reporter@v1\n        env:\n"
+    );
     for id in &ids {
         let _ = writeln!(out, "          {}_RESULTS: \"${{{{steps.{id}.outputs.result}}}}\"", id.to_uppercase());
     }

@@ -81,7 +81,9 @@ impl Test {
             name: self.name().to_owned(),
             score: 0.0,
             max_score: 0.0,
-            output: format!("Not graded: the lab's answer key fails this hidden test, so the test is in error, not the student. The key's result: {why}"),
+            output: format!(
+                "Not graded: the lab's answer key fails this hidden test, so the test is in error, not the student. The key's result: {why}"
+            ),
             mistake: None,
             status: "failed",
             visibility: "hidden",
@@ -191,7 +193,9 @@ impl Checker {
             return Finding { index, passed: false, output, mistake: None, images: None };
         }
         if let Some(name) = not_finite(value) {
-            output.push_str(&format!("\nThe result has {name}: a division by zero, or the root or logarithm of a negative number?"));
+            output.push_str(&format!(
+                "\nThe result has {name}: a division by zero, or the root or logarithm of a negative number?"
+            ));
         }
         if passed {
             return Finding { index, passed, output, mistake: None, images: None };
@@ -304,7 +308,10 @@ impl Checker {
             let (_, judged) = self.judged(test, &scene, &theirs, &yours);
             if judged.passed {
                 outcome = images::Outcome {
-                    output: format!("{}\n(as the lab's other right answer, {}: {})", judged.output, alternative.name, alternative.sentence),
+                    output: format!(
+                        "{}\n(as the lab's other right answer, {}: {})",
+                        judged.output, alternative.name, alternative.sentence
+                    ),
                     ..judged
                 };
             }
@@ -345,7 +352,13 @@ impl Checker {
     /// `yours` judged against `mirador` (a right answer's image) or, for a test against the
     /// tracer, against the traced image with `mirador`'s own error as the baseline: the image
     /// shown as correct, and the outcome.
-    fn judged(&self, test: &ImageTest, scene: &crate::scene::Scene, mirador: &RgbaImage, yours: &RgbaImage) -> (RgbaImage, Outcome) {
+    fn judged(
+        &self,
+        test: &ImageTest,
+        scene: &crate::scene::Scene,
+        mirador: &RgbaImage,
+        yours: &RgbaImage,
+    ) -> (RgbaImage, Outcome) {
         match test.against {
             Against::Reference => (mirador.clone(), images::judge(test, mirador, yours, None)),
             Against::Tracer => {

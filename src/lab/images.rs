@@ -65,7 +65,8 @@ pub async fn drawn_counted(gpu: &Gpu, scene: &Scene, wgsl: &Wgsl) -> Result<(Rgb
         .chunks_exact(8)
         .filter(|texel| texel.chunks_exact(2).any(|half| u16::from_le_bytes([half[0], half[1]]) & 0x7C00 == 0x7C00))
         .count();
-    let image = RgbaImage::from_raw(width, height, pixels).ok_or_else(|| "the readback has the wrong size".to_owned())?;
+    let image =
+        RgbaImage::from_raw(width, height, pixels).ok_or_else(|| "the readback has the wrong size".to_owned())?;
     Ok((image, not_finite))
 }
 

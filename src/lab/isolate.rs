@@ -439,7 +439,11 @@ mod tests {
     fn attributes_numbers_and_members_are_left_alone() {
         let text = "fn position() -> f32 { return 1e-5 + 2.5e3f; }\nfn slot(@builtin(position) p: vec4f) -> f32 { return position() + p.position; }\n";
         let isolated = Isolated::new(text, &["slot".to_owned()], &[]);
-        assert!(isolated.text.contains("fn slot(@builtin(position) p: vec4f) -> f32 { return student_position() + p.position; }"));
+        assert!(
+            isolated
+                .text
+                .contains("fn slot(@builtin(position) p: vec4f) -> f32 { return student_position() + p.position; }")
+        );
         assert!(isolated.text.contains("return 1e-5 + 2.5e3f;"));
     }
 }

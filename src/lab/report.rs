@@ -135,6 +135,7 @@ pub enum Format {
 
 /// The pictures a PrairieLearn result may carry, in bytes of data URL: its grader takes up to
 /// 1 MB of results in all.
+#[cfg(not(target_arch = "wasm32"))]
 const PICTURES_BUDGET: usize = 700_000;
 
 /// `results.json` for PrairieLearn's external grader: `gradable` (false when the file does not

@@ -27,19 +27,24 @@ pub fn tests(lab: &Lab, hidden: Option<&Path>) -> Result<Vec<Test>, String> {
     let Some(folder) = hidden else {
         return Ok(tests);
     };
-    let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
-        .map_err(|e| format!("{}: cannot read the hidden tests' folder: {e}", folder.display()))?
-        .filter_map(|entry| entry.ok().map(|e| e.path()))
-        .filter(|path| path.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    files.sort();
-    for path in files {
+    for path in hidden_files(folder)? {
         let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
         let file: TestFile = toml::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
         tests.extend(file.known.into_iter().map(|t| Test::Known(t, Some(folder.to_path_buf()))));
         tests.extend(file.image.into_iter().map(|t| Test::Image(t, Some(folder.to_path_buf()))));
     }
     Ok(tests)
+}
+
+/// The `*.toml` files of a teacher's folder of hidden tests, in name order.
+pub fn hidden_files(folder: &Path) -> Result<Vec<PathBuf>, String> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(folder)
+        .map_err(|e| format!("{}: cannot read the hidden tests' folder: {e}", folder.display()))?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    Ok(files)
 }
 
 /// Runs `tests[from..]` with the student's file `text`, writing each finding as a line to
