@@ -463,7 +463,8 @@ fn lab(command: LabCommand) -> ExitCode {
                     .get(index)
                     .ok_or_else(|| format!("{}: there is no test {index}", results.display()))?;
                 println!("{}: {}", test["name"].as_str().unwrap_or("?"), test["output"].as_str().unwrap_or(""));
-                Ok(test["status"] == "passed")
+                // A test worth nothing (a teacher's test in error) costs nobody a point.
+                Ok(test["status"] == "passed" || test["max_score"].as_f64() == Some(0.0))
             })
         }
         LabCommand::Run { dir, from, tests, lab: name, file, key } => {

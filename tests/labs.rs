@@ -168,6 +168,13 @@ fn a_syntax_error_is_given_at_the_students_line() {
         &[],
     );
     assert!(out.contains("return k * vec2f(("), "the line is shown:\n{out}");
+    // A helper's brace left open runs into what the checker appends: said at the end of the
+    // student's file, not in Mirador's.
+    let open = "\nfn helper() -> f32 {\n    return 1.0;\n";
+    let lines = format!("{key}{open}").lines().count();
+    let out =
+        broken("unclosed", |t| format!("{t}{open}"), &[&format!("bump.wgsl:{lines}:1: at the end of your file")], &[]);
+    assert!(!out.contains("in Mirador's"), "{out}");
 }
 
 #[test]

@@ -71,12 +71,19 @@ pub fn write(lab: &Lab, options: &Options) -> Result<Vec<PathBuf>, String> {
         Service::Gradescope | Service::Prairielearn => dir.join("lab"),
     };
     file(lab_dir.join("points.toml"), points_file(lab, &tests, &points).as_bytes(), false)?;
-    std::fs::create_dir_all(lab_dir.join("hidden")).map_err(|e| format!("{}: {e}", lab_dir.display()))?;
+    // A folder git keeps even when it holds no test (a repository drops empty folders, and the
+    // scripts name it).
+    file(lab_dir.join("hidden/README.md"), HIDDEN_README.as_bytes(), false)?;
     if let Some(hidden) = &options.hidden {
         for path in super::run::hidden_files(hidden)? {
             let text = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
             let name = path.file_name().expect("a listed file has a name");
             file(lab_dir.join("hidden").join(name), &text, false)?;
+        }
+    }
+    if options.service == Service::Classroom {
+        if let Some((name, value)) = points.iter().find(|(_, v)| v.fract() != 0.0) {
+            return Err(format!("`{name}` = {value}: GitHub Classroom's grader takes whole points"));
         }
     }
     let check = CheckLine { lab: &lab.name, time_limit: options.time_limit };
@@ -103,6 +110,10 @@ pub fn write(lab: &Lab, options: &Options) -> Result<Vec<PathBuf>, String> {
     }
     Ok(written)
 }
+
+const HIDDEN_README: &str = "# Hidden tests\n\nThe teacher's hidden tests: `*.toml` files in the lab's own format \
+(docs/course/labs.md, \"Points and hidden tests\"), run after the lab's own. This file keeps the \
+folder in a repository when it holds none.\n";
 
 /// Every test's points: the teacher's file, checked against the tests, over the lab's own.
 fn points(lab: &Lab, tests: &[Test], file: Option<&Path>) -> Result<BTreeMap<String, f32>, String> {
@@ -235,7 +246,7 @@ fn gradescope_run(lab: &Lab, check: &CheckLine) -> String {
         submission: "submission",
         lab_folder: "source/lab",
         format: "gradescope",
-        fallback: "{\"score\": 0, \"output\": \"The autograder could not grade this submission (mirador exited with %s). Your instructor has been told.\", \"tests\": []}",
+        fallback: "{\"score\": 0, \"output\": \"The autograder could not grade this submission (mirador exited with %s). Please tell your instructor.\", \"tests\": []}",
     }
     .script(check)
 }
@@ -368,6 +379,7 @@ jobs:
     );
     let mut ids = Vec::new();
     for (index, test) in tests.iter().enumerate() {
+        // GitHub Classroom's grader counts whole points (checked in `write`).
         let id = format!("test-{}", index + 1);
         let value = points.get(test.name()).copied().unwrap_or(test.points());
         let _ = write!(
@@ -382,7 +394,7 @@ jobs:
           max-score: {max}
 ",
             quoted = yaml_string(test.name()),
-            max = value.round() as u32,
+            max = value as u32,
         );
         ids.push(id);
     }

@@ -104,12 +104,16 @@ pub struct Finding {
     pub mistake: Option<(String, String)>,
     /// Correct, yours, difference: the image test's PNGs, relative to the lab's folder.
     pub images: Option<[String; 3]>,
+    /// The test did not run to its end (not started, stopped at the time limit, the checker
+    /// died): no verdict on the functions.
+    #[serde(default)]
+    pub unfinished: bool,
 }
 
 impl Finding {
     /// A test that did not run, and why.
     pub fn unfinished(index: usize, why: &str) -> Finding {
-        Finding { index, passed: false, output: why.to_owned(), mistake: None, images: None }
+        Finding { index, passed: false, output: why.to_owned(), mistake: None, images: None, unfinished: true }
     }
 }
 
@@ -132,8 +136,9 @@ pub struct Checker {
     /// The lab's own known-answer tests, which a known mistake must match on every one before a
     /// failing test names it.
     known: Vec<KnownAnswer>,
-    /// The slots the student left as the stub wrote them.
+    /// The slots the student left as the stub wrote them, and how many slots there are.
     untouched: Vec<String>,
+    slots: usize,
     /// The student's values on [`Self::known`], and each mistake's agreement with them, found
     /// when first needed.
     agreement: std::cell::RefCell<BTreeMap<usize, bool>>,
@@ -158,6 +163,7 @@ impl Checker {
             alternatives,
             known: lab.known_answers.clone(),
             untouched: source::untouched_slots(lab, text),
+            slots: lab.slots.len(),
             agreement: Default::default(),
             student_values: Default::default(),
             tripped: Default::default(),
@@ -177,7 +183,9 @@ impl Checker {
     async fn known_answer(&self, test: &KnownAnswer, index: usize) -> Finding {
         let call = match self.harness.call(&self.gpu, &self.student, &test.call).await {
             Ok(call) => call,
-            Err(error) => return Finding { index, passed: false, output: error, mistake: None, images: None },
+            Err(error) => {
+                return Finding { index, passed: false, output: error, mistake: None, images: None, unfinished: false };
+            }
         };
         let value = call.value;
         let (passed, wanted) = judge_value(test, value);
@@ -190,7 +198,7 @@ impl Checker {
                 test.call,
                 super::isolate::ITERATIONS
             );
-            return Finding { index, passed: false, output, mistake: None, images: None };
+            return Finding { index, passed: false, output, mistake: None, images: None, unfinished: false };
         }
         if let Some(name) = not_finite(value) {
             output.push_str(&format!(
@@ -198,11 +206,13 @@ impl Checker {
             ));
         }
         if passed {
-            return Finding { index, passed, output, mistake: None, images: None };
+            return Finding { index, passed, output, mistake: None, images: None, unfinished: false };
         }
-        if let Some(said) = self.stub_said() {
+        if let Some((said, whole)) = self.stub_said() {
             output.push_str(&said);
-            return Finding { index, passed, output, mistake: None, images: None };
+            if whole {
+                return Finding { index, passed, output, mistake: None, images: None, unfinished: false };
+            }
         }
         // The mistakes whose own value is this one (and is wrong) …
         let tolerance = test.tolerance.max(1e-5);
@@ -215,16 +225,22 @@ impl Checker {
         }
         // … and that give the student's value on every known-answer test.
         let mistake = self.named(candidates).await;
-        Finding { index, passed, output, mistake, images: None }
+        Finding { index, passed, output, mistake, images: None, unfinished: false }
     }
 
-    /// What to tell a student whose every slot is still the stub's, when a test fails.
-    fn stub_said(&self) -> Option<String> {
+    /// What to tell a student about the slots still the stub's, when a test fails, and whether
+    /// that is the whole file (then no known mistake is named: the stub made none).
+    fn stub_said(&self) -> Option<(String, bool)> {
         (!self.untouched.is_empty()).then(|| {
-            format!(
-                "\n`{}` is still the stub's neutral body: write it (TASK.md says what it computes).",
-                self.untouched.join("`, `")
-            )
+            let whole = self.untouched.len() == self.slots;
+            let said = format!(
+                "\n`{}` {} still the stub's neutral body: write {} (TASK.md says what {} computes).",
+                self.untouched.join("`, `"),
+                if self.untouched.len() == 1 { "is" } else { "are" },
+                if self.untouched.len() == 1 { "it" } else { "them" },
+                if self.untouched.len() == 1 { "it" } else { "each" },
+            );
+            (said, whole)
         })
     }
 
@@ -276,7 +292,7 @@ impl Checker {
 
     async fn image_test(&self, test: &ImageTest, folder: Option<&Path>, index: usize) -> Checked {
         let fail = |output: String| Checked {
-            finding: Finding { index, passed: false, output, mistake: None, images: None },
+            finding: Finding { index, passed: false, output, mistake: None, images: None, unfinished: false },
             pictures: None,
         };
         if self.tripped.get() {
@@ -327,9 +343,11 @@ impl Checker {
         }
         let mut mistake = None;
         if !passed {
-            if let Some(said) = self.stub_said() {
-                output.push_str(&said);
-            } else {
+            let said = self.stub_said();
+            if let Some((said, _)) = &said {
+                output.push_str(said);
+            }
+            if !said.is_some_and(|(_, whole)| whole) {
                 let mut candidates = Vec::new();
                 for (at, (_, wgsl)) in self.mistakes.iter().enumerate() {
                     let Ok(theirs) = images::drawn(gpu, &scene, wgsl).await else { continue };
@@ -342,7 +360,7 @@ impl Checker {
             }
         }
         Checked {
-            finding: Finding { index, passed, output, mistake, images: None },
+            finding: Finding { index, passed, output, mistake, images: None, unfinished: false },
             pictures: Some([correct, yours, error_map]),
         }
     }

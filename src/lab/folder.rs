@@ -70,7 +70,7 @@ fn toml_key(name: &str) -> String {
 fn task(lab: &Lab) -> String {
     let chapter = crate::lab::chapter_file(lab.chapter).unwrap_or_default();
     format!(
-        "# Lab `{}`: {}\n\nChapter {} of the course{}.\n{}\n## Files\n\n- `{}`: yours. Keep each function's signature; add helpers if you like (give them names of your own).\n- `scenes/`: the scenes the image tests draw, to render and look at: `mirador render scenes/NAME.toml -o look.png`.\n- `lab.toml`: which lab this is, and the points of its tests.\n\n`mirador lab check .` validates your file, runs the tests, and writes `results.json` and `report.md`.\n",
+        "# Lab `{}`: {}\n\nChapter {} of the course{}.\n{}\n## Files\n\n- `{}`: yours. Keep each function's signature; add helpers if you like, named as you like (the checker keeps your names apart from Mirador's).\n- `scenes/`: the scenes the image tests draw, to render and look at: `mirador render scenes/NAME.toml -o look.png`.\n- `lab.toml`: which lab this is, and the points of its tests.\n\n`mirador lab check .` validates your file, runs the tests, and writes `results.json` and `report.md`.\n",
         lab.name,
         lab.title,
         lab.chapter,

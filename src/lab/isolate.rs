@@ -73,17 +73,20 @@ impl Isolated {
             (token.kind == Kind::Identifier && token.renameable && declared.iter().any(|d| d == name))
                 .then(|| format!("{prefix}{name}"))
         };
-        // The text of `range` with the student's names renamed in it.
+        // The code of `range` (an argument), its tokens with the student's names renamed, one
+        // space apart: comments and line ends left out, so nothing can swallow what follows.
         let rewritten = |range: std::ops::Range<usize>| {
-            let (mut out, mut from) = (String::new(), range.start);
-            for token in tokens.iter().filter(|t| t.range.start >= range.start && t.range.end <= range.end) {
-                if let Some(name) = renamed(token) {
-                    out.push_str(&text[from..token.range.start]);
-                    out.push_str(&name);
-                    from = token.range.end;
+            let mut out = String::new();
+            let mut last: Option<usize> = None;
+            for t in tokens.iter().filter(|t| t.range.start >= range.start && t.range.end <= range.end) {
+                // Spaces between two tokens kept; a comment or a line end between them, one space.
+                if let Some(end) = last.filter(|&end| end < t.range.start) {
+                    let gap = &text[end..t.range.start];
+                    out.push_str(if gap.bytes().all(|b| b == b' ') { gap } else { " " });
                 }
+                out.push_str(&renamed(t).unwrap_or_else(|| text[t.range.clone()].to_owned()));
+                last = Some(t.range.end);
             }
-            out.push_str(&text[from..range.end]);
             out
         };
         let mut changes: Vec<(usize, usize, String)> = Vec::new();
@@ -97,9 +100,9 @@ impl Isolated {
             }
             if name == "textureDimensions" {
                 if let Some((end, [texture, level])) = two_arguments(&tokens, index) {
-                    let size = format!("textureDimensions({})", rewritten(texture).trim());
+                    let size = format!("textureDimensions({})", rewritten(texture));
                     let level = rewritten(level);
-                    let with = format!("max({size} >> ({size} * 0u + u32({})), {size} * 0u + 1u)", level.trim());
+                    let with = format!("max({size} >> ({size} * 0u + u32({level})), {size} * 0u + 1u)");
                     changes.push((token.range.start, end - token.range.start, with));
                 }
             }
@@ -111,7 +114,8 @@ impl Isolated {
         }
         // In order; a change inside an earlier one (a name in a rewritten call's arguments, a
         // call inside another's) is already part of it.
-        changes.sort_by_key(|change| (change.0, std::cmp::Reverse(change.1)));
+        // A guard inserted right after a loop's `{` comes before a name renamed there.
+        changes.sort_by_key(|change| (change.0, change.1 != 0, std::cmp::Reverse(change.1)));
         let mut end = 0;
         changes.retain(|(at, len, _)| {
             let keep = *at >= end;
@@ -286,12 +290,16 @@ fn tokens(text: &str) -> Vec<Token> {
 }
 
 /// Marks the identifiers that are no reference to a declaration: a struct's member names, and
-/// the arguments of attributes (`@builtin(position)`, `@interpolate(flat)`).
+/// the arguments of the attributes that take enumerants, not expressions (`@builtin(position)`,
+/// `@interpolate(flat)`, `@diagnostic(off, …)`); `@location(N)` or `@size(N)` may name the
+/// student's constant, and keep it.
 fn mark_unrenameable(text: &str, tokens: &mut [Token]) {
     let name = |t: &Token| &text[t.range.clone()];
-    let mut i = 0;
-    while i < tokens.len() {
-        if tokens[i].kind == Kind::Punct('@') && tokens.get(i + 2).is_some_and(|t| t.kind == Kind::Punct('(')) {
+    for i in 0..tokens.len() {
+        let enumerants = tokens[i].kind == Kind::Punct('@')
+            && tokens.get(i + 1).is_some_and(|t| matches!(name(t), "builtin" | "interpolate" | "diagnostic"))
+            && tokens.get(i + 2).is_some_and(|t| t.kind == Kind::Punct('('));
+        if enumerants {
             let mut parens = 0;
             for token in &mut tokens[i + 2..] {
                 match token.kind {
@@ -306,7 +314,7 @@ fn mark_unrenameable(text: &str, tokens: &mut [Token]) {
         }
         if tokens[i].kind == Kind::Identifier && name(&tokens[i]) == "struct" && !tokens[i].after_dot {
             // struct NAME { member: T, … }: a member is an identifier right before a `:` at the
-            // body's own depth.
+            // body's own depth. (The body's attributes are met by this loop in their turn.)
             let Some(open) = (i..tokens.len()).find(|&j| tokens[j].kind == Kind::Punct('{')) else { break };
             let body = tokens[open].depth + 1;
             let mut j = open + 1;
@@ -319,9 +327,7 @@ fn mark_unrenameable(text: &str, tokens: &mut [Token]) {
                 }
                 j += 1;
             }
-            i = j;
         }
-        i += 1;
     }
 }
 
@@ -362,8 +368,12 @@ fn two_arguments(tokens: &[Token], index: usize) -> Option<(usize, [std::ops::Ra
             Kind::Punct(')') | Kind::Punct(']') => {
                 depth -= 1;
                 if depth == 0 {
+                    // `(a, b)`, or `(a, b,)` with WGSL's trailing comma.
+                    let last = text_before(tokens, token).filter(|t| t.kind == Kind::Punct(','));
+                    let second_end = last.map_or(token.range.start, |t| t.range.start);
+                    let commas: Vec<usize> = commas.into_iter().filter(|&c| c != second_end).collect();
                     let [comma] = commas[..] else { return None };
-                    return Some((token.range.end, [open.range.end..comma, comma + 1..token.range.start]));
+                    return Some((token.range.end, [open.range.end..comma, comma + 1..second_end]));
                 }
             }
             Kind::Punct(',') if depth == 1 => commas.push(token.range.start),
@@ -371,6 +381,11 @@ fn two_arguments(tokens: &[Token], index: usize) -> Option<(usize, [std::ops::Ra
         }
     }
     None
+}
+
+/// The token right before `token` in `tokens`.
+fn text_before<'t>(tokens: &'t [Token], token: &Token) -> Option<&'t Token> {
+    tokens.iter().take_while(|t| t.range.start < token.range.start).last()
 }
 
 /// The offset of the `{` that opens the body of the loop whose keyword is `tokens[index]`.
@@ -433,6 +448,26 @@ mod tests {
         let isolated = Isolated::new(text, &["slot".to_owned()], &[]);
         assert!(isolated.text.contains("u32(student_lod(textureDimensions(t, 1).x))"), "{}", isolated.text);
         assert!(!isolated.text.contains("student_student_"));
+    }
+
+    #[test]
+    fn a_loop_whose_body_starts_with_a_renamed_name_is_guarded() {
+        let text = "var<private> count: u32;\nfn slot() -> u32 {\n    loop {count += 1u; if count > 3u { break; }}\n    return count;\n}\n";
+        let isolated = Isolated::new(text, &["slot".to_owned()], &[]);
+        assert_eq!(isolated.loops, 1);
+        assert!(
+            isolated.text.contains("loop { if loop_guard_step() { break; }student_count += 1u;"),
+            "{}",
+            isolated.text
+        );
+    }
+
+    #[test]
+    fn a_constant_in_an_expression_attribute_is_renamed_and_comments_leave_calls() {
+        let text = "const N = 2;\nstruct S { @size(N) a: f32, @builtin(position) p: vec4f }\nfn slot(t: texture_2d<f32>, l: i32) -> vec2u {\n    return textureDimensions(t, l // the level\n    ,);\n}\n";
+        let isolated = Isolated::new(text, &["slot".to_owned()], &[]);
+        assert!(isolated.text.contains("@size(student_N) a: f32, @builtin(position) p: vec4f"), "{}", isolated.text);
+        assert!(isolated.text.contains("u32(l))"), "{}", isolated.text);
     }
 
     #[test]

@@ -296,6 +296,17 @@ fn naga_problem(composed: &str, start: usize, text: &str, isolated: &Isolated) -
                 message,
             })
         }
+        (None, Some(offset)) if offset >= start => {
+            // Past the student's text (the guard's declarations, the lab's routes): what the
+            // student left open runs into them.
+            let line = text.lines().count().max(1) as u32;
+            Some(Problem {
+                line: Some(line),
+                column: Some(1),
+                text: text.lines().last().map(str::to_owned),
+                message: format!("at the end of your file (is a `}}` or a `;` missing?): {message}"),
+            })
+        }
         (None, Some(offset)) => {
             // In Mirador's code: say in which of its files, so a teacher can tell.
             let file = composed[..offset]

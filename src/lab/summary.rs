@@ -5,8 +5,9 @@
 //! compile, and the slowest checks.
 //!
 //! How well a test separates is its *discrimination*, as PrairieLearn's question statistics give
-//! it: the correlation, over the class, between passing the test (1 or 0) and the score on every
-//! other test (the rest score, so that a test is not correlated with itself). Near 0: the test
+//! it: the correlation, over the submissions that compiled, between passing the test (1 or 0) and
+//! the points scored on every other test (the rest score, so that a test is not correlated with
+//! itself). Near 0: the test
 //! does not tell strong from weak (everyone passes, or it is noise); negative: the strong fail it
 //! more often than the weak, which usually means the test is wrong.
 
@@ -24,8 +25,8 @@ pub struct Submission {
     pub seconds: f64,
     /// The file did not compile: no test ran.
     pub compile_error: Option<String>,
-    /// Each test's name, whether it passed, and the known mistake it named.
-    pub tests: Vec<(String, bool, Option<String>)>,
+    /// Each test's name, whether it passed, its score, and the known mistake it named.
+    pub tests: Vec<(String, bool, f64, Option<String>)>,
 }
 
 /// One test over the class.
@@ -68,7 +69,8 @@ fn collect(path: &Path, files: &mut Vec<PathBuf>) -> Result<(), String> {
     let entries = std::fs::read_dir(path).map_err(|e| format!("{}: {e}", path.display()))?;
     for entry in entries.filter_map(Result::ok) {
         let child = entry.path();
-        if child.is_dir() {
+        // Not through links: a link to a folder above would be followed for ever.
+        if entry.file_type().is_ok_and(|t| t.is_dir()) {
             collect(&child, files)?;
         } else if child.file_name().is_some_and(|n| n == "results.json") {
             files.push(child);
@@ -86,16 +88,17 @@ fn submission(file: &Path) -> Result<Submission, String> {
         .parent()
         .and_then(|p| p.file_name())
         .map_or_else(|| file.display().to_string(), |n| n.to_string_lossy().into_owned());
-    let tests: Vec<(String, bool, Option<String>)> = json["tests"]
+    let tests: Vec<(String, bool, f64, Option<String>)> = json["tests"]
         .as_array()
         .map(|tests| {
             tests
                 .iter()
-                // A teacher's test in error counts for nobody (max_score 0).
-                .filter(|t| t["max_score"].as_f64().unwrap_or(0.0) > 0.0)
+                // A teacher's test in error counts for nobody, and is not the class's.
+                .filter(|t| t["visibility"] != "hidden")
                 .map(|t| {
                     let passed = t["status"] == "passed" || t["score"].as_f64() == t["max_score"].as_f64();
-                    (t["name"].as_str().unwrap_or("?").to_owned(), passed, t["mistake"].as_str().map(str::to_owned))
+                    let name = t["name"].as_str().unwrap_or("?").to_owned();
+                    (name, passed, t["score"].as_f64().unwrap_or(0.0), t["mistake"].as_str().map(str::to_owned))
                 })
                 .collect()
         })
@@ -115,7 +118,7 @@ fn submission(file: &Path) -> Result<Submission, String> {
 pub fn summarise(submissions: Vec<Submission>) -> Summary {
     let mut names: Vec<String> = Vec::new();
     for submission in &submissions {
-        for (name, _, _) in &submission.tests {
+        for (name, _, _, _) in &submission.tests {
             if !names.contains(name) {
                 names.push(name.clone());
             }
@@ -124,21 +127,23 @@ pub fn summarise(submissions: Vec<Submission>) -> Summary {
     let tests = names
         .iter()
         .map(|name| {
-            let pairs: Vec<(f64, f64)> = submissions
-                .iter()
-                .filter_map(|s| {
-                    let passed = s.tests.iter().find(|t| &t.0 == name)?.1;
-                    let others = s.tests.iter().filter(|t| &t.0 != name && t.1).count() as f64;
-                    Some((if passed { 1.0 } else { 0.0 }, others))
-                })
-                .collect();
-            let pass_rate = pairs.iter().map(|p| p.0).sum::<f64>() / pairs.len().max(1) as f64;
-            TestFigures { name: name.clone(), pass_rate, discrimination: correlation(&pairs) }
+            // Passing the test, and the points of every other test, per submission.
+            let pairs = |s: &Submission| {
+                let passed = s.tests.iter().find(|t| &t.0 == name)?.1;
+                let others: f64 = s.tests.iter().filter(|t| &t.0 != name).map(|t| t.2).sum();
+                Some((if passed { 1.0 } else { 0.0 }, others))
+            };
+            let all: Vec<(f64, f64)> = submissions.iter().filter_map(pairs).collect();
+            let pass_rate = all.iter().map(|p| p.0).sum::<f64>() / all.len().max(1) as f64;
+            // A file that did not compile ran no test: it says nothing of how a test separates.
+            let compiled: Vec<(f64, f64)> =
+                submissions.iter().filter(|s| s.compile_error.is_none()).filter_map(pairs).collect();
+            TestFigures { name: name.clone(), pass_rate, discrimination: correlation(&compiled) }
         })
         .collect();
     let mut counts: BTreeMap<String, usize> = BTreeMap::new();
     for submission in &submissions {
-        let mut named: Vec<&String> = submission.tests.iter().filter_map(|t| t.2.as_ref()).collect();
+        let mut named: Vec<&String> = submission.tests.iter().filter_map(|t| t.3.as_ref()).collect();
         named.sort();
         named.dedup();
         for mistake in named {
@@ -343,7 +348,11 @@ mod tests {
             max_score: passed.len() as f64,
             seconds: 1.0,
             compile_error: None,
-            tests: passed.iter().enumerate().map(|(i, p)| (format!("t{i}"), *p, None)).collect(),
+            tests: passed
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (format!("t{i}"), *p, if *p { 1.0 } else { 0.0 }, None))
+                .collect(),
         }
     }
 
