@@ -69,7 +69,6 @@ impl Test {
             status: if finding.passed { "passed" } else { "failed" },
             visibility: if self.hidden() { "after_published" } else { "visible" },
             passed: finding.passed,
-            counted: true,
             images: finding.images,
         }
     }
@@ -88,7 +87,6 @@ impl Test {
             status: "failed",
             visibility: "hidden",
             passed: false,
-            counted: false,
             images: None,
         }
     }
@@ -111,6 +109,11 @@ pub struct Finding {
 }
 
 impl Finding {
+    /// A test that ran: its verdict, what it found, and the known mistake that matches.
+    fn ran(index: usize, passed: bool, output: String, mistake: Option<(String, String)>) -> Finding {
+        Finding { index, passed, output, mistake, images: None, unfinished: false }
+    }
+
     /// A test that did not run, and why.
     pub fn unfinished(index: usize, why: &str) -> Finding {
         Finding { index, passed: false, output: why.to_owned(), mistake: None, images: None, unfinished: true }
@@ -184,7 +187,7 @@ impl Checker {
         let call = match self.harness.call(&self.gpu, &self.student, &test.call).await {
             Ok(call) => call,
             Err(error) => {
-                return Finding { index, passed: false, output: error, mistake: None, images: None, unfinished: false };
+                return Finding::ran(index, false, error, None);
             }
         };
         let value = call.value;
@@ -198,7 +201,7 @@ impl Checker {
                 test.call,
                 super::isolate::ITERATIONS
             );
-            return Finding { index, passed: false, output, mistake: None, images: None, unfinished: false };
+            return Finding::ran(index, false, output, None);
         }
         if let Some(name) = not_finite(value) {
             output.push_str(&format!(
@@ -206,12 +209,12 @@ impl Checker {
             ));
         }
         if passed {
-            return Finding { index, passed, output, mistake: None, images: None, unfinished: false };
+            return Finding::ran(index, passed, output, None);
         }
         if let Some((said, whole)) = self.stub_said() {
             output.push_str(&said);
             if whole {
-                return Finding { index, passed, output, mistake: None, images: None, unfinished: false };
+                return Finding::ran(index, passed, output, None);
             }
         }
         // The mistakes whose own value is this one (and is wrong) …
@@ -225,7 +228,7 @@ impl Checker {
         }
         // … and that give the student's value on every known-answer test.
         let mistake = self.named(candidates).await;
-        Finding { index, passed, output, mistake, images: None, unfinished: false }
+        Finding::ran(index, passed, output, mistake)
     }
 
     /// What to tell a student about the slots still the stub's, when a test fails, and whether
@@ -291,10 +294,7 @@ impl Checker {
     }
 
     async fn image_test(&self, test: &ImageTest, folder: Option<&Path>, index: usize) -> Checked {
-        let fail = |output: String| Checked {
-            finding: Finding { index, passed: false, output, mistake: None, images: None, unfinished: false },
-            pictures: None,
-        };
+        let fail = |output: String| Checked { finding: Finding::ran(index, false, output, None), pictures: None };
         if self.tripped.get() {
             return fail(format!(
                 "not graded: your loops ran past {} iterations in a known-answer test (see above). On a GPU this shader would hang, so its images are not graded.",
@@ -314,24 +314,29 @@ impl Checker {
             Ok(drawn) => drawn,
             Err(error) => return fail(format!("drawing with Mirador's functions: {error}")),
         };
-        let (correct, mut outcome) = self.judged(test, &scene, &mirador, &yours);
+        // Against the tracer, the scene is traced once, whichever right answer is the baseline.
+        let traced = (test.against == Against::Tracer).then(|| images::traced(&scene));
+        let judged = |right: &RgbaImage| match &traced {
+            None => images::judge(test, right, &yours, None),
+            Some(traced) => images::judge(test, traced, &yours, Some(right)),
+        };
+        let mut outcome = judged(&mirador);
         // Another right answer draws another image: within the test's bounds of it is right too.
         for (alternative, wgsl) in &self.alternatives {
             if outcome.passed {
                 break;
             }
             let Ok(theirs) = images::drawn(gpu, &scene, wgsl).await else { continue };
-            let (_, judged) = self.judged(test, &scene, &theirs, &yours);
-            if judged.passed {
-                outcome = images::Outcome {
-                    output: format!(
-                        "{}\n(as the lab's other right answer, {}: {})",
-                        judged.output, alternative.name, alternative.sentence
-                    ),
-                    ..judged
-                };
+            let theirs = judged(&theirs);
+            if theirs.passed {
+                let output = format!(
+                    "{}\n(as the lab's other right answer, {}: {})",
+                    theirs.output, alternative.name, alternative.sentence
+                );
+                outcome = Outcome { output, ..theirs };
             }
         }
+        let correct = traced.unwrap_or(mirador);
         let Outcome { mut passed, error_map, mut output, .. } = outcome;
         if your_nans > mirador_nans {
             // A NaN shows as whatever the device makes of it: the same shader may pass here and
@@ -359,32 +364,7 @@ impl Checker {
                 mistake = self.named(candidates).await;
             }
         }
-        Checked {
-            finding: Finding { index, passed, output, mistake, images: None, unfinished: false },
-            pictures: Some([correct, yours, error_map]),
-        }
-    }
-}
-
-impl Checker {
-    /// `yours` judged against `mirador` (a right answer's image) or, for a test against the
-    /// tracer, against the traced image with `mirador`'s own error as the baseline: the image
-    /// shown as correct, and the outcome.
-    fn judged(
-        &self,
-        test: &ImageTest,
-        scene: &crate::scene::Scene,
-        mirador: &RgbaImage,
-        yours: &RgbaImage,
-    ) -> (RgbaImage, Outcome) {
-        match test.against {
-            Against::Reference => (mirador.clone(), images::judge(test, mirador, yours, None)),
-            Against::Tracer => {
-                let traced = images::traced(scene);
-                let outcome = images::judge(test, &traced, yours, Some(mirador));
-                (traced, outcome)
-            }
-        }
+        Checked { finding: Finding::ran(index, passed, output, mistake), pictures: Some([correct, yours, error_map]) }
     }
 }
 

@@ -42,29 +42,41 @@ pub fn raster(gpu: &Gpu, scene: &Scene, wgsl: &Wgsl) -> Result<RgbaImage, String
 
 /// [`raster`] as a future, which the page polls a frame at a time.
 pub async fn drawn(gpu: &Gpu, scene: &Scene, wgsl: &Wgsl) -> Result<RgbaImage, String> {
-    drawn_counted(gpu, scene, wgsl).await.map(|(image, _)| image)
+    drawn_with(gpu, scene, wgsl, false).await.map(|(image, _)| image)
 }
 
 /// [`drawn`], and how many of the image's pixels were not finite (NaN or infinite in any channel)
 /// before the output transform: the HDR target read back too. The transform shows a NaN as
 /// whatever the device makes of it, so such pixels are named rather than compared.
 pub async fn drawn_counted(gpu: &Gpu, scene: &Scene, wgsl: &Wgsl) -> Result<(RgbaImage, usize), String> {
-    let draw = || -> Result<_, crate::gpu::readback::ReadbackError> {
+    drawn_with(gpu, scene, wgsl, true).await
+}
+
+/// The image, and with `count` the number of its pixels that were not finite (else 0).
+async fn drawn_with(gpu: &Gpu, scene: &Scene, wgsl: &Wgsl, count: bool) -> Result<(RgbaImage, usize), String> {
+    use crate::gpu::readback::{Pending, ReadbackError};
+    let draw = || -> Result<_, ReadbackError> {
         let mut headless = Headless::with_wgsl(gpu, scene, wgsl.clone());
         let image = headless.render_later(gpu, scene, &scene.settings)?;
-        let hdr = crate::gpu::readback::Pending::start(&gpu.device, &gpu.queue, &headless.targets.hdr.texture, 8)?;
+        let hdr =
+            count.then(|| Pending::start(&gpu.device, &gpu.queue, &headless.targets.hdr.texture, 8)).transpose()?;
         Ok((image, hdr))
     };
     let started = gpu.checked_later(draw).await;
     let (readback, hdr) = started.map_err(|e| e.to_string())?.map_err(|e| e.to_string())?;
     let (width, height) = readback.size();
     let pixels = readback.texels(&gpu.device).await.map_err(|e| e.to_string())?;
-    let radiance = hdr.texels(&gpu.device).await.map_err(|e| e.to_string())?;
-    // Rgba16Float: a half is not finite when its exponent's bits are all set.
-    let not_finite = radiance
-        .chunks_exact(8)
-        .filter(|texel| texel.chunks_exact(2).any(|half| u16::from_le_bytes([half[0], half[1]]) & 0x7C00 == 0x7C00))
-        .count();
+    let not_finite = match hdr {
+        None => 0,
+        // Rgba16Float: a half is not finite when its exponent's bits are all set.
+        Some(hdr) => hdr
+            .texels(&gpu.device)
+            .await
+            .map_err(|e| e.to_string())?
+            .chunks_exact(8)
+            .filter(|texel| texel.chunks_exact(2).any(|half| u16::from_le_bytes([half[0], half[1]]) & 0x7C00 == 0x7C00))
+            .count(),
+    };
     let image =
         RgbaImage::from_raw(width, height, pixels).ok_or_else(|| "the readback has the wrong size".to_owned())?;
     Ok((image, not_finite))

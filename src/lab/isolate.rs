@@ -73,13 +73,14 @@ impl Isolated {
             (token.kind == Kind::Identifier && token.renameable && declared.iter().any(|d| d == name))
                 .then(|| format!("{prefix}{name}"))
         };
-        // The code of `range` (an argument), its tokens with the student's names renamed, one
-        // space apart: comments and line ends left out, so nothing can swallow what follows.
+        // The code of `range` (an argument), its tokens with the student's names renamed, and no
+        // comment or line end left between them: nothing can swallow what the rewrite follows
+        // it with.
         let rewritten = |range: std::ops::Range<usize>| {
             let mut out = String::new();
             let mut last: Option<usize> = None;
             for t in tokens.iter().filter(|t| t.range.start >= range.start && t.range.end <= range.end) {
-                // Spaces between two tokens kept; a comment or a line end between them, one space.
+                // Spaces between two tokens kept; a comment or a line end, one space instead.
                 if let Some(end) = last.filter(|&end| end < t.range.start) {
                     let gap = &text[end..t.range.start];
                     out.push_str(if gap.bytes().all(|b| b == b' ') { gap } else { " " });

@@ -26,10 +26,6 @@ pub struct TestResult {
     pub visibility: &'static str,
     #[serde(skip)]
     pub passed: bool,
-    /// False for a teacher's test in error ([`super::checks::Test::teachers_error`]): it neither
-    /// passes nor fails a student.
-    #[serde(skip)]
-    pub counted: bool,
     #[serde(skip)]
     pub images: Option<[String; 3]>,
 }
@@ -42,6 +38,14 @@ pub struct Report {
     pub seconds: f64,
 }
 
+impl TestResult {
+    /// Whether it counts: not a teacher's test in error ([`super::checks::Test::teachers_error`],
+    /// the one result never shown), which neither passes nor fails a student.
+    pub fn counted(&self) -> bool {
+        self.visibility != "hidden"
+    }
+}
+
 impl Report {
     pub fn score(&self) -> f32 {
         self.results.iter().map(|r| r.score).sum()
@@ -52,12 +56,12 @@ impl Report {
     }
 
     pub fn passed(&self) -> bool {
-        self.problems.is_empty() && self.results.iter().filter(|r| r.counted).all(|r| r.passed)
+        self.problems.is_empty() && self.results.iter().filter(|r| r.counted()).all(|r| r.passed)
     }
 
     /// The tests a teacher must mend: hidden tests the answer key fails.
     pub fn teachers_errors(&self) -> impl Iterator<Item = &TestResult> {
-        self.results.iter().filter(|r| !r.counted)
+        self.results.iter().filter(|r| !r.counted())
     }
 }
 
@@ -68,13 +72,13 @@ pub fn text(report: &Report) -> String {
         let _ = writeln!(out, "{}", problem.display(&report.lab.file));
     }
     for result in &report.results {
-        let mark = match (result.counted, result.passed) {
+        let mark = match (result.counted(), result.passed) {
             (false, _) => "SKIP",
             (true, true) => "pass",
             (true, false) => "FAIL",
         };
         let _ = writeln!(out, "{mark}  {:>4} / {:<4} {}", points(result.score), points(result.max_score), result.name);
-        if !result.passed || !result.counted {
+        if !result.passed || !result.counted() {
             for line in result.output.lines() {
                 let _ = writeln!(out, "            {line}");
             }
@@ -87,7 +91,7 @@ pub fn text(report: &Report) -> String {
         points(report.score()),
         points(report.max_score()),
         report.results.iter().filter(|r| r.passed).count(),
-        report.results.iter().filter(|r| r.counted).count(),
+        report.results.iter().filter(|r| r.counted()).count(),
         report.seconds
     );
     let errors: Vec<&str> = report.teachers_errors().map(|r| r.name.as_str()).collect();
@@ -146,7 +150,7 @@ const PICTURES_BUDGET: usize = 700_000;
 pub fn prairielearn_json(report: &Report, folder: &Path) -> String {
     use base64::Engine;
     let problems: Vec<String> = report.problems.iter().map(|p| p.display(&report.lab.file)).collect();
-    let counted: Vec<&TestResult> = report.results.iter().filter(|r| r.counted).collect();
+    let counted: Vec<&TestResult> = report.results.iter().filter(|r| r.counted()).collect();
     let tests: Vec<serde_json::Value> = counted
         .iter()
         .map(|r| {
@@ -220,7 +224,7 @@ fn markdown(report: &Report) -> String {
         points(report.score()),
         points(report.max_score()),
         report.results.iter().filter(|r| r.passed).count(),
-        report.results.iter().filter(|r| r.counted).count(),
+        report.results.iter().filter(|r| r.counted()).count(),
         report.seconds
     );
     if !report.problems.is_empty() {
@@ -232,7 +236,7 @@ fn markdown(report: &Report) -> String {
         out.push_str("```\n\n");
     }
     out.push_str("| Test | Score | What it found |\n|---|---|---|\n");
-    for result in report.results.iter().filter(|r| r.counted) {
+    for result in report.results.iter().filter(|r| r.counted()) {
         let found = result.output.replace('|', "\\|").replace('\n', "<br>");
         let _ =
             writeln!(out, "| {} | {} / {} | {} |", result.name, points(result.score), points(result.max_score), found);

@@ -69,7 +69,11 @@ pub fn reference(lab: &Lab) -> Wgsl {
 /// apart from Mirador's and its loops bounded: [`isolated`]), the lab's routes after them. The
 /// student's text comes first in what is appended, so its offsets map back to its own.
 pub fn student(lab: &Lab, student: &str) -> Wgsl {
-    let isolated = isolated(lab, student);
+    compiled(lab, &isolated(lab, student))
+}
+
+/// [`student`] of a text already isolated.
+fn compiled(lab: &Lab, isolated: &Isolated) -> Wgsl {
     let mut replaced: Vec<String> = lab.slots.iter().map(|slot| slot.name.clone()).collect();
     replaced.extend(lab.route_names());
     let mut code = isolated.text.clone();
@@ -164,8 +168,8 @@ pub fn problems_on(lab: &Lab, text: &str, profile: Profile) -> Vec<Problem> {
 
 /// naga's first complaint about a surface module or the known-answer harness with `text` in.
 fn compile_problem(lab: &Lab, text: &str) -> Option<Problem> {
-    let wgsl = student(lab, text);
     let isolated = isolated(lab, text);
+    let wgsl = compiled(lab, &isolated);
     let passes = [shaders::SCENE, shaders::TRANSPARENCY, shaders::REFRACTION, shaders::VOLUME];
     for pass in passes {
         let composed = wgsl.compose_surface(pass);
