@@ -246,6 +246,34 @@ fn a_loop_that_never_ends_is_found_and_named_not_timed_out() {
     assert!(start.elapsed().as_secs() < 60, "the check must stop the loop: {out}");
 }
 
+/// A loop that ends in every known-answer test (a 4×4 map) and runs away only in the image tests'
+/// scene (a map of hundreds of texels): no flag is read out of an image, so the checker draws it
+/// again with the slots' values NaN wherever the guard cut a loop off, and the two differ. Before,
+/// the guard stopped the loop, the value came out right, and a shader that hangs a GPU scored
+/// full marks.
+#[test]
+fn a_loop_that_runs_away_only_in_an_image_is_named() {
+    let dir = folder("shadow-map", "endless-image", true);
+    let path = dir.join("shadow_map.wgsl");
+    let key = std::fs::read_to_string(&path).unwrap();
+    let start = "    let centre = vec2i(floor(uv * f32(map_size)));\n";
+    assert!(key.contains(start));
+    let spin = "    var spin = 0u;\n    loop {\n        if spin > 3u && map_size < 64u { break; }\n        spin += 1u;\n    }\n";
+    std::fs::write(&path, key.replace(start, &format!("{start}{spin}"))).unwrap();
+    let (output, results) = check(&dir, &[]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(!output.status.success(), "{stdout}");
+    let tests = tests_of(&results);
+    let known = lab::find("shadow-map").unwrap().known_answers.len();
+    assert!(tests[..known].iter().all(|t| t["score"] == t["max_score"]), "the known answers never spin: {stdout}");
+    for test in &tests[known..] {
+        assert_eq!(test["score"], 0.0, "{stdout}");
+    }
+    assert!(stdout.contains("your loops ran past 16384 iterations while drawing this image"), "{stdout}");
+    assert!(stdout.contains("its images are not graded"), "{stdout}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A student's helpers may have any name WGSL allows: `project` is one of Mirador's functions
 /// (shaders/refraction.wgsl), `shade` another (shaders/common/surface.wgsl); before the
 /// student's names were put apart both scored 0 for a correct file.

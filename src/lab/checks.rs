@@ -146,9 +146,14 @@ pub struct Checker {
     /// when first needed.
     agreement: std::cell::RefCell<BTreeMap<usize, bool>>,
     student_values: std::cell::RefCell<Option<Vec<Option<[f32; 4]>>>>,
-    /// Whether a known-answer test found the student's loops cut off by the guard: the images
+    /// Whether a test found the student's loops cut off by the guard: the (other) images
     /// of a shader that would hang a GPU are not graded.
-    tripped: std::cell::Cell<bool>,
+    /// Where: "a known-answer test", or an image test's name.
+    tripped: std::cell::RefCell<Option<String>>,
+    /// The student's functions with the slots' values NaN where the guard cut the loops off,
+    /// when the file has loops: an image test draws it beside [`Self::student`] to find loops
+    /// that run away only in its scene ([`super::isolate::Isolated::poisoned`]).
+    poisoned: Option<Wgsl>,
 }
 
 impl Checker {
@@ -170,6 +175,7 @@ impl Checker {
             agreement: Default::default(),
             student_values: Default::default(),
             tripped: Default::default(),
+            poisoned: source::poisoned(lab, text),
             gpu,
         }
     }
@@ -195,7 +201,7 @@ impl Checker {
         let shown = |v: [f32; 4]| format!("({}, {}, {}, {})", v[0], v[1], v[2], v[3]);
         let mut output = format!("{} = {}; {wanted}", test.call, shown(value));
         if call.tripped {
-            self.tripped.set(true);
+            *self.tripped.borrow_mut() = Some("a known-answer test".to_owned());
             output = format!(
                 "{}: your loops ran past {} iterations in this one call, and the checker stopped them. On a GPU a loop that does not end hangs it: give every loop a bound it is sure to reach.\n{output}",
                 test.call,
@@ -295,9 +301,9 @@ impl Checker {
 
     async fn image_test(&self, test: &ImageTest, folder: Option<&Path>, index: usize) -> Checked {
         let fail = |output: String| Checked { finding: Finding::ran(index, false, output, None), pictures: None };
-        if self.tripped.get() {
+        if let Some(test) = self.tripped.borrow().as_ref() {
             return fail(format!(
-                "not graded: your loops ran past {} iterations in a known-answer test (see above). On a GPU this shader would hang, so its images are not graded.",
+                "not graded: your loops ran past {} iterations in {test} (see above). On a GPU this shader would hang, so its images are not graded.",
                 super::isolate::ITERATIONS
             ));
         }
@@ -310,6 +316,13 @@ impl Checker {
             Ok(drawn) => drawn,
             Err(error) => return fail(format!("drawing with your functions: {error}")),
         };
+        if let Some(cut) = self.cut_off(&scene, &yours).await {
+            *self.tripped.borrow_mut() = Some(format!("the image test “{}”", test.name));
+            return fail(format!(
+                "not graded: your loops ran past {} iterations while drawing this image, and the checker stopped them ({cut} of its pixels depend on where). On a GPU this shader would hang, so its images are not graded: give every loop a bound it is sure to reach.",
+                super::isolate::ITERATIONS
+            ));
+        }
         let (mirador, mirador_nans) = match images::drawn_counted(gpu, &scene, &self.reference).await {
             Ok(drawn) => drawn,
             Err(error) => return fail(format!("drawing with Mirador's functions: {error}")),
@@ -365,6 +378,19 @@ impl Checker {
             }
         }
         Checked { finding: Finding::ran(index, passed, output, mistake), pictures: Some([correct, yours, error_map]) }
+    }
+}
+
+impl Checker {
+    /// How many pixels of `yours` (the student's image of `scene`) the loop guard decided, when
+    /// any: the image drawn again with the slots' values NaN wherever the guard tripped differs
+    /// from it there. Two compilations of one shader may round a level apart, so a pixel counts
+    /// past [`images::LEVELS`].
+    async fn cut_off(&self, scene: &crate::scene::Scene, yours: &RgbaImage) -> Option<usize> {
+        let poisoned = images::drawn(&self.gpu, scene, self.poisoned.as_ref()?).await.ok()?;
+        let differ = |a: &[u8], b: &[u8]| a.iter().zip(b).any(|(a, b)| a.abs_diff(*b) > images::LEVELS);
+        let cut = yours.pixels().zip(poisoned.pixels()).filter(|(a, b)| differ(&a.0, &b.0)).count();
+        (cut > 0).then_some(cut)
     }
 }
 

@@ -13,7 +13,10 @@
 //!   the start of its body, `if student_guard() { break; }`: a per-invocation count of every
 //!   iteration of the student's loops, which once past [`ITERATIONS`] breaks each loop in turn
 //!   and sets a flag the known-answer tests read ([`Isolated::tripped`]). So every device runs the
-//!   student's code the same bounded way, and the checker says why it stopped.
+//!   student's code the same bounded way, and the checker says why it stopped. An image has no
+//!   pixel for the flag: the image tests draw a second, *poisoned* compilation beside the graded
+//!   one ([`Isolated::poisoned`]), whose slots return NaN once the guard tripped, and the pixels
+//!   where the two differ are the ones the guard decided.
 //!
 //! - **The same answer on every device.** `textureDimensions(t, level)` is compiled as
 //!   `max(textureDimensions(t) >> level, 1)`, which WGSL defines it to be: lavapipe answers it
@@ -49,6 +52,11 @@ pub struct Isolated {
     edits: Vec<(usize, usize, usize, usize)>,
     /// The student's text's length: offsets past it fall in the guard's declarations.
     original_len: usize,
+    /// [`Self::text`] with every value a float-valued slot returns multiplied by the guard's
+    /// poison, NaN once the loops were cut off: an image drawn with it differs from one drawn
+    /// with `text` exactly where the guard decided a value ([`Self::poisoned`]). `None` without
+    /// loops, or without a slot that returns floats.
+    poisoned: Option<String>,
 }
 
 impl Isolated {
@@ -113,32 +121,35 @@ impl Isolated {
                 }
             }
         }
-        // In order; a change inside an earlier one (a name in a rewritten call's arguments, a
-        // call inside another's) is already part of it.
-        // A guard inserted right after a loop's `{` comes before a name renamed there.
-        changes.sort_by_key(|change| (change.0, change.1 != 0, std::cmp::Reverse(change.1)));
-        let mut end = 0;
-        changes.retain(|(at, len, _)| {
-            let keep = *at >= end;
-            if keep {
-                end = at + len;
-            }
-            keep
-        });
+        let changes = outermost(changes);
         let loops = changes.iter().filter(|c| c.1 == 0).count();
-        let (mut out, mut edits, mut from) = (String::new(), Vec::new(), 0);
-        for (at, len, with) in changes {
-            out.push_str(&text[from..at]);
-            edits.push((out.len(), with.len(), at, len));
-            out.push_str(&with);
-            from = at + len;
-        }
-        out.push_str(&text[from..]);
-        if !out.ends_with('\n') {
-            out.push('\n');
-        }
+        let poisons = poisoned_returns(text, &tokens, slots, &guard_prefix);
+        let poisoned = (loops > 0 && !poisons.is_empty()).then(|| {
+            let (mut out, _) = applied(text, outermost([changes.clone(), poisons].concat()));
+            out.push_str(&poison(&guard_prefix));
+            out.push_str(&guard(&guard_prefix));
+            out
+        });
+        let (mut out, edits) = applied(text, changes);
         out.push_str(&guard(&guard_prefix));
-        Isolated { text: out, prefix, guard: guard_prefix, renamed: declared, loops, edits, original_len: text.len() }
+        Isolated {
+            text: out,
+            prefix,
+            guard: guard_prefix,
+            renamed: declared,
+            loops,
+            edits,
+            original_len: text.len(),
+            poisoned,
+        }
+    }
+
+    /// The text to draw an image with beside [`Self::text`] to see whether the guard cut the
+    /// student's loops off anywhere in it: where it did, the slot's value is NaN. An image test
+    /// has no pixel to read a flag from (the known-answer tests read [`Self::tripped`]), so the
+    /// two images are compared instead.
+    pub fn poisoned(&self) -> Option<&str> {
+        self.poisoned.as_deref()
     }
 
     /// The offset in the student's text of `offset` in [`Isolated::text`]; an offset inside an
@@ -173,6 +184,95 @@ impl Isolated {
     pub fn tripped(&self) -> String {
         format!("{}tripped", self.guard)
     }
+}
+
+/// `changes` in order, without those inside an earlier one (a name in a rewritten call's
+/// arguments, a call inside another's: already part of it). A guard inserted right after a
+/// loop's `{` comes before a name renamed there.
+fn outermost(mut changes: Vec<(usize, usize, String)>) -> Vec<(usize, usize, String)> {
+    changes.sort_by_key(|change| (change.0, change.1 != 0, std::cmp::Reverse(change.1)));
+    let mut end = 0;
+    changes.retain(|(at, len, _)| {
+        let keep = *at >= end;
+        if keep {
+            end = at + len;
+        }
+        keep
+    });
+    changes
+}
+
+/// `text` with `changes` (sorted) made, a line end after it; and each change's place in both texts.
+#[allow(clippy::type_complexity)]
+fn applied(text: &str, changes: Vec<(usize, usize, String)>) -> (String, Vec<(usize, usize, usize, usize)>) {
+    let (mut out, mut edits, mut from) = (String::new(), Vec::new(), 0);
+    for (at, len, with) in changes {
+        out.push_str(&text[from..at]);
+        edits.push((out.len(), with.len(), at, len));
+        out.push_str(&with);
+        from = at + len;
+    }
+    out.push_str(&text[from..]);
+    if !out.ends_with('\n') {
+        out.push('\n');
+    }
+    (out, edits)
+}
+
+/// The insertions that make every `return X;` of a slot returning floats (`f32`, a float vector
+/// or matrix) `return (X) * GUARDpoison();`.
+fn poisoned_returns(text: &str, tokens: &[Token], slots: &[String], guard: &str) -> Vec<(usize, usize, String)> {
+    let name = |t: &Token| &text[t.range.clone()];
+    let mut changes = Vec::new();
+    for i in 0..tokens.len().saturating_sub(1) {
+        let declares_slot = tokens[i].depth == 0
+            && name(&tokens[i]) == "fn"
+            && slots.iter().any(|slot| slot == name(&tokens[i + 1]));
+        let Some(open) = declares_slot.then(|| (i..tokens.len()).find(|&j| tokens[j].kind == Kind::Punct('{'))).flatten()
+        else {
+            continue;
+        };
+        let arrow = (i..open).find(|&j| tokens[j].kind == Kind::Punct('-') && tokens[j + 1].kind == Kind::Punct('>'));
+        let Some(arrow) = arrow else { continue };
+        let returned: String = tokens[arrow + 2..open].iter().map(name).collect();
+        if !floats(&returned) {
+            continue;
+        }
+        let body = tokens[open].depth + 1;
+        let end = (open + 1..tokens.len()).find(|&j| tokens[j].depth < body).unwrap_or(tokens.len());
+        for j in open + 1..end {
+            if tokens[j].kind != Kind::Identifier || tokens[j].after_dot || name(&tokens[j]) != "return" {
+                continue;
+            }
+            let Some(semicolon) = (j + 1..end).find(|&k| tokens[k].kind == Kind::Punct(';')) else { continue };
+            if semicolon == j + 1 {
+                continue;
+            }
+            changes.push((tokens[j + 1].range.start, 0, "(".to_owned()));
+            changes.push((tokens[semicolon].range.start, 0, format!(") * {guard}poison()")));
+        }
+    }
+    changes
+}
+
+/// Whether the WGSL type `returned` (its tokens joined) holds floats a scalar multiplies.
+fn floats(returned: &str) -> bool {
+    let vector = ["vec2", "vec3", "vec4"].iter().any(|v| returned == format!("{v}f") || returned == format!("{v}<f32>"));
+    let matrix = returned.starts_with("mat") && (returned.ends_with('f') || returned.ends_with("<f32>"));
+    returned == "f32" || vector || matrix
+}
+
+/// The poison the slots' values are multiplied by in [`Isolated::poisoned`]: 1, or NaN once the
+/// guard tripped (a NaN the compiler cannot fold: WGSL makes a constant NaN an error).
+fn poison(prefix: &str) -> String {
+    format!(
+        "// ---- the checker's poison: NaN once the loop guard tripped (src/lab/isolate.rs)
+var<private> {prefix}nan_bits: u32 = 0x7fc00000u;
+fn {prefix}poison() -> f32 {{
+    return select(1.0, bitcast<f32>({prefix}nan_bits), {prefix}tripped);
+}}
+"
+    )
 }
 
 /// The guard's declarations: the count, the flag, and the step each loop takes.
@@ -434,6 +534,25 @@ mod tests {
         let inside = isolated.text.find("loop_guard_step() { break; }").unwrap();
         assert_eq!(isolated.original(inside), Some(text.find("{ x += 1.0").unwrap() + 1));
         assert_eq!(isolated.original(isolated.text.len() - 2), None);
+    }
+
+    #[test]
+    fn a_float_slots_returns_are_poisoned_only_when_it_has_loops() {
+        let text = "fn helper(n: u32) -> f32 {\n    var x = 0.0;\n    loop { x += 1.0; if x > f32(n) { break; } }\n    return x;\n}\nfn slot(n: u32) -> vec3f {\n    if n == 0u { return vec3f(0.0); }\n    return vec3f(helper(n));\n}\nfn other(n: u32) -> bool { return n > 1u; }\n";
+        let slots = ["slot".to_owned(), "other".to_owned()];
+        let isolated = Isolated::new(text, &slots, &[]);
+        let poisoned = isolated.poisoned().expect("a float slot and a loop");
+        assert!(poisoned.contains("if n == 0u { return (vec3f(0.0)) * loop_guard_poison(); }"), "{poisoned}");
+        assert!(poisoned.contains("return (vec3f(student_helper(n))) * loop_guard_poison();"), "{poisoned}");
+        // Neither a helper's return nor a slot of another type is touched.
+        assert!(poisoned.contains("    return x;\n") && poisoned.contains("{ return n > 1u; }"), "{poisoned}");
+        // Beside the poison, the same text as the graded one.
+        let plain = poisoned.replace(") * loop_guard_poison()", "").replace("return (", "return ");
+        let cut = plain.find("// ---- the checker's poison").unwrap();
+        let guard = plain.find("// ---- the checker's loop guard").unwrap();
+        assert_eq!(format!("{}{}", &plain[..cut], &plain[guard..]), isolated.text);
+        let no_loop = Isolated::new("fn slot(n: u32) -> f32 { return 1.0; }\n", &slots, &[]);
+        assert_eq!(no_loop.poisoned(), None);
     }
 
     #[test]

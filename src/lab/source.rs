@@ -72,12 +72,25 @@ pub fn student(lab: &Lab, student: &str) -> Wgsl {
     compiled(lab, &isolated(lab, student))
 }
 
+/// [`student`] with the slots' values NaN wherever the loop guard cut the student's loops off
+/// ([`Isolated::poisoned`]): drawn beside [`student`], the images differ where the guard decided
+/// a value. `None` when the student's file has no loop (or no slot that returns floats).
+pub fn poisoned(lab: &Lab, student: &str) -> Option<Wgsl> {
+    let isolated = isolated(lab, student);
+    isolated.poisoned().map(|text| routed(lab, text, &isolated))
+}
+
 /// [`student`] of a text already isolated.
 fn compiled(lab: &Lab, isolated: &Isolated) -> Wgsl {
+    routed(lab, &isolated.text, isolated)
+}
+
+/// `text` (the isolated student's, or its poisoned twin) in place of the slots, the lab's routes
+/// after it.
+fn routed(lab: &Lab, text: &str, isolated: &Isolated) -> Wgsl {
     let mut replaced: Vec<String> = lab.slots.iter().map(|slot| slot.name.clone()).collect();
     replaced.extend(lab.route_names());
-    let mut code = isolated.text.clone();
-    code.push_str(&lab.routes.join("\n"));
+    let code = format!("{text}{}", lab.routes.join("\n"));
     Wgsl::replacing(replaced, code).with_tripped(isolated.tripped())
 }
 
