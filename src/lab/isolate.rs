@@ -225,10 +225,10 @@ fn poisoned_returns(text: &str, tokens: &[Token], slots: &[String], guard: &str)
     let name = |t: &Token| &text[t.range.clone()];
     let mut changes = Vec::new();
     for i in 0..tokens.len().saturating_sub(1) {
-        let declares_slot = tokens[i].depth == 0
-            && name(&tokens[i]) == "fn"
-            && slots.iter().any(|slot| slot == name(&tokens[i + 1]));
-        let Some(open) = declares_slot.then(|| (i..tokens.len()).find(|&j| tokens[j].kind == Kind::Punct('{'))).flatten()
+        let declares_slot =
+            tokens[i].depth == 0 && name(&tokens[i]) == "fn" && slots.iter().any(|slot| slot == name(&tokens[i + 1]));
+        let Some(open) =
+            declares_slot.then(|| (i..tokens.len()).find(|&j| tokens[j].kind == Kind::Punct('{'))).flatten()
         else {
             continue;
         };
@@ -257,7 +257,8 @@ fn poisoned_returns(text: &str, tokens: &[Token], slots: &[String], guard: &str)
 
 /// Whether the WGSL type `returned` (its tokens joined) holds floats a scalar multiplies.
 fn floats(returned: &str) -> bool {
-    let vector = ["vec2", "vec3", "vec4"].iter().any(|v| returned == format!("{v}f") || returned == format!("{v}<f32>"));
+    let vector =
+        ["vec2", "vec3", "vec4"].iter().any(|v| returned == format!("{v}f") || returned == format!("{v}<f32>"));
     let matrix = returned.starts_with("mat") && (returned.ends_with('f') || returned.ends_with("<f32>"));
     returned == "f32" || vector || matrix
 }
