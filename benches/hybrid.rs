@@ -7,7 +7,8 @@
 
 use std::time::{Duration, Instant};
 
-use mirador::trace::terms::{ViewRays, Wanted};
+use mirador::settings::{Traced, TracedSet};
+use mirador::trace::terms::ViewRays;
 use mirador::trace::{RenderControl, Tracer, primary_cone};
 
 const RUNS: usize = 5;
@@ -49,11 +50,9 @@ fn main() {
         println!("{name:>34}: {:8.1} ms, {rays:>8} rays, {mrays:5.2} Mrays/s", time.as_secs_f64() * 1e3);
         time
     };
-    let colour =
-        rate("terms: colour", &mut || tracer.terms(&view, Wanted { colour: true, ..Wanted::default() }).rays.total());
-    let visibility = rate("terms: visibility", &mut || {
-        tracer.terms(&view, Wanted { visibility: true, ..Wanted::default() }).rays.total()
-    });
+    let colour = rate("terms: colour", &mut || tracer.terms(&view, TracedSet::of(&[Traced::Textures])).rays.total());
+    let visibility =
+        rate("terms: visibility", &mut || tracer.terms(&view, TracedSet::of(&[Traced::Shadows])).rays.total());
     let render = rate("Tracer::render (the whole image)", &mut || {
         let (_, stats) = tracer.render(&RenderControl::default()).expect("nothing cancels it");
         stats.rays.total()

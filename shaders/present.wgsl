@@ -30,12 +30,6 @@ fn fs_present(@builtin(position) pixel: vec4f) -> @location(0) vec4f {
     return vec4f(tone_map(max(radiance * present.exposure, vec3f(0.0)), present.tone_map), 1.0);
 }
 
-// The curves of src/output.rs (`ToneMap`), in its order.
-const TONE_MAP_CLAMP: u32 = 0u;
-const TONE_MAP_REINHARD: u32 = 1u;
-const TONE_MAP_ACES: u32 = 2u;
-const TONE_MAP_PBR_NEUTRAL: u32 = 3u;
-
 fn tone_map(c: vec3f, curve: u32) -> vec3f {
     var mapped = c;
     switch curve {

@@ -20,8 +20,6 @@
 
 // REFRACTION_*: where L(t2) comes from.
 override REFRACTION: u32 = 1u;
-const REFRACTION_ENVIRONMENT: u32 = 1u;
-const REFRACTION_SCREEN: u32 = 2u;
 
 // Steps of the march along a ray's image, and the bisection after it.
 const MARCH_STEPS: u32 = 96u;

@@ -21,15 +21,6 @@ override VOLUME_SHADOWS: bool = false;
 override VOLUME_FAR_LIMIT: bool = false;
 override VOLUME_NEAR_LIMIT: bool = false;
 
-const VOLUME_GRADIENT_OFF: u32 = 0u;
-const VOLUME_GRADIENT_FORWARD: u32 = 1u;
-const VOLUME_GRADIENT_CENTRAL: u32 = 2u;
-
-const VOLUME_VIEW_SAMPLES: u32 = 1u;
-const VOLUME_MAX_SAMPLES: u32 = 4096u;
-const VOLUME_BISECTION_STEPS: u32 = 10u;
-const VOLUME_TABLE_SIZE: u32 = 256u;
-
 struct Volume {
     world_from_local: mat4x4f,
     local_from_world: mat4x4f,

@@ -1,7 +1,11 @@
 //! WGSL composition, in one place: every pass's shader is the device's profile
 //! (`shaders/profile/`, [`Profile`]) and the shared files of `shaders/common/`, followed by the
 //! pass's own file; the passes that draw the scene's surfaces get the surface code ([`SURFACE`])
-//! between the two. Shared code is never copied between shaders.
+//! between the two. Shared code is never copied between shaders. Ahead of them all comes the
+//! constants' prelude ([`constants::prelude`]): every constant the WGSL shares with the Rust code,
+//! written from the Rust.
+
+pub mod constants;
 
 /// What the device's shaders may use. Mirador's WGSL calls a few functions for what a small
 /// device lacks, and each profile's file defines them (`shaders/profile/`): the same passes,
@@ -201,7 +205,9 @@ impl Wgsl {
     fn compose_after<'a>(&self, shared: impl Iterator<Item = &'a (&'a str, &'a str)>, pass: &str) -> String {
         let mut source = String::new();
         let (profile, profile_text) = self.profile.wgsl();
-        for (name, text) in std::iter::once((profile, profile_text)).chain(shared.map(|&(name, text)| (name, text))) {
+        let prelude = constants::prelude();
+        let first = [("constants (src/shaders/constants.rs)", prelude.as_str()), (profile, profile_text)];
+        for (name, text) in first.into_iter().chain(shared.map(|&(name, text)| (name, text))) {
             source.push_str("// ---- ");
             source.push_str(name);
             source.push('\n');

@@ -58,7 +58,9 @@ fn every_scene_with_every_term_traced_is_the_tracers_image() {
 /// given to the whole block; refined to stride 1 they are every pixel's own.
 #[test]
 fn coarse_traced_terms_are_the_full_terms_of_each_blocks_first_pixel() {
-    use mirador::trace::terms::{ViewRays, Wanted};
+    use mirador::settings::hybrid::SURFACE_LAYER;
+    use mirador::settings::{Traced, TracedSet};
+    use mirador::trace::terms::ViewRays;
     let scene = smaller(common::load("scenes/mirrors.toml"), 96);
     let tracer = mirador::trace::Tracer::new(&scene, &scene.settings);
     let camera = scene.camera.clone();
@@ -73,20 +75,23 @@ fn coarse_traced_terms_are_the_full_terms_of_each_blocks_first_pixel() {
         lights: &[0],
         stride,
     };
-    let wanted = Wanted { visibility: true, reflection: true, transmission: false, colour: true };
+    let wanted = TracedSet::of(&[Traced::Shadows, Traced::Reflections, Traced::Textures]);
     let full = tracer.terms(&rays(1), wanted);
     let coarse = tracer.terms(&rays(4), wanted);
+    let layer = |terms: &mirador::trace::terms::TracedTerms, layer: u32| terms.layer(layer).expect("traced").to_vec();
+    let (surface, full_surface) = (layer(&coarse, SURFACE_LAYER), layer(&full, SURFACE_LAYER));
+    let (shadows, full_shadows) = (layer(&coarse, Traced::Shadows.layer()), layer(&full, Traced::Shadows.layer()));
     let width = size.0 as usize;
     let mut differing = 0;
-    for (i, (c, f)) in coarse.surface.iter().zip(&full.surface).enumerate() {
+    for (i, (c, f)) in surface.iter().zip(&full_surface).enumerate() {
         let (x, y) = (i % width, i / width);
         let first = (y - y % 4) * width + (x - x % 4);
-        assert_eq!(*c, full.surface[first], "pixel ({x}, {y}) holds its block's first pixel's terms");
-        assert_eq!(coarse.visibility[0][i], full.visibility[0][first]);
+        assert_eq!(*c, full_surface[first], "pixel ({x}, {y}) holds its block's first pixel's terms");
+        assert_eq!(shadows[i], full_shadows[first]);
         differing += usize::from(c != f);
     }
     // The other side: the coarse image is not the full one.
-    assert!(differing > coarse.surface.len() / 10, "{differing} of {} pixels differ", coarse.surface.len());
+    assert!(differing > surface.len() / 10, "{differing} of {} pixels differ", surface.len());
     assert!(
         coarse.rays.primary * 10 < full.rays.primary,
         "{} against {} primary rays",

@@ -2,8 +2,9 @@
 //! path) in `src/` is read, resolved to the module it names, and checked against
 //!
 //! - the crate's layers, each importing only from those below it:
-//!   `settings | shaders | files | base` ← `output | compare | settings_doc | volume`
-//!   ← `scene | linear_output` ← `texture` ← `trace | gpu` ← `raster` ← `budget | explain | lab` ← `viewer`
+//!   `settings | files | base` ← `output | compare | settings_doc | volume`
+//!   ← `scene | linear_output` ← `texture` ← `shaders` ← `trace | gpu` ← `raster` ← `budget | explain | lab`
+//!   ← `viewer`
 //!   ← `web` (← `main.rs`), where modules of one layer never import each other: `base` holds
 //!   what `scene` and `volume` share (the ray, the material and texture indices), so the scene
 //!   holds volumes and reads their files while `volume` knows nothing of the scene;
@@ -23,7 +24,6 @@ use std::path::Path;
 /// The rank of each top-level module: a module imports only from lower ranks.
 const LAYERS: &[(&str, u32)] = &[
     ("settings", 0),
-    ("shaders", 0),
     ("files", 0),
     ("base", 0),
     ("output", 1),
@@ -33,14 +33,15 @@ const LAYERS: &[(&str, u32)] = &[
     ("scene", 2),
     ("linear_output", 2),
     ("texture", 3),
-    ("trace", 4),
-    ("gpu", 4),
-    ("raster", 5),
-    ("budget", 6),
-    ("explain", 6),
-    ("lab", 6),
-    ("viewer", 7),
-    ("web", 8),
+    ("shaders", 4),
+    ("trace", 5),
+    ("gpu", 5),
+    ("raster", 6),
+    ("budget", 7),
+    ("explain", 7),
+    ("lab", 7),
+    ("viewer", 8),
+    ("web", 9),
 ];
 
 /// Imports the ranks allow but the design does not: the GPU layer knows nothing of scenes.

@@ -1,12 +1,13 @@
 //! Twins that cannot drift: every `#[repr(C)]` GPU struct has the size and the field offsets naga
 //! computes for its WGSL twin, every code shared by Rust and WGSL (light kinds, terms, filter
-//! modes, shadow methods, view modes, height sources, array limits) has the same value on both
-//! sides, and every pipeline constant the scene pass sets is an `override` of its shader. So
-//! padding and codes are checked here instead of being kept in step by hand in two places.
+//! modes, shadow methods, view modes, height sources, array limits) is written once, in Rust, and
+//! composed into the WGSL (no WGSL file declares its own), and every pipeline constant the scene
+//! pass sets is an `override` of its shader. So padding and codes are checked here instead of
+//! being kept in step by hand in two places.
 
 use std::mem::{offset_of, size_of};
 
-use mirador::raster::keys::{self, FrameKey, MaterialKey, SHADOW_FILTER_NAMES, shadow_filter_code};
+use mirador::raster::keys::{FrameKey, MaterialKey, shadow_filter_code};
 use mirador::raster::shadow::views::MAX_LAYERS;
 use mirador::raster::shadow::{GpuShadowLayer, GpuShadows};
 use mirador::raster::uniforms::{
@@ -227,92 +228,70 @@ fn instance_attributes_match_the_wgsl_locations() {
     assert_eq!(size_of::<GpuInstance>(), 108);
 }
 
+/// Every constant the WGSL shares with the Rust is written once, in Rust
+/// (`src/shaders/constants.rs`, and the approximations table's bits and layers), and composed
+/// ahead of every module: no WGSL file declares one of those names itself, so no second spelling
+/// can drift. Each is read by some WGSL, and every composed module parses with them.
 #[test]
-fn codes_shared_by_rust_and_wgsl_agree() {
+fn shared_constants_are_written_once_in_rust() {
+    let prelude = shaders::constants::prelude();
+    let names: Vec<&str> = prelude
+        .lines()
+        .filter_map(|line| line.strip_prefix("const "))
+        .map(|rest| rest.split([':', ' ']).next().unwrap())
+        .collect();
+    assert!(names.len() >= 80, "{} constants in the prelude", names.len());
+    let files = wgsl_files(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders")));
+    let declares = |text: &str, name: &str| text.lines().any(|l| l.trim_start().starts_with(&format!("const {name}:")));
+    for (path, text) in &files {
+        for name in &names {
+            assert!(!declares(text, name), "{path} declares {name}, which src/shaders/constants.rs writes");
+        }
+    }
+    // The check can fail: a file with its own copy is found.
+    assert!(declares("fn f() {}\nconst MAX_LIGHTS: u32 = 16u;\n", "MAX_LIGHTS"));
+    let all: String = files.iter().map(|(_, text)| text.as_str()).collect();
+    for name in &names {
+        let used = all.match_indices(name).any(|(at, _)| {
+            let after = all[at + name.len()..].chars().next();
+            !after.is_some_and(|c| c.is_alphanumeric() || c == '_')
+        });
+        assert!(used, "no WGSL reads {name}");
+    }
+    // Each value is the Rust's: the prelude of a few, as naga reads them.
     let module = surface_modules();
-    let codes: [(&str, f64); 51] = [
-        ("MAX_LIGHTS", uniforms::MAX_LIGHTS as f64),
-        ("MAX_SHADOW_LAYERS", MAX_LAYERS as f64),
-        ("LIGHT_POINT", uniforms::LIGHT_POINT.into()),
-        ("LIGHT_DIRECTIONAL", uniforms::LIGHT_DIRECTIONAL.into()),
-        ("LIGHT_SPOT", uniforms::LIGHT_SPOT.into()),
-        ("ATTENUATION_NONE", uniforms::ATTENUATION_NONE.into()),
-        ("ATTENUATION_INVERSE_SQUARE", uniforms::ATTENUATION_INVERSE_SQUARE.into()),
-        ("TERM_AMBIENT", uniforms::TERM_AMBIENT.into()),
-        ("TERM_DIFFUSE", uniforms::TERM_DIFFUSE.into()),
-        ("TERM_SPECULAR", uniforms::TERM_SPECULAR.into()),
-        ("TERM_EMISSION", uniforms::TERM_EMISSION.into()),
-        ("TERM_FRESNEL", uniforms::TERM_FRESNEL.into()),
-        ("MAX_ENV_CUBES", uniforms::MAX_ENV_CUBES as f64),
-        ("PARALLAX_INFINITE", uniforms::PARALLAX_INFINITE.into()),
-        ("PARALLAX_GROUND", uniforms::PARALLAX_GROUND.into()),
-        ("PARALLAX_BOX", uniforms::PARALLAX_BOX.into()),
-        ("REFRACTION_ENVIRONMENT", mirador::raster::refraction::REFRACTION_ENVIRONMENT.into()),
-        ("REFRACTION_SCREEN", mirador::raster::refraction::REFRACTION_SCREEN.into()),
-        ("INSPECT_REFRACTION", mirador::raster::inspect::INSPECT_REFRACTION.into()),
-        ("SHADOWS_OFF", keys::SHADOWS_OFF.into()),
-        ("SHADOWS_MAP", keys::SHADOWS_MAP.into()),
-        ("SHADOWS_PROJECTED", keys::SHADOWS_PROJECTED.into()),
-        ("TRACED_VISIBILITY", keys::TRACED_VISIBILITY.into()),
-        ("TRACED_REFLECTION", keys::TRACED_REFLECTION.into()),
-        ("TRACED_COLOUR", keys::TRACED_COLOUR.into()),
-        ("TRACED_TRANSMISSION", keys::TRACED_TRANSMISSION.into()),
-        ("TRACED_TRANSMISSION_LAYER", mirador::raster::targets::TRACED_TRANSMISSION.into()),
-        ("TRACED_SURFACE_LAYER", mirador::raster::targets::TRACED_SURFACE.into()),
-        ("TRACED_REFLECTION_LAYER", mirador::raster::targets::TRACED_REFLECTION.into()),
-        ("TRACED_VISIBILITY_LAYER", mirador::raster::targets::TRACED_VISIBILITY.into()),
-        ("BUMP_VIEW_NORMALS", keys::BUMP_VIEW_NORMALS.into()),
-        ("BUMP_VIEW_TANGENTS", keys::BUMP_VIEW_TANGENTS.into()),
-        ("HEIGHT_NONE", keys::HEIGHT_NONE.into()),
-        ("HEIGHT_TEXTURE", keys::HEIGHT_TEXTURE.into()),
-        ("HEIGHT_SINE", keys::HEIGHT_SINE.into()),
-        ("HEIGHT_NOISE", keys::HEIGHT_NOISE.into()),
-        ("ALPHA_OPAQUE", uniforms::ALPHA_OPAQUE.into()),
-        ("ALPHA_MASK", uniforms::ALPHA_MASK.into()),
-        ("ALPHA_BLEND", uniforms::ALPHA_BLEND.into()),
-        ("ENV_LAYER_WORLD", uniforms::ENV_LAYER_WORLD.into()),
-        ("ENV_LAYER_NONE", uniforms::ENV_LAYER_NONE.into()),
-        ("ENV_NONE", uniforms::ENV_NONE.into()),
-        ("ENV_SKY", uniforms::ENV_SKY.into()),
-        ("ENV_LATLONG", uniforms::ENV_LATLONG.into()),
-        ("ENV_CUBE", uniforms::ENV_CUBE.into()),
-        ("ENV_SPHERE", uniforms::ENV_SPHERE.into()),
-        ("ENV_MAP_CUBE", keys::ENV_MAP_CUBE.into()),
-        ("ENV_MAP_SPHERE", keys::ENV_MAP_SPHERE.into()),
-        ("ENV_MAP_LATLONG", keys::ENV_MAP_LATLONG.into()),
-        ("ENV_MAP_DYNAMIC", keys::ENV_MAP_DYNAMIC.into()),
-        ("MIP_PALETTE_LAST", (mirador::texture::mipmap::LEVEL_PALETTE.len() - 1) as f64),
-    ];
-    for (name, rust) in codes {
-        assert_eq!(constant(&module, name), rust, "{name}: WGSL vs Rust");
+    assert_eq!(constant(&module, "MAX_LIGHTS"), uniforms::MAX_LIGHTS as f64);
+    assert_eq!(constant(&module, "MAX_SHADOW_LAYERS"), MAX_LAYERS as f64);
+    assert_eq!(constant(&module, "ENV_LAYER_NONE"), f64::from(uniforms::ENV_LAYER_NONE));
+    for filter in [mirador::settings::ShadowFilter::None, mirador::settings::ShadowFilter::Poisson] {
+        let code = f64::from(shadow_filter_code(filter));
+        assert!(prelude.contains(&format!(
+            "const SHADOW_FILTER_{}: u32 = {code}u;",
+            if code == 0.0 { "NONE" } else { "POISSON" }
+        )));
     }
-    for (name, filter) in SHADOW_FILTER_NAMES {
-        assert_eq!(constant(&module, name), f64::from(shadow_filter_code(filter)), "{name}: WGSL vs Rust");
+    for term in mirador::settings::Traced::ALL {
+        let name = term.row().name.to_uppercase();
+        assert_eq!(constant(&module, &format!("TRACED_{name}")), f64::from(term.bit()));
+        assert_eq!(constant(&module, &format!("TRACED_{name}_LAYER")), f64::from(term.layer()));
     }
-    for (name, gradient) in mirador::raster::volume::VOLUME_GRADIENT_NAMES {
-        let code = mirador::raster::volume::gradient_code(gradient);
-        assert_eq!(constant(&module, name), f64::from(code), "{name}: WGSL vs Rust");
-    }
-    use mirador::volume::{march, transfer};
-    for (name, rust) in [
-        ("VOLUME_MAX_SAMPLES", march::MAX_SAMPLES as f64),
-        ("VOLUME_BISECTION_STEPS", march::BISECTION_STEPS as f64),
-        ("VOLUME_TABLE_SIZE", transfer::TABLE_SIZE as f64),
-        ("VOLUME_VIEW_SAMPLES", 1.0),
-    ] {
-        assert_eq!(constant(&module, name), rust, "{name}: WGSL vs Rust");
-    }
-    use mirador::settings::ToneMap;
     let present = parse(&shaders::compose(shaders::PRESENT));
-    for (name, curve) in [
-        ("TONE_MAP_CLAMP", ToneMap::Clamp),
-        ("TONE_MAP_REINHARD", ToneMap::Reinhard),
-        ("TONE_MAP_ACES", ToneMap::Aces),
-        ("TONE_MAP_PBR_NEUTRAL", ToneMap::PbrNeutral),
-    ] {
-        let code = mirador::raster::present::tone_map_code(curve);
-        assert_eq!(constant(std::slice::from_ref(&present), name), f64::from(code), "{name}: WGSL vs Rust");
+    let code = mirador::raster::present::tone_map_code(mirador::settings::ToneMap::Aces);
+    assert_eq!(constant(std::slice::from_ref(&present), "TONE_MAP_ACES"), f64::from(code));
+}
+
+/// Every `.wgsl` file under `dir`, with its text.
+fn wgsl_files(dir: &std::path::Path) -> Vec<(String, String)> {
+    let mut files = Vec::new();
+    for entry in std::fs::read_dir(dir).expect("the shaders folder") {
+        let path = entry.expect("a folder entry").path();
+        if path.is_dir() {
+            files.extend(wgsl_files(&path));
+        } else if path.extension().is_some_and(|e| e == "wgsl") {
+            files.push((path.display().to_string(), std::fs::read_to_string(&path).expect("a WGSL file")));
+        }
     }
+    files
 }
 
 /// The surface passes' own files, by name.

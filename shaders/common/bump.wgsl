@@ -5,20 +5,6 @@
 
 const BUMP_TAU: f32 = 6.28318530717958647692;
 
-// One colour per mip level for the level-colour view (linear RGB); levels 7 and smaller are grey.
-// Rust twin: texture::mipmap::LEVEL_PALETTE.
-const MIP_PALETTE_LAST: u32 = 7u;
-const MIP_LEVEL_PALETTE = array<vec3f, 8>(
-    vec3f(1.0, 0.0, 0.0),
-    vec3f(1.0, 0.5, 0.0),
-    vec3f(1.0, 1.0, 0.0),
-    vec3f(0.0, 1.0, 0.0),
-    vec3f(0.0, 1.0, 1.0),
-    vec3f(0.0, 0.0, 1.0),
-    vec3f(1.0, 0.0, 1.0),
-    vec3f(0.5, 0.5, 0.5),
-);
-
 // The level-colour view: the palette blended between levels floor(lod) and floor(lod) + 1, as
 // trilinear filtering blends texels. Clamp lod to the texture's last level first
 // (f32(texture_level_count(t) - 1u)) to show the level actually read.

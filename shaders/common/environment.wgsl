@@ -3,13 +3,6 @@
 // tests that pin the conventions; the passes that bind the maps are scene.wgsl (lookups and the
 // background) and environment.wgsl (making one form from another).
 
-// Environment.source: what the world's environment is made of.
-const ENV_NONE: u32 = 0u;
-const ENV_SKY: u32 = 1u;
-const ENV_LATLONG: u32 = 2u;
-const ENV_CUBE: u32 = 3u;
-const ENV_SPHERE: u32 = 4u;
-
 const PI: f32 = 3.14159265358979;
 
 struct Environment {
@@ -39,13 +32,6 @@ struct Environment {
     // Each dynamic cube's centre, where its six views were drawn from.
     cube_centres: array<vec4f, MAX_ENV_CUBES>,
 }
-
-const MAX_ENV_CUBES: u32 = 8u;
-
-// Environment.parallax: where a dynamic cube's lookup assumes the ray ends.
-const PARALLAX_INFINITE: u32 = 0u;
-const PARALLAX_GROUND: u32 = 1u;
-const PARALLAX_BOX: u32 = 2u;
 
 // The direction to read a cube drawn from `centre` for the ray p + t·d (docs/course/
 // 08-environment-maps.md#parallax): d itself when the ray is taken to end infinitely far, else

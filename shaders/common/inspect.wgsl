@@ -10,16 +10,6 @@
 
 override INSPECT: bool = false;
 
-const MAX_INSPECTED: u32 = 32u;
-
-const INSPECT_OPAQUE: u32 = 1u;
-const INSPECT_MIRROR: u32 = 2u;
-const INSPECT_TRANSPARENT: u32 = 3u;
-const INSPECT_BACKGROUND: u32 = 4u;
-const INSPECT_ISOSURFACE: u32 = 5u;
-const INSPECT_VOLUME: u32 = 6u;
-const INSPECT_REFRACTION: u32 = 7u;
-
 struct InspectLight {
     // Each part of S·L_dir, before the visibility.
     ambient: vec3f,

@@ -3,14 +3,6 @@
 // shared file names no pass's bindings. The Rust twins of the layout logic live in
 // src/raster/shadow/views.rs (cube_face, project).
 
-const SHADOW_FILTER_NONE: u32 = 0u;
-const SHADOW_FILTER_HARDWARE: u32 = 1u;
-const SHADOW_FILTER_PCF3: u32 = 2u;
-const SHADOW_FILTER_PCF5: u32 = 3u;
-const SHADOW_FILTER_POISSON: u32 = 4u;
-
-const MAX_SHADOW_LAYERS: u32 = 24u;
-
 struct ShadowLayer {
     clip_from_world: mat4x4f,
     // World size of a texel (at unit distance from the light for perspective views).

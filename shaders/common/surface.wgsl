@@ -35,33 +35,6 @@ override ALPHA_MODE: u32 = 0u;
 // ENV_MAP_*: the map curved mirrors look kps·MPS·L(r) up in; 0: none.
 override ENVIRONMENT: u32 = 0u;
 
-const SHADOWS_OFF: u32 = 0u;
-const SHADOWS_MAP: u32 = 1u;
-const SHADOWS_PROJECTED: u32 = 2u;
-
-const TRACED_VISIBILITY: u32 = 1u;
-const TRACED_REFLECTION: u32 = 2u;
-const TRACED_COLOUR: u32 = 4u;
-const TRACED_TRANSMISSION: u32 = 8u;
-// The layers of the view's traced image.
-const TRACED_SURFACE_LAYER: i32 = 0;
-const TRACED_REFLECTION_LAYER: i32 = 1;
-const TRACED_TRANSMISSION_LAYER: i32 = 2;
-const TRACED_VISIBILITY_LAYER: i32 = 3;
-
-const BUMP_VIEW_NORMALS: u32 = 1u;
-const BUMP_VIEW_TANGENTS: u32 = 2u;
-
-const HEIGHT_NONE: u32 = 0u;
-const HEIGHT_TEXTURE: u32 = 1u;
-const HEIGHT_SINE: u32 = 2u;
-const HEIGHT_NOISE: u32 = 3u;
-
-const ENV_MAP_CUBE: u32 = 1u;
-const ENV_MAP_SPHERE: u32 = 2u;
-const ENV_MAP_LATLONG: u32 = 3u;
-const ENV_MAP_DYNAMIC: u32 = 4u;
-
 @group(0) @binding(0) var<uniform> view: View;
 @group(0) @binding(1) var<uniform> frame: Frame;
 // Bilinear, for height and normal maps (read on level 0).
@@ -310,7 +283,7 @@ fn shade_surface(in: VertexOut) -> Shaded {
     // The hybrid's terms hold at this pixel only if they were traced on this fragment's surface.
     let here = TRACED != 0u && traced_object(in.clip.xy) == in.object + 1u;
     var color = surface_color(in.uv, duv_dx, duv_dy);
-    if (TRACED & TRACED_COLOUR) != 0u && here {
+    if (TRACED & TRACED_TEXTURES) != 0u && here {
         color = traced_term(in.clip.xy, TRACED_SURFACE_LAYER);
     }
     if INSPECT {
@@ -358,8 +331,8 @@ fn shade_surface(in: VertexOut) -> Shaded {
                 probe.lights[i].lit = 1.0;
             }
             var visible: vec3f;
-            if (TRACED & TRACED_VISIBILITY) != 0u && here && light.shadow_slot >= 0 {
-                visible = traced_term(in.clip.xy, TRACED_VISIBILITY_LAYER + light.shadow_slot);
+            if (TRACED & TRACED_SHADOWS) != 0u && here && light.shadow_slot >= 0 {
+                visible = traced_term(in.clip.xy, TRACED_SHADOWS_LAYER + light.shadow_slot);
             } else {
                 visible = visibility(light, in.world, facing, in.clip.xy);
             }
@@ -391,7 +364,7 @@ fn shade_surface(in: VertexOut) -> Shaded {
         environment_radiance = select(vec3f(0.0), environment_lookup(in.world, r, in.env_layer), in.env_layer != ENV_LAYER_NONE);
         // Where the hybrid traced this surface's reflection, that is added below instead (the
         // lookup stays: glass reads it).
-        if (TRACED & TRACED_REFLECTION) == 0u || !here {
+        if (TRACED & TRACED_REFLECTIONS) == 0u || !here {
             radiance += material.reflectance * environment_radiance;
         }
         if INSPECT {
@@ -400,10 +373,10 @@ fn shade_surface(in: VertexOut) -> Shaded {
             probe.env_layer = in.env_layer;
         }
     }
-    if (TRACED & TRACED_REFLECTION) != 0u && here {
+    if (TRACED & TRACED_REFLECTIONS) != 0u && here {
         // kps·MPS·L(r), L(r) traced: in place of the mirrored camera's image and the environment
         // maps, which the frame leaves out when this is on.
-        let traced_reflection = material.reflectance * traced_term(in.clip.xy, TRACED_REFLECTION_LAYER);
+        let traced_reflection = material.reflectance * traced_term(in.clip.xy, TRACED_REFLECTIONS_LAYER);
         radiance += traced_reflection;
         if INSPECT {
             probe.mirror = traced_reflection;

@@ -1,28 +1,6 @@
 // Uniform layouts shared by every pass. The Rust twins live in src/raster/uniforms.rs; a test
 // (tests/layouts.rs) checks that each struct here has the size and field offsets of its Rust twin.
 
-const MAX_LIGHTS: u32 = 16u;
-
-const LIGHT_POINT: u32 = 0u;
-const LIGHT_DIRECTIONAL: u32 = 1u;
-const LIGHT_SPOT: u32 = 2u;
-
-const ATTENUATION_NONE: u32 = 0u;
-const ATTENUATION_INVERSE_SQUARE: u32 = 1u;
-
-// Material.alpha_mode: how coverage α (glTF's base colour alpha) is read.
-const ALPHA_OPAQUE: u32 = 0u;
-const ALPHA_MASK: u32 = 1u;
-const ALPHA_BLEND: u32 = 2u;
-
-// Bits of Frame.terms: which terms of the illumination model are drawn.
-const TERM_AMBIENT: u32 = 1u;
-const TERM_DIFFUSE: u32 = 2u;
-const TERM_SPECULAR: u32 = 4u;
-const TERM_EMISSION: u32 = 8u;
-// Not a term of the model: glass's reflection and transmission weighted by Fresnel.
-const TERM_FRESNEL: u32 = 16u;
-
 struct Light {
     position: vec3f,
     kind: u32,
@@ -148,9 +126,6 @@ struct Instance {
     // The object's index in the scene (for inspecting a pixel); u32 max where unknown.
     @location(12) object: u32,
 }
-
-const ENV_LAYER_WORLD: i32 = -1;
-const ENV_LAYER_NONE: i32 = -2;
 
 fn instance_world_from_local(i: Instance) -> mat4x4f {
     return mat4x4f(i.world_from_local_0, i.world_from_local_1, i.world_from_local_2, i.world_from_local_3);

@@ -31,7 +31,7 @@ use crate::gpu::Gpu;
 use crate::raster::Headless;
 use crate::raster::shadow::views::MAX_SHADOWED_LIGHTS;
 use crate::raster::uniforms::MAX_LIGHTS;
-use crate::settings::{HybridSettings, RenderSettings};
+use crate::settings::{HybridSettings, RenderSettings, Traced};
 
 /// Differences of up to this many levels (of 255, in every channel) are not counted: they are
 /// rounding, not an approximation (the rasterizer's radiance passes through a half-float target:
@@ -39,46 +39,6 @@ use crate::settings::{HybridSettings, RenderSettings};
 /// its own; lavapipe and libm round their last bits differently from CPU to CPU). The tests'
 /// comparisons look past the same two levels (tests/README.md).
 pub const ROUNDING_LEVELS: u8 = 2;
-
-/// One of the rasterizer's approximations with a traced counterpart.
-pub struct Approximation {
-    /// Its name in the budget's report and JSON.
-    pub name: &'static str,
-    /// What the rasterizer does, and what replaces it.
-    pub swap: &'static str,
-    /// Whether `scene` (with its settings) makes this approximation anywhere.
-    pub in_use: fn(&Scene, &RenderSettings) -> bool,
-    /// Its switch in `settings.hybrid`.
-    pub traced: fn(&mut HybridSettings) -> &mut bool,
-}
-
-/// Every approximation the budget can swap, in the order it reports them.
-pub const APPROXIMATIONS: [Approximation; 4] = [
-    Approximation {
-        name: "shadows",
-        swap: "shadow maps or projected polygons → shadow rays from the visible surface",
-        in_use: |scene, settings| settings.shadows.enabled && !scene.lights.is_empty(),
-        traced: |hybrid| &mut hybrid.shadows,
-    },
-    Approximation {
-        name: "reflections",
-        swap: "mirrored cameras and environment maps → the traced L(r)",
-        in_use: |scene, _| scene.objects.iter().any(|o| scene.materials[o.material.0].reflects()),
-        traced: |hybrid| &mut hybrid.reflections,
-    },
-    Approximation {
-        name: "transmission",
-        swap: "sorted blending and screen-space refraction → the traced transmission",
-        in_use: |scene, _| scene.objects.iter().any(|o| scene.materials[o.material.0].is_transparent()),
-        traced: |hybrid| &mut hybrid.transmission,
-    },
-    Approximation {
-        name: "texture filtering",
-        swap: "trilinear from screen derivatives → the tracer's ray-cone filtering",
-        in_use: |scene, _| scene.objects.iter().any(|o| scene.materials[o.material.0].texture.is_some()),
-        traced: |hybrid| &mut hybrid.textures,
-    },
-];
 
 /// What keeps the fully swapped frame from the tracer's image in `scene`: the approximations
 /// without a traced counterpart that it uses, and what no swap removes.
@@ -126,7 +86,7 @@ pub struct Item {
 pub struct Budget {
     /// `FLIP(R, T)`.
     pub whole: f32,
-    /// The approximations the scene uses, in [`APPROXIMATIONS`]' order.
+    /// The approximations the scene uses, in the table's order (`crate::settings::hybrid`).
     pub items: Vec<Item>,
     /// `FLIP(R+all, T)`.
     pub floor: f32,
@@ -143,12 +103,13 @@ pub struct Budget {
 pub fn budget(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, traced: RgbaImage) -> Budget {
     let mut headless = Headless::new(gpu, scene);
     let mut raster = |settings: &RenderSettings| headless.render(gpu, scene, settings);
-    let used: Vec<&Approximation> = APPROXIMATIONS.iter().filter(|a| (a.in_use)(scene, settings)).collect();
-    let with = |traced_ones: &mut dyn Iterator<Item = &&Approximation>| {
+    let facts = scene.facts();
+    let used: Vec<Traced> = Traced::ALL.iter().copied().filter(|t| (t.row().in_use)(&facts, settings)).collect();
+    let with = |traced_ones: &mut dyn Iterator<Item = &Traced>| {
         let mut settings = settings.clone();
         settings.hybrid = HybridSettings::default();
-        for a in traced_ones {
-            *(a.traced)(&mut settings.hybrid) = true;
+        for term in traced_ones {
+            *term.switch(&mut settings.hybrid) = true;
         }
         settings
     };
@@ -159,13 +120,13 @@ pub fn budget(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, traced: RgbaI
     let hybrid = raster(&with(&mut used.iter()));
     let items = used
         .iter()
-        .map(|a| {
-            let added = raster(&with(&mut std::iter::once(a)));
-            let others = raster(&with(&mut used.iter().filter(|b| b.name != a.name)));
+        .map(|term| {
+            let added = raster(&with(&mut std::iter::once(term)));
+            let others = raster(&with(&mut used.iter().filter(|other| *other != term)));
             let alone = flip(&plain, &added);
             Item {
-                name: a.name,
-                swap: a.swap,
+                name: term.row().budget,
+                swap: term.row().swap,
                 alone: alone.flip_mean,
                 left_alone: flip(&traced, &others).flip_mean,
                 error_map: alone.error_map,

@@ -16,23 +16,15 @@
 //! Other views (mirrored cameras, cube faces) draw with the plain variants, and frames that
 //! inspect nothing never compile the `INSPECT` variants: normal frames pay nothing.
 
+pub use crate::shaders::constants::{
+    INSPECT_BACKGROUND, INSPECT_ISOSURFACE, INSPECT_MIRROR, INSPECT_OPAQUE, INSPECT_REFRACTION, INSPECT_TRANSPARENT,
+    INSPECT_VOLUME, MAX_INSPECTED,
+};
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec2, Vec3};
 
 use super::uniforms::MAX_LIGHTS;
 use crate::gpu::Gpu;
-
-/// `MAX_INSPECTED` of `shaders/common/inspect.wgsl`: the records one pixel keeps.
-pub const MAX_INSPECTED: usize = 32;
-
-/// `INSPECT_*` kinds of fragment.
-pub const INSPECT_OPAQUE: u32 = 1;
-pub const INSPECT_MIRROR: u32 = 2;
-pub const INSPECT_TRANSPARENT: u32 = 3;
-pub const INSPECT_BACKGROUND: u32 = 4;
-pub const INSPECT_ISOSURFACE: u32 = 5;
-pub const INSPECT_VOLUME: u32 = 6;
-pub const INSPECT_REFRACTION: u32 = 7;
 
 /// What the depth test and the blend do with a kind of record: how it takes part in the pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

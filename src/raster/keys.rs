@@ -11,8 +11,15 @@
 use super::uniforms::alpha_mode_code;
 use crate::scene::{Material, ProceduralHeight};
 use crate::settings::{
-    BumpView, EnvironmentMap, EnvironmentSettings, HybridSettings, RenderSettings, ShadowFilter, ShadowMethod,
-    ShadowView, TangentSource, TextureFilter,
+    BumpView, EnvironmentMap, EnvironmentSettings, RenderSettings, ShadowFilter, ShadowMethod, ShadowView,
+    TangentSource, TextureFilter,
+};
+pub use crate::shaders::constants::{
+    BUMP_VIEW_NORMALS, BUMP_VIEW_TANGENTS, ENV_MAP_CUBE, ENV_MAP_DYNAMIC, ENV_MAP_LATLONG, ENV_MAP_SPHERE,
+    HEIGHT_NOISE, HEIGHT_NONE, HEIGHT_SINE, HEIGHT_TEXTURE, SHADOWS_MAP, SHADOWS_OFF, SHADOWS_PROJECTED,
+};
+use crate::shaders::constants::{
+    SHADOW_FILTER_HARDWARE, SHADOW_FILTER_NONE, SHADOW_FILTER_PCF3, SHADOW_FILTER_PCF5, SHADOW_FILTER_POISSON,
 };
 
 /// A value a pipeline constant takes (WGSL's `override`s are set as `f64`).
@@ -84,39 +91,14 @@ pipeline_constants! {
         flat_colour: bool = "FLAT_COLOUR" <- settings.raster.flat_colour,
         /// `ENV_MAP_*`: where curved mirrors look their reflection up; 0: nowhere.
         environment: u32 = "ENVIRONMENT" <- environment_code(&settings.environment),
-        /// `TRACED_*` bits: the hybrid's terms read from the view's traced image.
-        traced: u32 = "TRACED" <- traced_code(&settings.hybrid),
+        /// `TRACED_*` bits, one a row of the approximations table (`crate::settings::hybrid`): the
+        /// hybrid's terms read from the view's traced image.
+        traced: u32 = "TRACED" <- settings.hybrid.traced().0,
         /// Record what the shading computes at the inspected pixel (`shaders/common/inspect.wgsl`): the
         /// main view of an inspected frame only.
         inspect: bool = "INSPECT" <- false,
     }
 }
-
-/// `ENVIRONMENT` codes: the world's cube, its sphere map, its lat–long map, or each reflective
-/// object's own dynamic cube (the world's for objects without one).
-pub const ENV_MAP_CUBE: u32 = 1;
-pub const ENV_MAP_SPHERE: u32 = 2;
-pub const ENV_MAP_LATLONG: u32 = 3;
-pub const ENV_MAP_DYNAMIC: u32 = 4;
-
-/// `TRACED` bits (shaders/common/surface.wgsl): which of the hybrid's terms the shading reads.
-pub const TRACED_VISIBILITY: u32 = 1;
-pub const TRACED_REFLECTION: u32 = 2;
-pub const TRACED_COLOUR: u32 = 4;
-pub const TRACED_TRANSMISSION: u32 = 8;
-
-fn traced_code(hybrid: &HybridSettings) -> u32 {
-    let bit = |on: bool, bit: u32| if on { bit } else { 0 };
-    bit(hybrid.shadows, TRACED_VISIBILITY)
-        | bit(hybrid.reflections, TRACED_REFLECTION)
-        | bit(hybrid.textures, TRACED_COLOUR)
-        | bit(hybrid.transmission, TRACED_TRANSMISSION)
-}
-
-/// `SHADOW_METHOD`: no shadows at all (no light casts one, or shadows are off).
-pub const SHADOWS_OFF: u32 = 0;
-pub const SHADOWS_MAP: u32 = 1;
-pub const SHADOWS_PROJECTED: u32 = 2;
 
 /// The `SHADOW_METHOD` code: none when no light casts a shadow or shadows are off.
 fn shadow_method_code(settings: &RenderSettings, shadowed: bool) -> u32 {
@@ -150,22 +132,13 @@ pub fn environment_code(settings: &EnvironmentSettings) -> u32 {
 /// The `SHADOW_FILTER_*` code of `shaders/common/shadow.wgsl`.
 pub fn shadow_filter_code(filter: ShadowFilter) -> u32 {
     match filter {
-        ShadowFilter::None => 0,
-        ShadowFilter::Hardware => 1,
-        ShadowFilter::Pcf3x3 => 2,
-        ShadowFilter::Pcf5x5 => 3,
-        ShadowFilter::Poisson => 4,
+        ShadowFilter::None => SHADOW_FILTER_NONE,
+        ShadowFilter::Hardware => SHADOW_FILTER_HARDWARE,
+        ShadowFilter::Pcf3x3 => SHADOW_FILTER_PCF3,
+        ShadowFilter::Pcf5x5 => SHADOW_FILTER_PCF5,
+        ShadowFilter::Poisson => SHADOW_FILTER_POISSON,
     }
 }
-
-/// Every `ShadowFilter` and its code, for the test that ties them to the WGSL.
-pub const SHADOW_FILTER_NAMES: [(&str, ShadowFilter); 5] = [
-    ("SHADOW_FILTER_NONE", ShadowFilter::None),
-    ("SHADOW_FILTER_HARDWARE", ShadowFilter::Hardware),
-    ("SHADOW_FILTER_PCF3", ShadowFilter::Pcf3x3),
-    ("SHADOW_FILTER_PCF5", ShadowFilter::Pcf5x5),
-    ("SHADOW_FILTER_POISSON", ShadowFilter::Poisson),
-];
 
 pipeline_constants! {
     /// What a material brings to the shader: which textures and which height field.
@@ -189,15 +162,6 @@ fn height_kind(material: &Material) -> u32 {
         (None, None) => HEIGHT_NONE,
     }
 }
-
-/// `BUMP_VIEW_*` codes.
-pub const BUMP_VIEW_NORMALS: u32 = 1;
-pub const BUMP_VIEW_TANGENTS: u32 = 2;
-/// `HEIGHT_*` codes: where a material's bump heights come from.
-pub const HEIGHT_NONE: u32 = 0;
-pub const HEIGHT_TEXTURE: u32 = 1;
-pub const HEIGHT_SINE: u32 = 2;
-pub const HEIGHT_NOISE: u32 = 3;
 
 /// The pipeline constants of one scene-module variant: the frame's toggles and the material's.
 pub fn constants(frame: &FrameKey, material: &MaterialKey) -> Vec<(&'static str, f64)> {

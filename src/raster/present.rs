@@ -11,6 +11,7 @@ use crate::gpu::{Gpu, layout};
 use crate::output::OutputTransform;
 use crate::settings::ToneMap;
 use crate::shaders;
+use crate::shaders::constants::{TONE_MAP_ACES, TONE_MAP_CLAMP, TONE_MAP_PBR_NEUTRAL, TONE_MAP_REINHARD};
 
 pub struct PresentPass {
     pipeline: wgpu::RenderPipeline,
@@ -97,9 +98,9 @@ impl PresentPass {
 /// `TONE_MAP_*` of `shaders/present.wgsl`: the curve the shader runs.
 pub fn tone_map_code(curve: ToneMap) -> u32 {
     match curve {
-        ToneMap::Clamp => 0,
-        ToneMap::Reinhard => 1,
-        ToneMap::Aces => 2,
-        ToneMap::PbrNeutral => 3,
+        ToneMap::Clamp => TONE_MAP_CLAMP,
+        ToneMap::Reinhard => TONE_MAP_REINHARD,
+        ToneMap::Aces => TONE_MAP_ACES,
+        ToneMap::PbrNeutral => TONE_MAP_PBR_NEUTRAL,
     }
 }

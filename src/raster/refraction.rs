@@ -37,6 +37,7 @@ use std::collections::HashMap;
 
 use super::context::{Figure, FrameContext, FrameEncoder};
 use super::geometry::TransparentObject;
+pub use crate::shaders::constants::{REFRACTION_ENVIRONMENT, REFRACTION_SCREEN};
 use glam::Vec3;
 use serde::Serialize;
 
@@ -51,11 +52,6 @@ use crate::gpu::layout;
 use crate::gpu::texture::GpuTexture;
 use crate::settings::{Refraction, RenderSettings};
 use crate::shaders;
-
-/// `REFRACTION` of `shaders/refraction.wgsl`: where the light along the twice-refracted ray is
-/// read.
-pub const REFRACTION_ENVIRONMENT: u32 = 1;
-pub const REFRACTION_SCREEN: u32 = 2;
 
 pipeline_constants! {
     /// The pipeline constant the refraction pass sets besides the surface code's: where the

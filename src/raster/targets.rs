@@ -38,20 +38,16 @@ pub enum ViewImage {
     /// (`super::shadow::projected`, drawn after the view's depth prepass).
     ProjectedMask,
     /// The hybrid's traced terms at each pixel's first opaque surface (`super::traced`, copied in
-    /// before the view draws): layer [`TRACED_SURFACE`] holds `C` and the surface's object + 1,
-    /// layer [`TRACED_REFLECTION`] `L(r)`, layer [`TRACED_TRANSMISSION`] what a transparent
-    /// surface lets through, and the layers from [`TRACED_VISIBILITY`] on each shadowed light's
+    /// before the view draws): the surface layer holds `C` and the surface's object + 1, each
+    /// traced term its own layers ([`crate::settings::Traced::layer`]): `L(r)`, what a
+    /// transparent surface lets through, each shadowed light's
     /// `V_i`. Made at the targets' size only when a frame traces a term.
     Traced,
 }
 
-/// The layers of [`ViewImage::Traced`].
-pub const TRACED_SURFACE: u32 = 0;
-pub const TRACED_REFLECTION: u32 = 1;
-pub const TRACED_TRANSMISSION: u32 = 2;
-pub const TRACED_VISIBILITY: u32 = 3;
-/// Its layers: a visibility layer for each of the rasterizer's shadowed lights (four).
-pub const TRACED_LAYERS: u32 = TRACED_VISIBILITY + 4;
+/// The layers of [`ViewImage::Traced`]: the surface's, then each traced term's, numbered by the
+/// approximations table (`crate::settings::hybrid`).
+pub use crate::settings::hybrid::TRACED_LAYERS;
 
 impl ViewImage {
     /// Every view image, in the order the targets keep them.

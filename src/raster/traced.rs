@@ -19,9 +19,7 @@ use glam::{Vec2, Vec3, Vec4};
 
 use super::context::{Figure, FrameEncoder};
 use super::shadow::views::{MAX_SHADOWED_LIGHTS, ShadowLayout};
-use super::targets::{
-    FrameTargets, TRACED_LAYERS, TRACED_REFLECTION, TRACED_SURFACE, TRACED_TRANSMISSION, TRACED_VISIBILITY, ViewImage,
-};
+use super::targets::{FrameTargets, ViewImage};
 use super::view::{FrameView, View, ViewKind, ViewSlot};
 use crate::base::Ray;
 use crate::scene::{Camera, Scene};
@@ -30,39 +28,17 @@ use crate::texture::RayCone;
 use crate::trace::Tracer;
 use crate::trace::terms::{TracedTerms, ViewRays, Wanted};
 
-const _: () = assert!(TRACED_LAYERS as usize == TRACED_VISIBILITY as usize + MAX_SHADOWED_LIGHTS);
 const _: () = assert!(crate::trace::terms::MAX_SLOTS == MAX_SHADOWED_LIGHTS);
 
 /// The terms `settings` asks to trace, or `None`.
 pub fn wanted(settings: &RenderSettings) -> Option<Wanted> {
-    let hybrid = &settings.hybrid;
-    let wanted = Wanted {
-        visibility: hybrid.shadows && settings.shadows.enabled,
-        reflection: hybrid.reflections,
-        transmission: hybrid.transmission,
-        colour: hybrid.textures,
-    };
-    (wanted != Wanted::default()).then_some(wanted)
+    Some(settings.hybrid.traced()).filter(|wanted| !wanted.is_empty())
 }
 
-/// The settings the rasterizer's own passes draw with: what a traced term replaces is left out.
-/// Traced reflections replace the mirrored cameras (the environment maps stay: glass reads them,
-/// and the opaque surfaces the terms were traced on skip their lookup, `TRACED_REFLECTION` in
-/// shaders/common/surface.wgsl); traced transmission replaces the transparency pass and
-/// refraction (transparent surfaces are then drawn with the opaque ones, each adding what the
-/// tracer says it lets through).
+/// The settings the rasterizer's own passes draw with: what each traced term replaces left out
+/// (each row of the approximations table says what, `crate::settings::hybrid`).
 pub fn raster_settings(settings: &RenderSettings) -> Option<RenderSettings> {
-    let hybrid = &settings.hybrid;
-    (hybrid.reflections || hybrid.transmission).then(|| {
-        let mut raster = settings.clone();
-        if hybrid.reflections {
-            raster.mirrors.enabled = false;
-        }
-        if hybrid.transmission {
-            raster.transparency.enabled = false;
-        }
-        raster
-    })
+    settings.hybrid.raster_settings(settings)
 }
 
 /// Every view's traced terms, ready to be copied into its image: each view's buffer holds the
@@ -151,10 +127,7 @@ fn padded_row(width: u32) -> u32 {
 
 /// The terms traced, layer after layer, each row padded; and each one's layer in the image.
 fn upload(device: &wgpu::Device, terms: &TracedTerms) -> Upload {
-    let mut layers: Vec<(u32, &[[f32; 4]])> = vec![(TRACED_SURFACE, &terms.surface)];
-    layers.extend(terms.reflection.as_deref().map(|r| (TRACED_REFLECTION, r)));
-    layers.extend(terms.transmission.as_deref().map(|t| (TRACED_TRANSMISSION, t)));
-    layers.extend(terms.visibility.iter().enumerate().map(|(slot, v)| (TRACED_VISIBILITY + slot as u32, &v[..])));
+    let layers = &terms.layers;
     let [_, _, width, height] = terms.window;
     let row = padded_row(width) as usize;
     let layer_bytes = row * height as usize;

@@ -8,26 +8,13 @@ use glam::{Mat3, Mat4, Vec3};
 use crate::scene::{AlphaMode, Attenuation, Light, LightKind, Material, ProceduralHeight};
 use crate::settings::RenderSettings;
 
-pub const MAX_LIGHTS: usize = 16;
-
-/// The most objects with a dynamic environment cube of their own (six views each); the others
-/// reflect the world's.
-pub const MAX_ENV_CUBES: usize = 8;
-
-/// `Light.kind` codes (`LIGHT_*` in `shaders/common/types.wgsl`).
-pub const LIGHT_POINT: u32 = 0;
-pub const LIGHT_DIRECTIONAL: u32 = 1;
-pub const LIGHT_SPOT: u32 = 2;
-/// `Light.attenuation` codes (`ATTENUATION_*`).
-pub const ATTENUATION_NONE: u32 = 0;
-pub const ATTENUATION_INVERSE_SQUARE: u32 = 1;
-/// Bits of `Frame.terms` (`TERM_*`).
-pub const TERM_AMBIENT: u32 = 1;
-pub const TERM_DIFFUSE: u32 = 2;
-pub const TERM_SPECULAR: u32 = 4;
-pub const TERM_EMISSION: u32 = 8;
-/// Not a term of the model: glass's reflection and transmission weighted by Fresnel.
-pub const TERM_FRESNEL: u32 = 16;
+/// The codes and sizes the uniforms share with the WGSL, defined once in `crate::shaders::constants`.
+pub use crate::shaders::constants::{
+    ALPHA_BLEND, ALPHA_MASK, ALPHA_OPAQUE, ATTENUATION_INVERSE_SQUARE, ATTENUATION_NONE, ENV_CUBE, ENV_LATLONG,
+    ENV_LAYER_NONE, ENV_LAYER_WORLD, ENV_NONE, ENV_SKY, ENV_SPHERE, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPOT,
+    MAX_ENV_CUBES, MAX_LIGHTS, PARALLAX_BOX, PARALLAX_GROUND, PARALLAX_INFINITE, TERM_AMBIENT, TERM_DIFFUSE,
+    TERM_EMISSION, TERM_FRESNEL, TERM_SPECULAR,
+};
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
@@ -150,11 +137,6 @@ pub struct GpuMaterial {
     pub _pad: [f32; 3],
 }
 
-/// `ALPHA_*` codes: how a material's coverage is read.
-pub const ALPHA_OPAQUE: u32 = 0;
-pub const ALPHA_MASK: u32 = 1;
-pub const ALPHA_BLEND: u32 = 2;
-
 pub fn alpha_mode_code(mode: AlphaMode) -> u32 {
     match mode {
         AlphaMode::Opaque => ALPHA_OPAQUE,
@@ -214,11 +196,6 @@ impl Material {
     }
 }
 
-/// `Instance.env_layer` of objects that look the world's environment up.
-pub const ENV_LAYER_WORLD: i32 = -1;
-/// `Instance.env_layer` of objects that look nothing up (planar mirrors).
-pub const ENV_LAYER_NONE: i32 = -2;
-
 /// Per object: its transforms, as instance attributes (vertex buffer 1, `Instance` in
 /// `shaders/common/types.wgsl`).
 #[repr(C)]
@@ -275,13 +252,6 @@ pub struct GpuView {
     pub clip_from_reflected: [[f32; 4]; 4],
 }
 
-/// `Environment.source` codes (`ENV_*` in `shaders/common/environment.wgsl`).
-pub const ENV_NONE: u32 = 0;
-pub const ENV_SKY: u32 = 1;
-pub const ENV_LATLONG: u32 = 2;
-pub const ENV_CUBE: u32 = 3;
-pub const ENV_SPHERE: u32 = 4;
-
 /// The world's environment and the sphere map's rotations (`Environment` in
 /// `shaders/common/environment.wgsl`).
 #[repr(C)]
@@ -311,11 +281,6 @@ pub struct GpuEnvironment {
     /// Each dynamic cube's centre, where its six views were drawn from.
     pub cube_centres: [[f32; 4]; MAX_ENV_CUBES],
 }
-
-/// `Environment.parallax`: where a dynamic cube's lookup assumes the ray ends.
-pub const PARALLAX_INFINITE: u32 = 0;
-pub const PARALLAX_GROUND: u32 = 1;
-pub const PARALLAX_BOX: u32 = 2;
 
 /// A 3×3 matrix as WGSL's `mat3x3f` lays it out: columns of four floats.
 pub fn mat3_columns(m: Mat3) -> [[f32; 4]; 3] {

@@ -43,6 +43,9 @@ use crate::gpu::uniform::UniformBuffer;
 use crate::scene::Scene;
 use crate::settings::{VOLUME_SAMPLES_WHITE, VolumeGradient, VolumeReconstruction, VolumeSettings, VolumeView};
 use crate::shaders;
+use crate::shaders::constants::{
+    VOLUME_GRADIENT_CENTRAL, VOLUME_GRADIENT_FORWARD, VOLUME_GRADIENT_OFF, VOLUME_VIEW_SAMPLES,
+};
 use crate::volume::transfer::TABLE_SIZE;
 use crate::volume::{Grid, Reconstruction, Rendering, Volume};
 
@@ -78,18 +81,12 @@ pipeline_constants! {
     }
 }
 
-/// `VOLUME_GRADIENT` codes.
-pub const VOLUME_GRADIENT_NAMES: [(&str, VolumeGradient); 3] = [
-    ("VOLUME_GRADIENT_OFF", VolumeGradient::Off),
-    ("VOLUME_GRADIENT_FORWARD", VolumeGradient::Forward),
-    ("VOLUME_GRADIENT_CENTRAL", VolumeGradient::Central),
-];
-
+/// The `VOLUME_GRADIENT_*` code of `gradient`.
 pub fn gradient_code(gradient: VolumeGradient) -> u32 {
     match gradient {
-        VolumeGradient::Off => 0,
-        VolumeGradient::Forward => 1,
-        VolumeGradient::Central => 2,
+        VolumeGradient::Off => VOLUME_GRADIENT_OFF,
+        VolumeGradient::Forward => VOLUME_GRADIENT_FORWARD,
+        VolumeGradient::Central => VOLUME_GRADIENT_CENTRAL,
     }
 }
 
@@ -157,7 +154,7 @@ impl VolumeGpu {
             iso: volume.iso,
             termination: if settings.early_termination { settings.threshold } else { 2.0 },
             opacity_correction: u32::from(settings.opacity_correction),
-            view: u32::from(settings.view == VolumeView::Samples),
+            view: if settings.view == VolumeView::Samples { VOLUME_VIEW_SAMPLES } else { 0 },
             samples_white: VOLUME_SAMPLES_WHITE as f32,
         }
     }

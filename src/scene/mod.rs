@@ -37,7 +37,7 @@ pub use mesh::Mesh;
 pub type ModelImport = gltf::GltfImport;
 
 use crate::base::MaterialId;
-use crate::settings::RenderSettings;
+use crate::settings::{RenderSettings, SceneFacts};
 
 /// The geometry of an object, in its local coordinates.
 #[derive(Clone, Debug, PartialEq)]
@@ -196,6 +196,18 @@ impl Scene {
             Shape::RoundedBox { half, radius } => {
                 Cow::Owned(Mesh::rounded_box(half, radius, self.settings.sphere_segments))
             }
+        }
+    }
+
+    /// What the approximations table asks of the scene to say which approximations it makes
+    /// (`crate::settings::hybrid`).
+    pub fn facts(&self) -> SceneFacts {
+        let material = |o: &Object| &self.materials[o.material.0];
+        SceneFacts {
+            lights: self.lights.len(),
+            reflective: self.objects.iter().any(|o| material(o).reflects()),
+            transparent: self.objects.iter().any(|o| material(o).is_transparent()),
+            textured: self.objects.iter().any(|o| material(o).texture.is_some()),
         }
     }
 

@@ -18,7 +18,7 @@ pub mod field;
 
 mod bump;
 mod environment;
-mod hybrid;
+pub mod hybrid;
 mod mirrors;
 mod raster;
 mod shadows;
@@ -30,10 +30,10 @@ mod volume;
 
 pub use bump::{BumpSettings, BumpView, TangentSource};
 pub use environment::{EnvironmentMap, EnvironmentSettings, EnvironmentView, Parallax, SphereView};
-pub use hybrid::{HybridSettings, TRACED_CHOICES};
+pub use hybrid::{APPROXIMATIONS, Approximation, HybridSettings, SceneFacts, Traced, TracedSet};
 pub use mirrors::{MAX_MIRROR_DEPTH, MirrorSettings, MirrorView};
 pub use raster::{Prepass, RasterSettings};
-pub use shadows::{ShadowFilter, ShadowFit, ShadowMethod, ShadowSettings, ShadowView};
+pub use shadows::{MAX_SHADOWED_LIGHTS, ShadowFilter, ShadowFit, ShadowMethod, ShadowSettings, ShadowView};
 pub use terms::TermSettings;
 pub use textures::{TextureFilter, TextureSettings, TracerLod};
 pub use trace::{AccelKind, AntiAliasing, TraceSettings};

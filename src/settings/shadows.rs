@@ -3,6 +3,9 @@
 
 use super::field::{choices, section};
 
+/// At most this many lights cast shadows in the rasterizer; the others light everything they face.
+pub const MAX_SHADOWED_LIGHTS: usize = 4;
+
 section! {
     /// How both renderers find the visibility `V_i` of each light.
     #[derive(Copy)]

@@ -81,8 +81,8 @@ impl Filter {
 }
 
 /// One colour per mip level for the level-colour view, linear RGB: red, orange, yellow, green,
-/// cyan, blue, magenta, then grey for level 7 and every smaller level. The WGSL twin is
-/// `MIP_LEVEL_PALETTE` in `shaders/common/bump.wgsl`.
+/// cyan, blue, magenta, then grey for level 7 and every smaller level. Written into the WGSL as
+/// `MIP_LEVEL_PALETTE` (`crate::shaders::constants::prelude`).
 pub const LEVEL_PALETTE: [Vec3; 8] = [
     Vec3::new(1.0, 0.0, 0.0),
     Vec3::new(1.0, 0.5, 0.0),

@@ -36,16 +36,12 @@ use super::geometry::SurfaceHit;
 use super::whitted::{RayCounts, surface_offset};
 use crate::base::Ray;
 use crate::scene::shading::{facing_viewer, lights_surface};
+use crate::settings::hybrid::{SURFACE_LAYER, TRACED_LAYERS};
+use crate::settings::{Traced, TracedSet};
 use crate::texture::RayCone;
 
-/// Which terms to trace.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Wanted {
-    pub visibility: bool,
-    pub reflection: bool,
-    pub transmission: bool,
-    pub colour: bool,
-}
+/// Which terms to trace: a set of the approximations table's rows.
+pub type Wanted = TracedSet;
 
 /// One view of the raster frame, as the tracer looks through it.
 pub struct ViewRays<'a> {
@@ -69,60 +65,31 @@ pub struct ViewRays<'a> {
     pub stride: u32,
 }
 
-/// The most shadowed lights whose visibility is traced (the rasterizer's four).
-pub const MAX_SLOTS: usize = 4;
+/// The most shadowed lights whose visibility is traced: a layer each.
+pub const MAX_SLOTS: usize = Traced::Shadows.row().layers as usize;
 
-/// The traced terms of one view's window, row by row, four floats a pixel; a term not asked for
-/// is `None` (visibility: empty).
+/// The traced terms of one view's window, row by row, four floats a pixel, as the layers of the
+/// view's traced image they fill: the surface's, then those of each term asked for (of the
+/// visibility, a layer per slot).
 pub struct TracedTerms {
     /// The window of the view's image the terms cover: `[x, y, width, height]`.
     pub window: [u32; 4],
-    /// `C` and `object + 1` (0: no surface).
-    pub surface: Vec<[f32; 4]>,
-    /// `L(r)` (0 where the surface is no mirror).
-    pub reflection: Option<Vec<[f32; 4]>>,
-    /// What a transparent surface lets through (0 on others).
-    pub transmission: Option<Vec<[f32; 4]>>,
-    /// `V_i` of each slot's light.
-    pub visibility: Vec<Vec<[f32; 4]>>,
+    /// Each layer traced, and its values: layer [`SURFACE_LAYER`] holds `C` and `object + 1`
+    /// (0: no surface); the others are each term's ([`Traced::layer`]).
+    pub layers: Vec<(u32, Vec<[f32; 4]>)>,
     /// The rays traced, for the frame's figures.
     pub rays: RayCounts,
 }
 
-/// One pixel's terms.
-#[derive(Clone, Copy)]
-struct Pixel {
-    surface: [f32; 4],
-    reflection: [f32; 4],
-    transmission: [f32; 4],
-    visibility: [[f32; 4]; MAX_SLOTS],
-}
-
-impl Default for Pixel {
-    fn default() -> Pixel {
-        Pixel { surface: [0.0; 4], reflection: [0.0; 4], transmission: [0.0; 4], visibility: [[1.0; 4]; MAX_SLOTS] }
+impl TracedTerms {
+    /// The values of layer `layer`, if it was traced.
+    pub fn layer(&self, layer: u32) -> Option<&[[f32; 4]]> {
+        self.layers.iter().find(|(l, _)| *l == layer).map(|(_, values)| &values[..])
     }
 }
 
-/// One layer of [`TracedTerms`].
-#[derive(Clone, Copy)]
-enum Layer {
-    Surface,
-    Reflection,
-    Transmission,
-    Visibility(usize),
-}
-
-impl Layer {
-    fn of(self, pixel: &Pixel) -> [f32; 4] {
-        match self {
-            Layer::Surface => pixel.surface,
-            Layer::Reflection => pixel.reflection,
-            Layer::Transmission => pixel.transmission,
-            Layer::Visibility(slot) => pixel.visibility[slot],
-        }
-    }
-}
+/// One pixel's terms, by layer of the traced image.
+struct Pixel([[f32; 4]; TRACED_LAYERS as usize]);
 
 impl Tracer<'_> {
     /// The terms `wanted` at every pixel of `view`'s window.
@@ -131,14 +98,15 @@ impl Tracer<'_> {
         let [x0, y0, w, h] = view.window;
         let (x1, y1) = ((x0 + w).min(width), (y0 + h).min(height));
         let (x0, y0) = (x0.min(x1), y0.min(y1));
-        let slots = if wanted.visibility { view.lights.len().min(MAX_SLOTS) } else { 0 };
+        let slots = if wanted.contains(Traced::Shadows) { view.lights.len().min(MAX_SLOTS) } else { 0 };
         let stride = view.stride.max(1);
         // The layers asked for, each row holding them one after another: no image of whole
         // pixels is made.
-        let mut layers = vec![Layer::Surface];
-        layers.extend(wanted.reflection.then_some(Layer::Reflection));
-        layers.extend(wanted.transmission.then_some(Layer::Transmission));
-        layers.extend((0..slots).map(Layer::Visibility));
+        let mut layers = vec![SURFACE_LAYER];
+        for &term in Traced::ALL.iter().filter(|&&t| wanted.contains(t)) {
+            let count = if term == Traced::Shadows { slots as u32 } else { term.row().layers };
+            layers.extend(term.layer()..term.layer() + count);
+        }
         // The traced rows and columns: the first of each block.
         let row_width = (x1 - x0).div_ceil(stride) as usize;
         let traced_rows: Vec<(Vec<[f32; 4]>, RayCounts)> = (y0..y1)
@@ -150,8 +118,8 @@ impl Tracer<'_> {
                 let mut row = vec![[0.0; 4]; row_width * layers.len()];
                 for (i, x) in (x0..x1).step_by(stride as usize).enumerate() {
                     let pixel = self.pixel_terms(view, (x, y), wanted, slots, &mut counts);
-                    for (k, layer) in layers.iter().enumerate() {
-                        row[k * row_width + i] = layer.of(&pixel);
+                    for (k, &layer) in layers.iter().enumerate() {
+                        row[k * row_width + i] = pixel.0[layer as usize];
                     }
                 }
                 (row, counts)
@@ -162,23 +130,19 @@ impl Tracer<'_> {
             all
         });
         // Each layer in turn, every pixel given its block's terms.
-        let mut images = (0..layers.len()).map(|k| {
-            let mut values = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-            for y in 0..y1 - y0 {
-                let row = &traced_rows[(y / stride) as usize].0[k * row_width..][..row_width];
-                values.extend((0..x1 - x0).map(|x| row[(x / stride) as usize]));
-            }
-            values
-        });
-        let mut next = || images.next().expect("one image a layer");
-        TracedTerms {
-            window: [x0, y0, x1 - x0, y1 - y0],
-            surface: next(),
-            reflection: wanted.reflection.then(&mut next),
-            transmission: wanted.transmission.then(&mut next),
-            visibility: (0..slots).map(|_| next()).collect(),
-            rays,
-        }
+        let layers = layers
+            .iter()
+            .enumerate()
+            .map(|(k, &layer)| {
+                let mut values = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+                for y in 0..y1 - y0 {
+                    let row = &traced_rows[(y / stride) as usize].0[k * row_width..][..row_width];
+                    values.extend((0..x1 - x0).map(|x| row[(x / stride) as usize]));
+                }
+                (layer, values)
+            })
+            .collect();
+        TracedTerms { window: [x0, y0, x1 - x0, y1 - y0], layers, rays }
     }
 
     fn pixel_terms(
@@ -189,11 +153,12 @@ impl Tracer<'_> {
         slots: usize,
         counts: &mut RayCounts,
     ) -> Pixel {
-        let mut pixel = Pixel::default();
+        let mut pixel = Pixel([[0.0; 4]; TRACED_LAYERS as usize]);
         let Some((ray, start)) = (view.ray)(x as f32 + 0.5, y as f32 + 0.5) else { return pixel };
         counts.primary += 1;
         let cone = view.cone.continued(start);
-        let Some((hit, ray, cone)) = self.first_surface(&ray, cone, view.skip, !wanted.transmission) else {
+        let opaque = !wanted.contains(Traced::Transmission);
+        let Some((hit, ray, cone)) = self.first_surface(&ray, cone, view.skip, opaque) else {
             return pixel;
         };
         let whitted = &self.whitted;
@@ -201,24 +166,26 @@ impl Tracer<'_> {
         let v = -ray.direction;
         let outside = facing_viewer(hit.geometric_normal, v);
         let offset = surface_offset(hit.point);
-        let colour = if wanted.colour {
+        let colour = if wanted.contains(Traced::Textures) {
             whitted.textures.colour(material, &hit, ray.direction, &cone, &whitted.texture_settings)
         } else {
             Vec3::ZERO
         };
-        pixel.surface = [colour.x, colour.y, colour.z, hit.object as f32 + 1.0];
-        if !(wanted.visibility || wanted.reflection || wanted.transmission) {
+        pixel.0[SURFACE_LAYER as usize] = [colour.x, colour.y, colour.z, hit.object as f32 + 1.0];
+        if wanted == TracedSet(Traced::Textures.bit()) {
             return pixel;
         }
         let n = whitted.shading_normal(material, &hit, v);
-        if wanted.visibility {
+        if wanted.contains(Traced::Shadows) {
+            let first = Traced::Shadows.layer() as usize;
             for (slot, &light) in view.lights.iter().enumerate().take(slots) {
+                pixel.0[first + slot] = [1.0; 4];
                 let Some(incidence) = self.scene.lights.get(light).and_then(|l| l.incidence(hit.point)) else {
                     continue;
                 };
                 // A light the tracer does not add here (behind the surface, no ambient term) is
                 // weighted 0, with no ray cast.
-                pixel.visibility[slot] = if lights_surface(n, incidence.l, material.ka, whitted.terms) {
+                pixel.0[first + slot] = if lights_surface(n, incidence.l, material.ka, whitted.terms) {
                     let origin = hit.point + offset * outside;
                     whitted.visibility(origin, incidence.l, incidence.distance, counts).extend(1.0).into()
                 } else {
@@ -226,13 +193,14 @@ impl Tracer<'_> {
                 };
             }
         }
-        if wanted.reflection && material.reflects() && whitted.max_depth > 0 {
+        if wanted.contains(Traced::Reflections) && material.reflects() && whitted.max_depth > 0 {
             let radiance =
                 whitted.reflected((&hit, n, v), cone.continued(hit.t), 0, (counts, &mut Unobserved), (Vec3::ONE, ""));
-            pixel.reflection = radiance.extend(1.0).into();
+            pixel.0[Traced::Reflections.layer() as usize] = radiance.extend(1.0).into();
         }
-        if wanted.transmission && material.is_transparent() {
-            pixel.transmission = self.transmitted((&ray, cone), (&hit, n), counts).extend(1.0).into();
+        if wanted.contains(Traced::Transmission) && material.is_transparent() {
+            let through = self.transmitted((&ray, cone), (&hit, n), counts);
+            pixel.0[Traced::Transmission.layer() as usize] = through.extend(1.0).into();
         }
         pixel
     }

@@ -12,7 +12,7 @@
 use egui::collapsing_header::CollapsingState;
 
 use crate::RenderSettings;
-use crate::settings::TRACED_CHOICES;
+use crate::settings::HybridSettings;
 use crate::settings_doc::{FieldDoc, describe};
 
 /// The name a key shows: its last part, words separated (`shadows.map_size` → "map size").
@@ -43,7 +43,7 @@ pub fn settings_ui(ui: &mut egui::Ui, settings: &RenderSettings) -> Vec<String> 
     }
     for (name, value) in &table {
         if let toml::Value::Table(section) = value {
-            let traced = TRACED_CHOICES.iter().find(|(s, _)| s == name).map(|(_, switch)| *switch);
+            let traced = HybridSettings::choice_of(name);
             let traced = traced.and_then(|switch| Some((switch, table.get("hybrid")?.get(switch)?.as_bool()?)));
             section_ui(ui, name, section, traced, &mut changes);
         }

@@ -20,10 +20,9 @@ use glam::{Mat4, Vec3, Vec4};
 use crate::scene::{LightKind, Scene};
 use crate::settings::{ShadowFit, ShadowSettings};
 
-/// At most this many lights cast shadows; the others light everything they face.
-pub const MAX_SHADOWED_LIGHTS: usize = 4;
+pub use crate::settings::MAX_SHADOWED_LIGHTS;
 /// Six layers for each point light.
-pub const MAX_LAYERS: usize = 6 * MAX_SHADOWED_LIGHTS;
+pub const MAX_LAYERS: usize = crate::shaders::constants::MAX_SHADOW_LAYERS;
 
 /// Extra field of view of each cube face, in map texels on each side.
 const CUBE_MARGIN_TEXELS: f32 = 3.0;
