@@ -7,7 +7,7 @@
 mod common;
 
 use mirador::Scene;
-use mirador::settings::RenderSettings;
+use mirador::settings::{RenderSettings, Traced};
 
 /// `scene` drawn at most `width` pixels wide, its aspect kept.
 fn smaller(mut scene: Scene, width: u32) -> Scene {
@@ -19,10 +19,17 @@ fn smaller(mut scene: Scene, width: u32) -> Scene {
     scene
 }
 
+/// `settings` with every row of the approximations table traced.
 fn every_term_traced(settings: &RenderSettings) -> RenderSettings {
+    traced(settings, Traced::ALL)
+}
+
+/// `settings` with `terms` traced.
+fn traced(settings: &RenderSettings, terms: &[Traced]) -> RenderSettings {
     let mut hybrid = settings.clone();
-    let h = &mut hybrid.hybrid;
-    (h.shadows, h.reflections, h.transmission, h.textures) = (true, true, true, true);
+    for term in terms {
+        *term.switch(&mut hybrid.hybrid) = true;
+    }
     hybrid
 }
 
@@ -98,4 +105,30 @@ fn coarse_traced_terms_are_the_full_terms_of_each_blocks_first_pixel() {
         coarse.rays.primary,
         full.rays.primary
     );
+}
+
+/// The lights past the fourth, traced (the approximations table's row added to show what a new
+/// row costs: the row, the tracer's term, the shading's branch). The shadow scene with four point
+/// lights more above it: the rasterizer shadows the key, the fill and the first two, and draws
+/// the last two as if nothing stood in their way, so their light shows through the casters; with
+/// the shadows and the lights past the fourth traced, the frame is the tracer's image again.
+#[test]
+fn the_lights_past_the_fourth_traced_cast_their_shadows() {
+    let mut scene = smaller(common::load("scenes/shadows.toml"), 200);
+    let key = scene.lights[0].clone();
+    for (k, position) in [[-2.5, 4.0, 2.0], [2.5, 4.0, 2.0], [0.0, 4.5, -0.5], [3.5, 2.5, 3.0]].into_iter().enumerate() {
+        let mut light = key.clone();
+        light.name = format!("point {k}");
+        light.kind = mirador::scene::LightKind::Point { position: position.into() };
+        light.intensity = 0.12;
+        scene.lights.push(light);
+    }
+    assert!((Traced::Lights.row().in_use)(&scene.facts(), &scene.settings), "six lights: the row is in use");
+    let tracer = mirador::trace::render_image(&scene, &scene.settings);
+    let flip = |terms: &[Traced]| common::flip(&tracer, &common::raster(&scene, &traced(&scene.settings, terms)));
+    let (shadows, lights) = (flip(&[Traced::Shadows]), flip(&[Traced::Shadows, Traced::Lights]));
+    eprintln!("shadows traced {shadows:.4}, and the lights past the fourth {lights:.4}");
+    // Measured on lavapipe: see tests/README.md.
+    assert!(lights < 0.003, "the lights past the fourth traced vs the tracer: FLIP {lights}");
+    assert!(shadows > 4.0 * lights, "without the row the two unshadowed lights show: {shadows} against {lights}");
 }

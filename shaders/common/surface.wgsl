@@ -320,10 +320,12 @@ fn shade_surface(in: VertexOut) -> Shaded {
         probe.global_ambient = select(vec3f(0.0), frame.ambient * surface.kd * surface.color, (frame.terms & TERM_AMBIENT) != 0u);
     }
     var checker = -1.0;
+    // The hybrid's traced lights: where traced, the lights without a shadow map are the tracer's.
+    let traced_lights = (TRACED & TRACED_LIGHTS) != 0u && here;
     for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {
         let light = frame.lights[i];
         let incidence = light_incidence(light, in.world);
-        if incidence.valid {
+        if incidence.valid && !(traced_lights && light.shadow_slot < 0) {
             let facing = select(-n, n, dot(n, incidence.l) >= 0.0);
             if INSPECT {
                 probe_light = i;
@@ -352,6 +354,9 @@ fn shade_surface(in: VertexOut) -> Shaded {
                 checker = shadow_texel_checker(shadow_coordinates(shadows.layers[layer].clip_from_world, in.world).xy, shadows.map_size);
             }
         }
+    }
+    if traced_lights {
+        radiance += traced_term(in.clip.xy, TRACED_LIGHTS_LAYER);
     }
     if checker >= 0.0 {
         radiance *= mix(0.55, 1.0, checker);

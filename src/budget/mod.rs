@@ -29,7 +29,6 @@ use crate::Scene;
 use crate::compare::difference_beyond;
 use crate::gpu::Gpu;
 use crate::raster::Headless;
-use crate::raster::shadow::views::MAX_SHADOWED_LIGHTS;
 use crate::raster::uniforms::MAX_LIGHTS;
 use crate::settings::{HybridSettings, RenderSettings, Traced};
 
@@ -52,10 +51,6 @@ pub fn unswapped(scene: &Scene, settings: &RenderSettings) -> Vec<&'static str> 
         if settings.shadows.enabled {
             causes.push("volumes' shadows (isosurfaces, volume.shadows): shadow maps, not traced");
         }
-    }
-    let shadowed = scene.lights.len().min(MAX_LIGHTS);
-    if settings.shadows.enabled && shadowed > MAX_SHADOWED_LIGHTS {
-        causes.push("lights past the fourth: the rasterizer shadows four, the tracer every light");
     }
     if scene.lights.len() > MAX_LIGHTS {
         causes.push("lights past the sixteenth: the rasterizer draws sixteen");

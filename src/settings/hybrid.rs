@@ -170,6 +170,18 @@ approximations! {
         // `C` shares the surface layer (layer 0) with the object every term is traced on.
         layers: 0,
     },
+    /// The lights past the fourth, traced: the rasterizer shadows four lights and draws the
+    /// others (up to its sixteen) as if nothing stood in their way; traced, their whole direct
+    /// term `Σ V_i·S_i ⊗ (ka·C + kd·C·max(0, n·l) + ks·Sc·max(0, r·v)^e)` comes from the tracer,
+    /// shadow rays and all.
+    lights: Lights {
+        budget: "lights past the fourth",
+        swap: "the lights past the fourth drawn unshadowed → their light traced, shadow rays and all",
+        sections: &[],
+        in_use: |scene, settings| settings.shadows.enabled && scene.lights > super::MAX_SHADOWED_LIGHTS,
+        replaces: |_| {},
+        layers: 1,
+    },
 }
 
 /// The layer of a view's traced image that holds the surface colour `C` and the object + 1 the
@@ -276,7 +288,7 @@ mod tests {
     #[test]
     fn bits_and_layers_are_numbered_from_the_rows() {
         assert_eq!(Traced::Shadows.bit(), 1);
-        assert_eq!(Traced::Textures.bit(), 1 << (APPROXIMATIONS.len() - 1));
+        assert_eq!(Traced::Lights.bit(), 1 << (APPROXIMATIONS.len() - 1));
         assert_eq!(Traced::Shadows.layer(), SURFACE_LAYER + 1);
         for pair in Traced::ALL.windows(2) {
             assert_eq!(pair[1].layer(), pair[0].layer() + pair[0].row().layers);

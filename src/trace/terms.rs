@@ -17,6 +17,8 @@
 //! - **transmission**: what a transparent surface lets through, as the tracer adds it to the
 //!   surface's own `α·Im`: `α·((1 − F)·kt·MT·L(t) + F·kt·MT·L(r)) + (1 − α)·L(behind)` (without
 //!   Fresnel `F = 0`; on total internal reflection all of `kt·MT` is reflected);
+//! - **lights**: the direct light of the lights the rasterizer draws without a shadow map (past
+//!   the fourth shadowed, up to its sixteen), each weighted by its shadow ray's `V_i`;
 //! - **colour**: `C`, the material's colour times its texture filtered over the ray cone's
 //!   footprint, and the surface's object, so the shading uses the traced terms only on the
 //!   surface they were traced on.
@@ -35,7 +37,8 @@ use super::explain::Unobserved;
 use super::geometry::SurfaceHit;
 use super::whitted::{RayCounts, surface_offset};
 use crate::base::Ray;
-use crate::scene::shading::{facing_viewer, lights_surface};
+use crate::scene::shading::{SurfaceSample, direct, facing_viewer, lights_surface};
+use crate::shaders::constants::MAX_LIGHTS;
 use crate::settings::hybrid::{SURFACE_LAYER, TRACED_LAYERS};
 use crate::settings::{Traced, TracedSet};
 use crate::texture::RayCone;
@@ -202,7 +205,40 @@ impl Tracer<'_> {
             let through = self.transmitted((&ray, cone), (&hit, n), counts);
             pixel.0[Traced::Transmission.layer() as usize] = through.extend(1.0).into();
         }
+        if wanted.contains(Traced::Lights) {
+            let light = self.unshadowed_light((&ray, cone), (&hit, n), view.lights, counts);
+            pixel.0[Traced::Lights.layer() as usize] = light.extend(1.0).into();
+        }
         pixel
+    }
+
+    /// The direct light of the lights the rasterizer draws without a shadow (of its first
+    /// [`MAX_LIGHTS`], those not in `shadowed`), as [`super::whitted`] adds it: each weighted by
+    /// its shadow ray's `V_i`.
+    fn unshadowed_light(
+        &self,
+        (ray, cone): (&Ray, RayCone),
+        (hit, n): (&SurfaceHit, Vec3),
+        shadowed: &[usize],
+        counts: &mut RayCounts,
+    ) -> Vec3 {
+        let whitted = &self.whitted;
+        let material = &self.scene.materials[hit.material.0];
+        let colour = whitted.textures.colour(material, hit, ray.direction, &cone, &whitted.texture_settings);
+        let sample = SurfaceSample::new(material, colour);
+        let v = -ray.direction;
+        let origin = hit.point + surface_offset(hit.point) * facing_viewer(hit.geometric_normal, v);
+        let mut light = Vec3::ZERO;
+        for (index, source) in self.scene.lights.iter().enumerate().take(MAX_LIGHTS) {
+            let Some(incidence) = source.incidence(hit.point).filter(|_| !shadowed.contains(&index)) else {
+                continue;
+            };
+            if lights_surface(n, incidence.l, sample.ka, whitted.terms) {
+                let visibility = whitted.visibility(origin, incidence.l, incidence.distance, counts);
+                light += visibility * direct(&sample, n, v, &incidence, whitted.terms);
+            }
+        }
+        light
     }
 
     /// What the transparent surface `hit` lets through, as [`super::whitted`] adds it to the
