@@ -170,6 +170,42 @@ fn no_function_in_src_runs_over_100_lines() {
     assert!(long.is_empty(), "functions over {MAX_LINES} lines:\n{}", long.join("\n"));
 }
 
+/// The WGSL is held to the same limit, and the shading of a surface, which every technique
+/// reaches into, to 80 lines: each technique's part in a function of its own
+/// (`shaders/common/surface.wgsl`).
+#[test]
+fn no_wgsl_function_runs_over_100_lines_and_the_shading_over_80() {
+    let mut files = Vec::new();
+    let mut folders = vec![Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders")];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).expect("the shaders folder") {
+            let path = entry.expect("an entry").path();
+            if path.is_dir() {
+                folders.push(path);
+            } else if path.extension().is_some_and(|e| e == "wgsl") {
+                files.push(path);
+            }
+        }
+    }
+    assert!(files.len() > 15, "found {} files", files.len());
+    let mut long = Vec::new();
+    let mut shading = None;
+    for path in &files {
+        let source = std::fs::read_to_string(path).expect("reading a shader");
+        for f in functions(&source) {
+            if f.name == "shade_surface" {
+                shading = Some(f.lines);
+            }
+            if f.lines > MAX_LINES {
+                long.push(format!("{}:{} `{}`: {} lines", path.display(), f.line, f.name, f.lines));
+            }
+        }
+    }
+    assert!(long.is_empty(), "WGSL functions over {MAX_LINES} lines:\n{}", long.join("\n"));
+    let shading = shading.expect("shade_surface is found");
+    assert!(shading <= 80, "shade_surface has {shading} lines");
+}
+
 /// The checker on a made-up source: braces in comments, strings, raw strings and characters,
 /// lifetimes, an array type in a signature, a nested function, a declaration without a body, a
 /// function of exactly the limit and one a line over it.

@@ -116,7 +116,8 @@ fn coarse_traced_terms_are_the_full_terms_of_each_blocks_first_pixel() {
 fn the_lights_past_the_fourth_traced_cast_their_shadows() {
     let mut scene = smaller(common::load("scenes/shadows.toml"), 200);
     let key = scene.lights[0].clone();
-    for (k, position) in [[-2.5, 4.0, 2.0], [2.5, 4.0, 2.0], [0.0, 4.5, -0.5], [3.5, 2.5, 3.0]].into_iter().enumerate() {
+    for (k, position) in [[-2.5, 4.0, 2.0], [2.5, 4.0, 2.0], [0.0, 4.5, -0.5], [3.5, 2.5, 3.0]].into_iter().enumerate()
+    {
         let mut light = key.clone();
         light.name = format!("point {k}");
         light.kind = mirador::scene::LightKind::Point { position: position.into() };

@@ -274,6 +274,8 @@ fn shade(in: VertexOut) -> vec3f {
     return shade_surface(in).radiance;
 }
 
+// The illumination model at a fragment, each technique's part in a function of its own, in the
+// order the model adds them (the sums' order is the image's bits).
 fn shade_surface(in: VertexOut) -> Shaded {
     // Screen-space derivatives first, in uniform control flow: the texture's level of detail and
     // the tangents ∂p/∂u, ∂p/∂v of the surface, from the change of position and uv across pixels.
@@ -287,16 +289,7 @@ fn shade_surface(in: VertexOut) -> Shaded {
         color = traced_term(in.clip.xy, TRACED_SURFACE_LAYER);
     }
     if INSPECT {
-        probe.world = in.world;
-        probe.uv = in.uv;
-        probe.colour = color;
-        probe.geometric = normalize(in.normal);
-        probe.lod = -1.0;
-        if COLOR_TEXTURE {
-            let size = vec2f(textureDimensions(color_texture));
-            probe.lod = mip_lod(duv_dx, duv_dy, size, frame.lod_bias);
-            probe.footprint = vec2f(length(duv_dx * size), length(duv_dy * size));
-        }
+        inspect_texture(in, color, duv_dx, duv_dy);
     }
     if FLAT_COLOUR {
         return Shaded(color, normalize(in.normal), view_vector(in.world), vec3f(0.0));
@@ -319,6 +312,28 @@ fn shade_surface(in: VertexOut) -> Shaded {
         probe.emission = select(vec3f(0.0), surface.emission, (frame.terms & TERM_EMISSION) != 0u);
         probe.global_ambient = select(vec3f(0.0), frame.ambient * surface.kd * surface.color, (frame.terms & TERM_AMBIENT) != 0u);
     }
+    radiance = lit_by_lights(radiance, in, surface, n, v, here);
+    return with_mirror_term(radiance, in, n, v, here);
+}
+
+// What the inspection records of the surface: where, its colour and its texture's level.
+fn inspect_texture(in: VertexOut, color: vec3f, duv_dx: vec2f, duv_dy: vec2f) {
+    probe.world = in.world;
+    probe.uv = in.uv;
+    probe.colour = color;
+    probe.geometric = normalize(in.normal);
+    probe.lod = -1.0;
+    if COLOR_TEXTURE {
+        let size = vec2f(textureDimensions(color_texture));
+        probe.lod = mip_lod(duv_dx, duv_dy, size, frame.lod_bias);
+        probe.footprint = vec2f(length(duv_dx * size), length(duv_dy * size));
+    }
+}
+
+// radiance + Σ_i V_i·S_i·L_dir over the frame's lights, each V_i from its shadow (or the hybrid's
+// traced term), in the lights' order; the shadow-map texel view's checker over it.
+fn lit_by_lights(ambient: vec3f, in: VertexOut, surface: Surface, n: vec3f, v: vec3f, here: bool) -> vec3f {
+    var radiance = ambient;
     var checker = -1.0;
     // The hybrid's traced lights: where traced, the lights without a shadow map are the tracer's.
     let traced_lights = (TRACED & TRACED_LIGHTS) != 0u && here;
@@ -347,11 +362,7 @@ fn shade_surface(in: VertexOut) -> Shaded {
             }
             radiance += visible * direct(surface, n, v, incidence, frame.terms);
             if SHADOW_TEXELS_VIEW && SHADOW_METHOD == SHADOWS_MAP && light.shadow_layer >= 0 && checker < 0.0 {
-                var layer = u32(light.shadow_layer);
-                if light.kind == LIGHT_POINT {
-                    layer += cube_face(in.world - light.position);
-                }
-                checker = shadow_texel_checker(shadow_coordinates(shadows.layers[layer].clip_from_world, in.world).xy, shadows.map_size);
+                checker = texel_checker(light, in.world);
             }
         }
     }
@@ -361,6 +372,22 @@ fn shade_surface(in: VertexOut) -> Shaded {
     if checker >= 0.0 {
         radiance *= mix(0.55, 1.0, checker);
     }
+    return radiance;
+}
+
+// The shadow-map texel view: which of the map's texels `world` falls in, as a checker.
+fn texel_checker(light: Light, world: vec3f) -> f32 {
+    var layer = u32(light.shadow_layer);
+    if light.kind == LIGHT_POINT {
+        layer += cube_face(world - light.position);
+    }
+    return shadow_texel_checker(shadow_coordinates(shadows.layers[layer].clip_from_world, world).xy, shadows.map_size);
+}
+
+// radiance plus the mirror term kps·MPS·L(r) of a curved mirror: L(r) from the environment map,
+// or traced by the hybrid; and the environment's L(r), which glass reads.
+fn with_mirror_term(lit: vec3f, in: VertexOut, n: vec3f, v: vec3f, here: bool) -> Shaded {
+    var radiance = lit;
     var environment_radiance = vec3f(0.0);
     if ENVIRONMENT != 0u {
         // Looked up everywhere (its derivatives need uniform control flow), kept where the

@@ -28,6 +28,6 @@
 // is 1 where the polygons cover this view's pixel.
 @group(2) @binding(4) var projected_mask: texture_2d<f32>;
 // The hybrid's traced terms (src/raster/traced.rs), at the first opaque surface of this view's
-// pixel: layer 0 its colour C and object + 1, layer 1 L(r), layer 2 what it lets through (transparent
-// surfaces), layers 3.. each shadowed light's V_i.
+// pixel: layer TRACED_SURFACE_LAYER its colour C and object + 1, then each traced term's layers
+// from TRACED_NAME_LAYER (the approximations table, src/settings/hybrid.rs).
 @group(2) @binding(13) var traced: texture_2d_array<f32>;

@@ -81,10 +81,10 @@ pub fn write(lab: &Lab, options: &Options) -> Result<Vec<PathBuf>, String> {
             file(lab_dir.join("hidden").join(name), &text, false)?;
         }
     }
-    if options.service == Service::Classroom {
-        if let Some((name, value)) = points.iter().find(|(_, v)| v.fract() != 0.0) {
-            return Err(format!("`{name}` = {value}: GitHub Classroom's grader takes whole points"));
-        }
+    if options.service == Service::Classroom
+        && let Some((name, value)) = points.iter().find(|(_, v)| v.fract() != 0.0)
+    {
+        return Err(format!("`{name}` = {value}: GitHub Classroom's grader takes whole points"));
     }
     let check = CheckLine { lab: &lab.name, time_limit: options.time_limit };
     match options.service {

@@ -107,18 +107,18 @@ impl Isolated {
             if token.kind != Kind::Identifier || token.after_dot {
                 continue;
             }
-            if name == "textureDimensions" {
-                if let Some((end, [texture, level])) = two_arguments(&tokens, index) {
-                    let size = format!("textureDimensions({})", rewritten(texture));
-                    let level = rewritten(level);
-                    let with = format!("max({size} >> ({size} * 0u + u32({level})), {size} * 0u + 1u)");
-                    changes.push((token.range.start, end - token.range.start, with));
-                }
+            if name == "textureDimensions"
+                && let Some((end, [texture, level])) = two_arguments(&tokens, index)
+            {
+                let size = format!("textureDimensions({})", rewritten(texture));
+                let level = rewritten(level);
+                let with = format!("max({size} >> ({size} * 0u + u32({level})), {size} * 0u + 1u)");
+                changes.push((token.range.start, end - token.range.start, with));
             }
-            if matches!(name, "loop" | "for" | "while") {
-                if let Some(open) = loop_body(&tokens, index) {
-                    changes.push((open + 1, 0, format!(" if {guard_prefix}step() {{ break; }}")));
-                }
+            if matches!(name, "loop" | "for" | "while")
+                && let Some(open) = loop_body(&tokens, index)
+            {
+                changes.push((open + 1, 0, format!(" if {guard_prefix}step() {{ break; }}")));
             }
         }
         let changes = outermost(changes);

@@ -211,7 +211,7 @@ fn broken(summary: &Summary) -> Vec<(String, Vec<&str>)> {
             None => groups.push((first, vec![&s.name])),
         }
     }
-    groups.sort_by(|a, b| b.1.len().cmp(&a.1.len()));
+    groups.sort_by_key(|group| std::cmp::Reverse(group.1.len()));
     groups
 }
 

@@ -38,9 +38,9 @@ use super::geometry::SurfaceHit;
 use super::whitted::{RayCounts, surface_offset};
 use crate::base::Ray;
 use crate::scene::shading::{SurfaceSample, direct, facing_viewer, lights_surface};
-use crate::shaders::constants::MAX_LIGHTS;
 use crate::settings::hybrid::{SURFACE_LAYER, TRACED_LAYERS};
 use crate::settings::{Traced, TracedSet};
+use crate::shaders::constants::MAX_LIGHTS;
 use crate::texture::RayCone;
 
 /// Which terms to trace: a set of the approximations table's rows.
