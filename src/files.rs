@@ -110,6 +110,8 @@ builtin_files!(
     "assets/scenes/course/bump-fields.toml",
     "assets/scenes/course/camera-orthographic.toml",
     "assets/scenes/course/camera-perspective.toml",
+    "assets/scenes/course/displacement-plane.toml",
+    "assets/scenes/course/displacement-sphere.toml",
     "assets/scenes/course/environment-ball.toml",
     "assets/scenes/course/illumination-ambient.toml",
     "assets/scenes/course/illumination-terms.toml",

@@ -653,6 +653,12 @@ fn prepare(args: &SceneArgs, clock: &mut Stopwatch) -> anyhow::Result<Scene> {
     scene.camera.width = args.width.unwrap_or(scene.camera.width);
     scene.camera.height = args.height.unwrap_or(scene.camera.height);
     scene.camera.validate().context("--width/--height")?;
+    // `bump.method = "displacement"`: the height fields' surfaces made as triangles, for both
+    // renderers alike.
+    let displaced = clock.time("displacement", || mirador::texture::displacement::displace(&mut scene));
+    if let Some(line) = displaced.summary().filter(|_| args.stats) {
+        println!("{line}");
+    }
     Ok(scene)
 }
 

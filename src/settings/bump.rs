@@ -9,6 +9,17 @@ section! {
         /// Bump mapping and normal maps: the shading normal perturbed by the height field's slope
         /// (or read from the normal map); off, surfaces are shaded with the geometric normal `n`.
         enabled: bool = true,
+        /// What the height field `f(u, v)` changes, in both renderers: the shading normal alone
+        /// (bump mapping: the silhouette and the shadows stay the smooth surface's), or the
+        /// surface itself, `p + k·f·n`, made as triangles (displacement mapping: the silhouette,
+        /// the self-shadows and what hides what are the relief's).
+        method: BumpMethod = BumpMethod::Normal,
+        /// Displacement's tessellation: the longest edge of the displaced triangles, in steps of
+        /// the height field (texels of a height map; a 64th of a sine's period, a 16th of the
+        /// finest noise cell). Smaller follows more detail with more triangles (at most two
+        /// million in a scene: past that the level is lowered, and said).
+        #[values(closed(0.25, 64.0).unit("texels").slider(0.25, 16.0))]
+        displacement_texels: f32 = 2.0,
         /// Where the rasterizer's tangents `t_u = ∂p/∂u`, `t_v = ∂p/∂v` come from (the tracer
         /// uses the third source, the analytic surface).
         tangents: TangentSource = TangentSource::Derivatives,
@@ -27,6 +38,16 @@ section! {
         /// Teaching view instead of the shaded colour: the perturbed normal `n'` or the tangent
         /// `t_u` as colour.
         view: BumpView = BumpView::Off,
+    }
+}
+
+choices! {
+    /// What a height field changes.
+    pub enum BumpMethod {
+        /// Bump mapping: the shading normal perturbed by the field's slope, the surface unmoved.
+        Normal,
+        /// Displacement mapping: the surface moved by `k·f(u, v)` along its normal, as geometry.
+        Displacement,
     }
 }
 

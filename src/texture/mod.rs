@@ -9,6 +9,7 @@
 //! - [`height`]: height fields `f_h(u, v)`: grey textures, a sine field, value noise.
 //! - [`bump`]: finite differences and the perturbed normal `n' = normalize(t'_u × t'_v)`.
 //! - [`tangents`]: `t_u`, `t_v` per triangle and per vertex (MikkTSpace), glTF normal maps.
+//! - [`displacement`]: the surface `p + k·f(u, v)·n` itself, pre-tessellated for both renderers.
 //!
 //! How the renderers use them (one meaning in both, so raster and trace stay comparable):
 //!
@@ -28,6 +29,7 @@
 //!   `∂p/∂u`, `∂p/∂v`, so the same `k` gives the same relief.
 
 pub mod bump;
+pub mod displacement;
 pub mod height;
 pub mod lod;
 pub mod mipmap;

@@ -148,7 +148,7 @@ impl Viewer {
         let remembered = config.scenes.clone();
         let changes = remembered.get(&scene_key(scene.source.as_deref())).cloned().unwrap_or_default();
         let (settings, warnings) = super::config::apply_settings(&scene.settings, &changes);
-        let mut scene = SceneState::new(scene);
+        let mut scene = SceneState::new(super::scene_state::displaced(scene, &settings));
         scene.scene.settings = settings.clone();
         let wgsl = lab.as_mut().map_or_else(Wgsl::builtin, |lab| {
             lab.take_changed();
@@ -412,9 +412,27 @@ impl Viewer {
         if self.settings.sphere_segments != self.scene.seed_settings.sphere_segments {
             self.scene.touch();
         }
-        self.settings = self.scene.seed_settings.clone();
+        let before = std::mem::replace(&mut self.settings, self.scene.seed_settings.clone());
+        self.redisplace(&before);
         self.scene.scene.settings = self.settings.clone();
         self.notice("settings reset to the scene's own".into());
+    }
+
+    /// Makes the scene again from its file when the settings changed from `before` in what the
+    /// displaced geometry is made of (`bump.method = "displacement"`, its scale and tessellation).
+    fn redisplace(&mut self, before: &RenderSettings) {
+        if !SceneState::displacement_changed(before, &self.settings) {
+            return;
+        }
+        let size = (self.scene.scene.camera.width, self.scene.scene.camera.height);
+        let camera = self.scene.scene.camera.clone();
+        match self.scene.scene.source.clone() {
+            Some(path) if self.scene.load(&path, Some(&self.settings)) => {
+                self.scene.scene.camera = Camera { width: size.0, height: size.1, ..camera };
+            }
+            Some(_) => self.notice("the scene could not be made again for displacement".into()),
+            None => self.notice("displacement is made from the scene's file, and this scene has none".into()),
+        }
     }
 
     fn notice(&mut self, message: String) {
@@ -748,12 +766,14 @@ impl Viewer {
             }
             return;
         }
+        let before = self.settings.clone();
         match self.settings.set(assignment) {
             Ok(()) => {
                 if self.settings.sphere_segments != self.scene.scene.settings.sphere_segments {
                     self.scene.touch();
                 }
                 self.scene.scene.settings = self.settings.clone();
+                self.redisplace(&before);
             }
             Err(e) => self.notice(format!("setting refused: {e}")),
         }

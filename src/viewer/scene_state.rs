@@ -55,6 +55,17 @@ pub fn load(path: Option<&Path>, overrides: &[String]) -> Result<Scene, crate::s
     crate::scene::file::overrides::load(path.unwrap_or(&builtin), overrides)
 }
 
+/// `scene` with its height fields displaced into triangles where `settings` ask for
+/// displacement (`crate::texture::displacement`); its own settings kept.
+pub fn displaced(mut scene: Scene, settings: &RenderSettings) -> Scene {
+    let seed_settings = std::mem::replace(&mut scene.settings, settings.clone());
+    if let Some(line) = crate::texture::displacement::displace(&mut scene).summary() {
+        log::info!("{line}");
+    }
+    scene.settings = seed_settings;
+    scene
+}
+
 impl SceneState {
     pub fn new(scene: Scene) -> SceneState {
         let watch = scene.source.clone().map(|path| Watch { modified: modified(&path), path, checked: Instant::now() });
@@ -96,17 +107,28 @@ impl SceneState {
         }
     }
 
-    /// Replaces the scene with `scene` at the window's image size, drawn with `settings`.
+    /// Replaces the scene with `scene` at the window's image size, drawn with `settings` (its
+    /// height fields displaced into triangles where `settings` ask for displacement).
     pub fn replace(&mut self, scene: Scene, settings: &RenderSettings) {
         let (width, height) = (self.scene.camera.width, self.scene.camera.height);
         let revision = self.revision + 1;
         let overrides = std::mem::take(&mut self.overrides);
-        *self = SceneState::new(scene);
+        *self = SceneState::new(displaced(scene, settings));
         self.overrides = overrides;
         self.revision = revision;
         self.scene.settings = settings.clone();
         self.scene.camera.width = width;
         self.scene.camera.height = height;
+    }
+
+    /// Whether going from `before` to `after` changes the displaced geometry: the scene must be
+    /// made again from its file (`bump.method = "displacement"` and what it reads).
+    pub fn displacement_changed(before: &RenderSettings, after: &RenderSettings) -> bool {
+        use crate::texture::displacement::wanted;
+        let (b, a) = (&before.bump, &after.bump);
+        wanted(b) != wanted(a)
+            || (wanted(a) && (b.scale != a.scale || b.displacement_texels != a.displacement_texels))
+            || (wanted(a) && before.sphere_segments != after.sphere_segments)
     }
 
     /// Reloads the scene when its file changed on disk since it was loaded (polled, cheap);

@@ -40,8 +40,10 @@ impl SceneRecipe {
     }
 
     pub(crate) fn scene(self) -> Result<(Scene, RenderSettings), String> {
-        let mut scene =
+        let scene =
             crate::viewer::scene_state::load(self.source.as_deref(), &self.overrides).map_err(|e| e.to_string())?;
+        // Displaced as the viewer's was, so its objects and materials are the viewer's.
+        let mut scene = crate::viewer::scene_state::displaced(scene, &self.settings);
         if scene.materials.len() != self.materials.len() || scene.lights.len() != self.lights.len() {
             return Err("the scene file changed since the page read it".into());
         }

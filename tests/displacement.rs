@@ -1,0 +1,143 @@
+//! Displacement mapping (`bump.method = "displacement"`, src/texture/displacement.rs): the height
+//! field's surface made as triangles, for both renderers alike. Checked against the theory:
+//!
+//! - the rasterizer and the tracer draw one displaced surface, so they agree as on any surface;
+//! - bump mapping is that surface's shading without its geometry: against the traced displaced
+//!   surface it is measurably worse, at the silhouette (sky where the relief stands) and in the
+//!   self-shadows;
+//! - the displaced sphere is closed (no sky through it), whatever the seam and the poles;
+//! - bad input (a huge scale, a bound on triangles) ends in a surface or a said level, never a
+//!   panic or unbounded memory.
+
+mod common;
+
+use mirador::Scene;
+use mirador::settings::BumpMethod;
+use mirador::texture::displacement::{self, MAX_TRIANGLES};
+
+/// `path`'s scene with `method`, displaced when asked.
+fn with_method(path: &str, method: BumpMethod) -> Scene {
+    let mut scene = common::load(path);
+    scene.settings.bump.method = method;
+    displacement::displace(&mut scene);
+    scene
+}
+
+/// FLIP of the rasterizer's image of `raster` against the tracer's of `traced`.
+fn raster_against_traced(raster: &Scene, traced: &Scene) -> f32 {
+    let reference = mirador::trace::render_image(traced, &traced.settings);
+    common::flip(&reference, &common::raster(raster, &raster.settings))
+}
+
+/// The displaced sphere and plane: raster against the tracer on one displaced surface, and bump
+/// mapping against the same traced surface.
+#[test]
+fn both_renderers_draw_one_displaced_surface_and_bump_mapping_misses_it() {
+    for path in ["scenes/course/displacement-sphere.toml", "scenes/course/displacement-plane.toml"] {
+        let displaced = with_method(path, BumpMethod::Displacement);
+        let bumped = with_method(path, BumpMethod::Normal);
+        let agree = raster_against_traced(&displaced, &displaced);
+        let bump = raster_against_traced(&bumped, &displaced);
+        eprintln!("{path}: displaced raster vs displaced tracer {agree:.4}; bump raster vs displaced tracer {bump:.4}");
+        // Measured on lavapipe: see tests/README.md.
+        assert!(agree < 0.02, "{path}: the two renderers on one displaced surface: FLIP {agree}");
+        assert!(bump > 2.0 * agree, "{path}: bump mapping {bump} is not worse than displacement {agree}");
+    }
+}
+
+/// Where the relief stands out of the sphere, the displaced image has the ball and bump mapping
+/// the sky: the silhouette is the one thing no shading can fix.
+#[test]
+fn bump_mapping_keeps_a_circular_silhouette_and_displacement_breaks_it() {
+    let path = "scenes/course/displacement-sphere.toml";
+    let displaced = with_method(path, BumpMethod::Displacement);
+    let bumped = with_method(path, BumpMethod::Normal);
+    let sky = displaced.background;
+    let is_sky = |p: &image::Rgba<u8>, reference: &image::Rgba<u8>| {
+        p.0.iter().zip(reference.0).take(3).all(|(a, b)| a.abs_diff(b) <= 2)
+    };
+    let traced_displaced = mirador::trace::render_image(&displaced, &displaced.settings);
+    let bump_image = common::raster(&bumped, &bumped.settings);
+    let plain = mirador::trace::render_image(&common::load(path), &common::load(path).settings);
+    // The sky's own colour, read where no ball can be (the top-left corner).
+    let sky_pixel = *plain.get_pixel(0, 0);
+    assert!(sky.max_element() > 0.0);
+    let (mut ball_in_displaced_only, mut sky_in_both) = (0, 0);
+    for (d, b) in traced_displaced.pixels().zip(bump_image.pixels()) {
+        match (is_sky(d, &sky_pixel), is_sky(b, &sky_pixel)) {
+            (false, true) => ball_in_displaced_only += 1,
+            (true, true) => sky_in_both += 1,
+            _ => {}
+        }
+    }
+    eprintln!("pixels of relief outside the bump-mapped circle: {ball_in_displaced_only}");
+    assert!(sky_in_both > 10_000, "the sky is found: {sky_in_both}");
+    assert!(ball_in_displaced_only > 200, "the displaced outline adds {ball_in_displaced_only} pixels of ball");
+}
+
+/// No sky through a closed displaced sphere: every pixel well inside its outline is the ball,
+/// across the seam (u = 0 = 1) and at the poles, where vertices at one point are moved together.
+#[test]
+fn a_displaced_sphere_is_closed() {
+    let mut scene = with_method("scenes/course/displacement-sphere.toml", BumpMethod::Displacement);
+    // A background no shading of the ball makes, and the ball turned so that its seam and a
+    // pole face the camera.
+    scene.background = glam::Vec3::new(1.0, 0.0, 1.0);
+    let turn = glam::Mat4::from_rotation_x(1.1) * glam::Mat4::from_rotation_y(3.0);
+    for object in &mut scene.objects {
+        object.world_from_local = turn * object.world_from_local;
+    }
+    let image = common::raster(&scene, &scene.settings);
+    let (w, h) = (image.width() as f32, image.height() as f32);
+    // The ball's outline on screen: radius 0.8 at distance ~2.92 with fovy 40°.
+    let radius_pixels = 0.8 / (2.92 * (20f32.to_radians()).tan()) * h / 2.0;
+    let mut holes = 0;
+    for (x, y, p) in image.enumerate_pixels() {
+        let d = ((x as f32 + 0.5 - w / 2.0).powi(2) + (y as f32 + 0.5 - h / 2.0 + 0.0).powi(2)).sqrt();
+        if d < 0.85 * radius_pixels && p.0[0] > 200 && p.0[1] < 60 && p.0[2] > 200 {
+            holes += 1;
+        }
+    }
+    assert_eq!(holes, 0, "{holes} background pixels inside the displaced ball");
+}
+
+/// What `bump.method = "normal"` does to a scene: nothing; and the summary says what was made.
+#[test]
+fn bump_mapping_leaves_the_scene_alone_and_displacement_says_what_it_made() {
+    let mut scene = common::load("scenes/course/displacement-sphere.toml");
+    let before = (scene.objects.len(), scene.meshes.len(), scene.materials.len());
+    assert_eq!(displacement::displace(&mut scene), Default::default());
+    assert_eq!(before, (scene.objects.len(), scene.meshes.len(), scene.materials.len()));
+    scene.settings.bump.method = BumpMethod::Displacement;
+    let made = displacement::displace(&mut scene);
+    assert_eq!(made.objects.len(), 1);
+    assert!(made.triangles > 10_000, "{made:?}");
+    let summary = made.summary().expect("a summary");
+    assert!(summary.starts_with("displacement: 1 objects,") && !summary.contains("forced"), "{summary}");
+    // The displaced material has no height field left: the geometry carries the relief.
+    let material = &scene.materials[scene.objects[0].material.0];
+    assert!(material.height_map.is_none() && material.height_field.is_none());
+}
+
+/// Bad input: a scale of 10³⁰ moves the surface off to where f32 ends, and the offsets that
+/// are not finite stay unmoved: both renderers draw something, nothing panics. A tessellation
+/// finer than the bound is made at the level the bound allows, and the summary says so.
+#[test]
+fn a_huge_scale_and_a_level_past_the_bound_are_handled() {
+    let mut scene = common::load("scenes/course/displacement-sphere.toml");
+    scene.settings.bump.method = BumpMethod::Displacement;
+    scene.settings.bump.scale = 1e30;
+    displacement::displace(&mut scene);
+    assert!(scene.meshes.iter().all(|m| m.positions.iter().all(|p| p.is_finite())));
+    let _ = common::raster(&scene, &scene.settings);
+    let _ = mirador::trace::render_image(&scene, &scene.settings);
+
+    let mut scene = common::load("scenes/course/displacement-sphere.toml");
+    scene.settings.bump.method = BumpMethod::Displacement;
+    scene.settings.bump.displacement_texels = 0.25;
+    scene.settings.sphere_segments = 192;
+    let made = displacement::displace(&mut scene);
+    assert!(made.triangles <= MAX_TRIANGLES, "{made:?}");
+    let summary = made.summary().expect("a summary");
+    assert!(summary.contains("forced `ball` at level"), "{summary}");
+}
