@@ -940,7 +940,8 @@ impl Viewer {
                 }
             }
             Step::Set(assignment) => {
-                self.settings.set(&assignment).with_context(|| format!("step `set {assignment}`"))?;
+                // Checked on a copy first: a refused setting ends the script.
+                self.settings.clone().set(&assignment).with_context(|| format!("step `set {assignment}`"))?;
                 self.set(&assignment);
             }
             Step::View(mode) => self.view.mode = mode,
