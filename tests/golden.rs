@@ -256,3 +256,14 @@ fn the_worst_region_is_the_mean_of_the_worst_window() {
     let error = GoldenError::from_flip(&spread, width as u32, height as u32);
     assert!((error.worst_region - error.flip_mean).abs() < 1e-6, "{error:?}");
 }
+
+/// Displacement mapping: the cobbled ball with its relief made as triangles (its outline and
+/// self-shadows the relief's).
+#[test]
+fn displaced_ball() {
+    let mut scene = common::load("scenes/course/displacement-sphere.toml");
+    (scene.camera.width, scene.camera.height) = (480, 270);
+    scene.settings.bump.method = mirador::settings::BumpMethod::Displacement;
+    mirador::texture::displacement::displace(&mut scene);
+    common::assert_golden("displaced-ball", &common::raster(&scene, &scene.settings), TOLERANCE);
+}
