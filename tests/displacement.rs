@@ -45,6 +45,27 @@ fn both_renderers_draw_one_displaced_surface_and_bump_mapping_misses_it() {
     }
 }
 
+/// Parallax mapping, between the two: its two renderers agree (the same march in WGSL and in
+/// Rust), and against the traced displaced surface it is nearer than bump mapping (the relief
+/// hides itself) and farther than displacement (the outline and the shadows stay flat).
+#[test]
+fn parallax_mapping_lies_between_bump_mapping_and_displacement() {
+    for path in ["scenes/course/displacement-sphere.toml", "scenes/course/displacement-plane.toml"] {
+        let displaced = with_method(path, BumpMethod::Displacement);
+        let parallax = with_method(path, BumpMethod::Parallax);
+        let bumped = with_method(path, BumpMethod::Normal);
+        let agree = raster_against_traced(&parallax, &parallax);
+        let reference = mirador::trace::render_image(&displaced, &displaced.settings);
+        let against = |scene: &Scene| common::flip(&reference, &common::raster(scene, &scene.settings));
+        let (bump, between, displacement) = (against(&bumped), against(&parallax), against(&displaced));
+        eprintln!(
+            "{path}: parallax raster vs parallax tracer {agree:.4}; against the traced displaced surface: bump {bump:.4}, parallax {between:.4}, displacement {displacement:.4}"
+        );
+        assert!(agree < 0.02, "{path}: parallax in the two renderers: FLIP {agree}");
+        assert!(displacement < between && between < bump, "{path}: {displacement} < {between} < {bump} does not hold");
+    }
+}
+
 /// Where the relief stands out of the sphere, the displaced image has the ball and bump mapping
 /// the sky: the silhouette is the one thing no shading can fix.
 #[test]

@@ -23,6 +23,8 @@ override BUMP: bool = false;
 override BUMP_VIEW: u32 = 0u;
 override TANGENTS_PER_VERTEX: bool = false;
 override BUMP_ANALYTIC: bool = false;
+// bump.method = "parallax": the relief's point the view ray meets first is shaded.
+override PARALLAX: bool = false;
 override FLAT_COLOUR: bool = false;
 // TRACED_* bits: the hybrid's terms read from the view's traced image (src/raster/traced.rs).
 override TRACED: u32 = 0u;
@@ -257,6 +259,83 @@ fn surface_tangents(in: VertexOut) -> SurfaceTangents {
     return tangents_from_derivatives(dpdx(in.world), dpdy(in.world), dpdx(in.uv), dpdy(in.uv));
 }
 
+// The least and the greatest height the material's field can take: the slab parallax mapping
+// marches through (Rust twin: HeightField::range, src/texture/height.rs).
+fn height_range() -> vec2f {
+    let a = abs(material.height_amplitude);
+    switch HEIGHT_KIND {
+        case HEIGHT_SINE: {
+            return vec2f(-a, a);
+        }
+        case HEIGHT_NOISE: {
+            return vec2f(-2.0 * a, 2.0 * a);
+        }
+        default: {
+            return vec2f(0.0, 1.0);
+        }
+    }
+}
+
+// Parallax occlusion mapping (docs/course/04-bump-mapping.md; src/texture/parallax.rs, the same
+// operations in the same order): the texture coordinates where the view ray along d, through
+// the flat surface's point at uv, first meets the surface displaced by k·f. A point p + s·d of the
+// ray is at height s·(d·n), at uv + s·duv_ds; PARALLAX_STEPS equal steps from the slab's top to
+// its bottom find the first under the relief, PARALLAX_REFINEMENTS secant steps the crossing.
+fn parallax_uv(uv: vec2f, n: vec3f, tangents: SurfaceTangents, d: vec3f) -> vec2f {
+    let k = material.bump_scale * frame.bump_scale;
+    let tu = tangents.tu;
+    let tv = tangents.tv;
+    let dn = dot(d, n);
+    let a = dot(tu, tu);
+    let b = dot(tu, tv);
+    let c = dot(tv, tv);
+    let det = a * c - b * b;
+    if !(dn < -1e-4) || k == 0.0 || !(abs(det) > 1e-12) || !tangents.valid {
+        return uv;
+    }
+    let range = height_range();
+    let h_low = min(k * range.x, k * range.y);
+    let h_high = max(k * range.x, k * range.y);
+    let along = d - dn * n;
+    let x = dot(along, tu);
+    let y = dot(along, tv);
+    let duv_ds = vec2f(c * x - b * y, a * y - b * x) / det;
+    let s_top = h_high / dn;
+    let s_bottom = h_low / dn;
+    var before = vec2f(s_top, parallax_gap(uv, duv_ds, s_top, dn, k));
+    for (var step = 1u; step <= PARALLAX_STEPS; step++) {
+        let s = s_top + (s_bottom - s_top) * (f32(step) / f32(PARALLAX_STEPS));
+        let after = vec2f(s, parallax_gap(uv, duv_ds, s, dn, k));
+        if after.y <= 0.0 {
+            return uv + parallax_crossing(before, after, uv, duv_ds, dn, k) * duv_ds;
+        }
+        before = after;
+    }
+    return uv + s_bottom * duv_ds;
+}
+
+// How far the ray's point at s is above the displaced surface there.
+fn parallax_gap(uv: vec2f, duv_ds: vec2f, s: f32, dn: f32, k: f32) -> f32 {
+    return s * dn - k * height_at(uv + s * duv_ds);
+}
+
+// The s where the gap crosses zero between above (gap > 0) and below (gap ≤ 0): secant steps,
+// each keeping the pair that brackets the crossing.
+fn parallax_crossing(above_start: vec2f, below_start: vec2f, uv: vec2f, duv_ds: vec2f, dn: f32, k: f32) -> f32 {
+    var above = above_start;
+    var below = below_start;
+    for (var i = 0u; i < PARALLAX_REFINEMENTS; i++) {
+        let s = above.x + (below.x - above.x) * (above.y / (above.y - below.y));
+        let at = vec2f(s, parallax_gap(uv, duv_ds, s, dn, k));
+        if at.y > 0.0 {
+            above = at;
+        } else {
+            below = at;
+        }
+    }
+    return above.x + (below.x - above.x) * (above.y / (above.y - below.y));
+}
+
 // What shading a fragment found: the radiance leaving it towards the viewer, and for the
 // passes that add transmission (transparency.wgsl, refraction.wgsl) the shading normal n (turned
 // to the viewer), the view vector v and L(r), the environment looked up along the reflected
@@ -284,7 +363,12 @@ fn shade_surface(in: VertexOut) -> Shaded {
     let tangents = surface_tangents(in);
     // The hybrid's terms hold at this pixel only if they were traced on this fragment's surface.
     let here = TRACED != 0u && traced_object(in.clip.xy) == in.object + 1u;
-    var color = surface_color(in.uv, duv_dx, duv_dy);
+    // Parallax mapping shades the point of the relief the view ray meets first.
+    var at = in;
+    if PARALLAX && HEIGHT_KIND != HEIGHT_NONE {
+        at.uv = parallax_uv(in.uv, normalize(in.normal), tangents, -view_vector(in.world));
+    }
+    var color = surface_color(at.uv, duv_dx, duv_dy);
     if (TRACED & TRACED_TEXTURES) != 0u && here {
         color = traced_term(in.clip.xy, TRACED_SURFACE_LAYER);
     }
@@ -295,7 +379,7 @@ fn shade_surface(in: VertexOut) -> Shaded {
         return Shaded(color, normalize(in.normal), view_vector(in.world), vec3f(0.0));
     }
     let v = view_vector(in.world);
-    let n = facing_viewer(shading_normal(in, tangents), v);
+    let n = facing_viewer(shading_normal(at, tangents), v);
     if BUMP_VIEW == BUMP_VIEW_NORMALS {
         return Shaded(0.5 + 0.5 * n, n, v, vec3f(0.0));
     }

@@ -11,7 +11,7 @@
 use super::uniforms::alpha_mode_code;
 use crate::scene::{Material, ProceduralHeight};
 use crate::settings::{
-    BumpView, EnvironmentMap, EnvironmentSettings, RenderSettings, ShadowFilter, ShadowMethod, ShadowView,
+    BumpMethod, BumpView, EnvironmentMap, EnvironmentSettings, RenderSettings, ShadowFilter, ShadowMethod, ShadowView,
     TangentSource, TextureFilter,
 };
 pub use crate::shaders::constants::{
@@ -88,6 +88,7 @@ pipeline_constants! {
         bump_view: u32 = "BUMP_VIEW" <- bump_view_code(settings.bump.view),
         tangents_per_vertex: bool = "TANGENTS_PER_VERTEX" <- settings.bump.tangents == TangentSource::PerVertex,
         bump_analytic: bool = "BUMP_ANALYTIC" <- settings.bump.analytic,
+        parallax: bool = "PARALLAX" <- settings.bump.enabled && settings.bump.method == BumpMethod::Parallax,
         flat_colour: bool = "FLAT_COLOUR" <- settings.raster.flat_colour,
         /// `ENV_MAP_*`: where curved mirrors look their reflection up; 0: nowhere.
         environment: u32 = "ENVIRONMENT" <- environment_code(&settings.environment),

@@ -10,9 +10,10 @@ section! {
         /// (or read from the normal map); off, surfaces are shaded with the geometric normal `n`.
         enabled: bool = true,
         /// What the height field `f(u, v)` changes, in both renderers: the shading normal alone
-        /// (bump mapping: the silhouette and the shadows stay the smooth surface's), or the
-        /// surface itself, `p + k·f·n`, made as triangles (displacement mapping: the silhouette,
-        /// the self-shadows and what hides what are the relief's).
+        /// (bump mapping: the silhouette and the shadows stay the smooth surface's), the point
+        /// shaded as well (parallax mapping: the view ray marched through the relief, which hides
+        /// itself), or the surface itself, `p + k·f·n`, made as triangles (displacement mapping:
+        /// the silhouette, the self-shadows and what hides what are the relief's).
         method: BumpMethod = BumpMethod::Normal,
         /// Displacement's tessellation: the longest edge of the displaced triangles, in steps of
         /// the height field (texels of a height map; a 64th of a sine's period, a 16th of the
@@ -46,6 +47,10 @@ choices! {
     pub enum BumpMethod {
         /// Bump mapping: the shading normal perturbed by the field's slope, the surface unmoved.
         Normal,
+        /// Parallax occlusion mapping: the flat surface shaded, at each point, as the point of
+        /// the displaced surface the view ray meets first (the relief hides itself; the outline
+        /// and the shadows stay flat).
+        Parallax,
         /// Displacement mapping: the surface moved by `k·f(u, v)` along its normal, as geometry.
         Displacement,
     }

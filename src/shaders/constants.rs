@@ -118,6 +118,10 @@ wgsl_constants! {
     INSPECT_ISOSURFACE: u32 as U32 = 5;
     INSPECT_VOLUME: u32 as U32 = 6;
     INSPECT_REFRACTION: u32 as U32 = 7;
+    /// Parallax mapping's march: its equal steps through the relief's slab and the secant steps
+    /// that refine the crossing (`crate::texture::parallax`'s).
+    PARALLAX_STEPS: u32 as U32 = crate::texture::parallax::STEPS;
+    PARALLAX_REFINEMENTS: u32 as U32 = crate::texture::parallax::REFINEMENTS;
     /// `Volume.gradient`: how a volume's normals are estimated.
     VOLUME_GRADIENT_OFF: u32 as U32 = 0;
     VOLUME_GRADIENT_FORWARD: u32 as U32 = 1;

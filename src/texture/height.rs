@@ -41,6 +41,10 @@ pub trait HeightField: Sync {
     /// The finite-difference step `Δ` to use when the user gives none: one texel for a texture
     /// (`Δ ≈ 1/n_t`).
     fn default_delta(&self) -> Vec2;
+
+    /// The least and the greatest height the field can take: the slab parallax mapping marches
+    /// through (WGSL twin: `height_range` in `shaders/common/surface.wgsl`).
+    fn range(&self) -> (f32, f32);
 }
 
 /// A grey-level texture as a height field: the red channel of level 0, bilinear, repeat.
@@ -62,6 +66,10 @@ impl HeightField for TextureHeight {
 
     fn default_delta(&self) -> Vec2 {
         Vec2::new(1.0 / self.level.width as f32, 1.0 / self.level.height as f32)
+    }
+
+    fn range(&self) -> (f32, f32) {
+        (0.0, 1.0)
     }
 }
 
@@ -89,6 +97,10 @@ impl HeightField for SineField {
     fn default_delta(&self) -> Vec2 {
         // A 64th of the shortest period: fine enough to look smooth, far from f32's limit.
         1.0 / (64.0 * self.frequency.abs().max(Vec2::ONE))
+    }
+
+    fn range(&self) -> (f32, f32) {
+        (-self.amplitude.abs(), self.amplitude.abs())
     }
 }
 
@@ -175,6 +187,11 @@ impl HeightField for ValueNoise {
         // A 16th of the finest octave's cell.
         let finest = self.cells.max(1) << (self.octaves.max(1) - 1).min(20);
         Vec2::splat(1.0 / (16.0 * finest as f32))
+    }
+
+    fn range(&self) -> (f32, f32) {
+        // Octave o adds at most a/2^o: less than 2a in all.
+        (-2.0 * self.amplitude.abs(), 2.0 * self.amplitude.abs())
     }
 }
 

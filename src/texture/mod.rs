@@ -9,6 +9,7 @@
 //! - [`height`]: height fields `f_h(u, v)`: grey textures, a sine field, value noise.
 //! - [`bump`]: finite differences and the perturbed normal `n' = normalize(t'_u × t'_v)`.
 //! - [`tangents`]: `t_u`, `t_v` per triangle and per vertex (MikkTSpace), glTF normal maps.
+//! - [`parallax`]: parallax occlusion mapping, the view ray marched through the relief.
 //! - [`displacement`]: the surface `p + k·f(u, v)·n` itself, pre-tessellated for both renderers.
 //!
 //! How the renderers use them (one meaning in both, so raster and trace stay comparable):
@@ -33,6 +34,7 @@ pub mod displacement;
 pub mod height;
 pub mod lod;
 pub mod mipmap;
+pub mod parallax;
 pub mod tangents;
 
 pub use bump::{BumpParams, bump_normal, height_gradient, perturbed_normal};

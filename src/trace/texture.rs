@@ -65,6 +65,7 @@ use crate::base::TextureId;
 use crate::output::srgb_decode;
 use crate::scene::{ColorSpace, Material, ProceduralHeight, Scene, Texture};
 use crate::settings::{BumpSettings, TextureFilter, TextureSettings, TracerLod};
+use crate::texture::parallax::parallax_uv;
 use crate::texture::tangents::normal_map_normal;
 use crate::texture::{
     BumpParams, Filter, HeightField, MipChain, RayCone, SineField, TextureHeight, ValueNoise, bump_normal,
@@ -281,6 +282,25 @@ impl SceneTextures {
             n = normal_map_normal(n, t.extend(sign), rgb, material.normal_scale);
         }
         n
+    }
+
+    /// Parallax mapping (`bump.method = "parallax"`, `crate::texture::parallax`): `hit` with the
+    /// texture coordinates of the point of the displaced surface that the ray along `direction`
+    /// meets first, where the material has a height field; `None` otherwise.
+    pub fn parallaxed(
+        &self,
+        material: &Material,
+        hit: &SurfaceHit,
+        direction: Vec3,
+        settings: &BumpSettings,
+    ) -> Option<SurfaceHit> {
+        if !settings.enabled || settings.method != crate::settings::BumpMethod::Parallax {
+            return None;
+        }
+        let k = material.bump_scale * settings.scale;
+        let frame = (hit.normal, hit.dpdu, hit.dpdv);
+        let uv = self.with_height_field(material, |field| parallax_uv(field, k, hit.uv, frame, direction))?;
+        Some(SurfaceHit { uv, ..*hit })
     }
 
     /// Bump mapping's slopes `(du, dv) = k·∇f_h` at the hit, where it applies.

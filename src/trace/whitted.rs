@@ -310,6 +310,9 @@ impl Whitted<'_> {
     ) -> Vec3 {
         let material = &self.scene.materials[hit.material.0];
         let v = -ray.direction;
+        // Parallax mapping shades the point of the relief the ray meets first.
+        let parallaxed = self.textures.parallaxed(material, hit, ray.direction, &self.bump);
+        let hit = parallaxed.as_ref().unwrap_or(hit);
         // The teaching views show the nearest surface itself, blended or not.
         if depth == 0 {
             let shown = match self.bump.view {
