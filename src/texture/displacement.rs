@@ -439,6 +439,36 @@ mod tests {
         SineField { amplitude, frequency: Vec2::new(2.0, 2.0) }
     }
 
+    /// `f = u`: a field that does not tile.
+    struct Ramp;
+    impl HeightField for Ramp {
+        fn height(&self, uv: Vec2) -> f32 {
+            uv.x
+        }
+        fn default_delta(&self) -> Vec2 {
+            Vec2::splat(0.01)
+        }
+        fn range(&self) -> (f32, f32) {
+            (0.0, 1.0)
+        }
+    }
+
+    /// The edges of `mesh` (by their ends' positions) not met by exactly two triangles; a pole's
+    /// degenerate triangles left out.
+    fn open_edges(mesh: &Mesh) -> usize {
+        let mut edges: HashMap<([u32; 3], [u32; 3]), i32> = HashMap::new();
+        for t in mesh.indices.chunks_exact(3) {
+            let p = [t[0], t[1], t[2]].map(|i| position_key(mesh.positions[i as usize]));
+            if p[0] == p[1] || p[1] == p[2] || p[0] == p[2] {
+                continue;
+            }
+            for (a, b) in [(p[0], p[1]), (p[1], p[2]), (p[2], p[0])] {
+                *edges.entry(if a < b { (a, b) } else { (b, a) }).or_default() += 1;
+            }
+        }
+        edges.values().filter(|&&count| count != 2).count()
+    }
+
     #[test]
     fn a_split_triangle_has_n_squared_triangles_and_shares_its_edges() {
         let mesh = Mesh::plane(Vec2::new(2.0, 2.0), Vec2::ONE);
@@ -475,19 +505,33 @@ mod tests {
             let expected = split.positions[i] + 0.1 * field.height(uv) * split.normals[i];
             assert!(moved.positions[i].distance(expected) < 1e-5, "{i}: {} against {expected}", moved.positions[i]);
         }
-        // Closed: each edge of the displaced mesh, by its ends' positions, is met by two triangles.
-        let mut edges: HashMap<([u32; 3], [u32; 3]), i32> = HashMap::new();
-        for t in moved.indices.chunks_exact(3) {
-            let p = [t[0], t[1], t[2]].map(|i| position_key(moved.positions[i as usize]));
-            if p[0] == p[1] || p[1] == p[2] || p[0] == p[2] {
-                continue; // a pole's degenerate triangle
-            }
-            for (a, b) in [(p[0], p[1]), (p[1], p[2]), (p[2], p[0])] {
-                *edges.entry(if a < b { (a, b) } else { (b, a) }).or_default() += 1;
-            }
-        }
-        let open = edges.values().filter(|&&count| count != 2).count();
-        assert_eq!(open, 0, "{open} of {} edges are not shared by two triangles", edges.len());
+        assert_eq!(open_edges(&moved), 0, "the displaced sphere is closed");
+        // A height field that does not tile (f = u: 0 on one side of the seam, 1 on the other):
+        // the seam's two sides move by their mean, and the sphere stays closed.
+        let moved = displaced_mesh(&sphere, &Ramp, 0.1, Mat4::IDENTITY, 3);
+        assert_eq!(open_edges(&moved), 0, "a seam of a field that does not tile is closed");
+    }
+
+    /// Bad input: a mesh without texture coordinates or normals, with a degenerate triangle and
+    /// an index out of range: displaced without a panic, every position and normal finite (no
+    /// coordinates: a constant height, the mesh moved along its faces' normals).
+    #[test]
+    fn a_mesh_without_uvs_or_normals_and_with_degenerate_triangles_is_displaced() {
+        let mesh = Mesh {
+            name: "bare".into(),
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Y, Vec3::new(2.0, 0.0, 0.0)],
+            normals: Vec::new(),
+            uvs: Vec::new(),
+            tangents: Vec::new(),
+            // A good triangle, one with two corners at one point, one on a line, one out of range.
+            indices: vec![0, 1, 2, 0, 2, 3, 0, 1, 4, 0, 1, 9],
+        };
+        let moved = displaced_mesh(&mesh, &flat(1.0), 0.1, Mat4::IDENTITY, 3);
+        assert!(moved.positions.iter().chain(&moved.normals).all(|v| v.is_finite()));
+        assert_eq!(moved.positions.len(), moved.normals.len());
+        assert!(moved.indices.iter().all(|&i| (i as usize) < moved.positions.len()));
+        // The out-of-range triangle is left out; the other three are split 9 ways each.
+        assert_eq!(moved.indices.len() / 3, 3 * 9);
     }
 
     #[test]
