@@ -206,6 +206,41 @@ fn no_wgsl_function_runs_over_100_lines_and_the_shading_over_80() {
     assert!(shading <= 80, "shade_surface has {shading} lines");
 }
 
+/// The viewer's frame stays one reader's worth: `Viewer` holds at most 15 fields (each tool's
+/// state is its own: the script, the cursor's tools, the inspection, the error budget, the lab)
+/// and `src/viewer/frame.rs` at most 500 lines (the steps, the lab's part, the settings' changes
+/// and each tool's work live beside it).
+#[test]
+fn the_viewer_is_tools_around_a_small_frame() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/viewer/frame.rs");
+    let source = std::fs::read_to_string(&path).expect("reading the viewer's frame");
+    let lines = source.lines().count();
+    assert!(lines <= 500, "src/viewer/frame.rs has {lines} lines");
+    let fields = struct_fields(&source, "Viewer").expect("pub struct Viewer in src/viewer/frame.rs");
+    assert!(fields.len() <= 15, "Viewer has {} fields: {fields:?}", fields.len());
+    // The counter can tell.
+    let made_up = "pub struct Viewer {\n    /// A doc.\n    pub a: u32,\n    b: Option<(u32, u32)>,\n    #[cfg(x)]\n    c: Vec<u8>,\n}\n";
+    assert_eq!(struct_fields(made_up, "Viewer").unwrap(), ["a", "b", "c"]);
+}
+
+/// The fields of `pub struct NAME { … }` in `source`, by name.
+fn struct_fields(source: &str, name: &str) -> Option<Vec<String>> {
+    let start = source.find(&format!("pub struct {name} {{"))?;
+    let body = &source[start..];
+    let body = &body[body.find('{')? + 1..body.find("\n}")?];
+    Some(
+        body.lines()
+            .map(str::trim)
+            .filter(|line| !line.starts_with("//") && !line.starts_with("#["))
+            .filter_map(|line| {
+                let line = line.trim_start_matches("pub(super) ").trim_start_matches("pub ");
+                let (field, _) = line.split_once(':')?;
+                field.chars().all(|c| c.is_ascii_alphanumeric() || c == '_').then(|| field.to_owned())
+            })
+            .collect(),
+    )
+}
+
 /// The checker on a made-up source: braces in comments, strings, raw strings and characters,
 /// lifetimes, an array type in a signature, a nested function, a declaration without a body, a
 /// function of exactly the limit and one a line over it.

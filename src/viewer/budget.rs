@@ -75,6 +75,15 @@ impl FrameBudget {
     }
 }
 
+/// The frames' pace: the render scale moving frames are drawn at, when the camera last moved (plus
+/// the settling time), and when the last frame started and whether it asked for the next at once.
+#[derive(Clone, Debug, Default)]
+pub struct Pace {
+    pub scale: FrameBudget,
+    pub moving_until: Option<web_time::Instant>,
+    pub last_frame: Option<(web_time::Instant, bool)>,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

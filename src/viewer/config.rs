@@ -164,6 +164,15 @@ pub fn apply_settings(defaults: &RenderSettings, changes: &toml::Table) -> (Rend
     (settings, warnings)
 }
 
+/// What the viewer remembers of the settings: those changed in each scene opened before, by scene
+/// key, and the settings and the scene's own the panel's list of changed settings was made from,
+/// with the list.
+#[derive(Clone, Debug, Default)]
+pub struct Remembered {
+    pub scenes: BTreeMap<String, toml::Table>,
+    pub changed: (RenderSettings, RenderSettings, Vec<String>),
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

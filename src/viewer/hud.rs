@@ -143,3 +143,20 @@ impl FrameStats {
         text
     }
 }
+
+/// The panel's notices (the last twenty), and the camera section's error.
+#[derive(Clone, Debug, Default)]
+pub struct Notices {
+    pub list: Vec<String>,
+    pub camera_error: Option<String>,
+}
+
+impl Notices {
+    /// Adds `message`, dropping the oldest past twenty.
+    pub fn push(&mut self, message: String) {
+        self.list.push(message);
+        if self.list.len() > 20 {
+            self.list.remove(0);
+        }
+    }
+}

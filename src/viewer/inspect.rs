@@ -216,3 +216,11 @@ impl Projector<'_> {
         );
     }
 }
+
+/// The inspect tool's state: the inspected pixel's explanation, and a pixel to inspect once the
+/// view has its size (a click, the I key, the step `inspect`).
+#[derive(Default)]
+pub struct InspectTool {
+    pub shown: Option<Inspection>,
+    pub next: Option<glam::Vec2>,
+}

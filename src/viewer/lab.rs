@@ -242,6 +242,11 @@ pub struct LabView {
     difference: super::lab_difference::DifferenceView,
     /// The last check run from the panel.
     pub checking: Option<Checking>,
+    /// A check asked for (the panel's button, the step `lab check`), started where the frame has
+    /// the GPU.
+    pub check_next: bool,
+    /// The last finished check's `results.json`, until the page takes it.
+    pub results: Option<String>,
 }
 
 impl LabView {
@@ -252,6 +257,8 @@ impl LabView {
             shown: LabShown::Student,
             difference: Default::default(),
             checking: None,
+            check_next: false,
+            results: None,
         }
     }
 

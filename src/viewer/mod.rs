@@ -28,20 +28,25 @@
 pub mod budget;
 pub mod camera_control;
 pub mod config;
+pub mod error_budget;
 pub mod frame;
 pub mod hud;
 pub mod inspect;
 pub mod kept;
 pub mod lab;
 pub mod lab_difference;
+pub mod lab_frame;
 pub mod panel;
 pub mod picking;
 pub mod raster_view;
 pub mod scene_panel;
+pub mod scene_settings;
 pub mod scene_state;
 pub mod screen;
 pub mod script;
 pub mod seen;
+pub mod steps;
+pub mod tools;
 pub mod traced;
 pub mod ui;
 pub mod upscale;
@@ -211,10 +216,10 @@ impl App {
             let _ = proxy.send_event(Wake);
         };
         let mut viewer = Viewer::new(&mut screen, scene, &config, self.options.steps.clone(), wake, self.lab.take());
-        viewer.notices.extend(notices);
+        viewer.notices.list.extend(notices);
         viewer.scene.overrides = std::mem::take(&mut self.overrides);
         viewer.apply_settings(&self.settings);
-        viewer.scripted = self.options.scripted();
+        viewer.script.scripted = self.options.scripted();
         if self.options.stats {
             println!("adapter: {}", screen.gpu.describe());
         }
@@ -244,7 +249,7 @@ impl App {
         if self.options.stats
             && let Some((_, viewer)) = &self.running
         {
-            if let Some((_, _, w, h)) = viewer.view_pixels {
+            if let Some((_, _, w, h)) = viewer.view.pixels {
                 println!("3D view: {w}x{h} pixels");
             }
             println!("{}", viewer.stats.summary());

@@ -34,6 +34,8 @@ const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
 pub struct RasterView {
     renderer: Renderer,
+    /// What the device's shaders may use (the page's labs need it).
+    device_profile: Profile,
     composition: Composition,
     format: wgpu::TextureFormat,
     /// The scene revision the renderer loaded.
@@ -101,6 +103,12 @@ pub enum Drawn {
 }
 
 impl RasterView {
+    /// What the device's shaders may use.
+    #[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+    pub fn profile(&self) -> Profile {
+        self.device_profile
+    }
+
     /// The view of `scene`, drawn by passes compiled from `wgsl` (Mirador's own, or a lab's:
     /// `super::lab`).
     pub fn new(screen: &mut Screen, scene: &Scene, revision: u64, wgsl: Wgsl) -> RasterView {
@@ -115,6 +123,7 @@ impl RasterView {
         let texture_id = screen.painter.register_native_texture(&gpu.device, &view, wgpu::FilterMode::Nearest);
         RasterView {
             renderer,
+            device_profile: gpu.profile(),
             composition: screen.composition,
             format,
             revision,

@@ -38,7 +38,10 @@
 //!
 //! Blank lines and lines starting with `#` are skipped in script files.
 
+use std::collections::VecDeque;
 use std::path::{Path, PathBuf};
+
+use web_time::Instant;
 
 use glam::{Vec2, Vec3};
 
@@ -207,6 +210,37 @@ pub fn parse_file(path: &Path) -> Result<Vec<Step>, ScriptError> {
             parse(line).map_err(|e| ScriptError::Line { path: path.into(), line: number + 1, source: Box::new(e) })
         })
         .collect()
+}
+
+/// Scripted steps still to run and the wait in progress.
+#[derive(Default)]
+pub struct Script {
+    pub(super) steps: VecDeque<Step>,
+    pub(super) wait_frames: u32,
+    /// A `wait 2s` step's end.
+    pub(super) wait_until: Option<Instant>,
+    pub(super) wait_traced_since: Option<Instant>,
+    /// A `wait checked` step's start.
+    pub(super) wait_checked_since: Option<Instant>,
+    /// A `measure` step ran: the stats start where it said, not after the last step.
+    pub(super) measured: bool,
+    /// Start the stats again after this frame.
+    pub(super) reset_stats: bool,
+    /// A scripted run: every frame follows the last at once.
+    pub scripted: bool,
+    /// The screenshot asked for (a step, the panel's button, the page), and since when it has
+    /// waited for egui's animations to end.
+    pub(super) screenshot: Option<PathBuf>,
+    pub(super) screenshot_waiting: Option<Instant>,
+    /// Print the volume ray under the cursor after this frame's UI (the `probe` step).
+    pub(super) print_probe: bool,
+}
+
+impl Script {
+    /// A script of `steps`.
+    pub fn new(steps: Vec<Step>) -> Script {
+        Script { steps: steps.into(), ..Default::default() }
+    }
 }
 
 #[cfg(test)]

@@ -59,6 +59,8 @@ pub struct ViewState {
     pub scripted_cursor: Option<glam::Vec2>,
     /// Clicks inspect pixels (`super::inspect`) instead of picking objects.
     pub inspecting: bool,
+    /// The 3D view's size in pixels, and where it sits in the window (`x, y, width, height`).
+    pub pixels: Option<(u32, u32, u32, u32)>,
 }
 
 impl Default for ViewState {
@@ -73,6 +75,7 @@ impl Default for ViewState {
             overlay_open: true,
             scripted_cursor: None,
             inspecting: false,
+            pixels: None,
         }
     }
 }

@@ -361,3 +361,12 @@ pub fn probe_at(
         probe(scene, settings, &ray, picker.nearest(&ray))
     })
 }
+
+/// What the viewer shows of what is under the cursor: the volume ray's samples, the direction the
+/// environment is seen in (the lat–long view's marker), and the cursor the last layout saw.
+#[derive(Default)]
+pub struct CursorTools {
+    pub probe: CursorProbe,
+    pub seen: super::seen::CursorDirection,
+    pub at: Option<Vec2>,
+}

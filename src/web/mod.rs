@@ -151,9 +151,9 @@ impl App {
                 self.next_frame = None;
             }
         }
-        page::remember_view(viewer.view_pixels);
+        page::remember_view(viewer.view.pixels);
         page::remember_lab_file(viewer.lab_file());
-        if let Some(json) = viewer.lab_results.take() {
+        if let Some(json) = viewer.lab.as_mut().and_then(|lab| lab.results.take()) {
             page::lab_checked(json);
         }
     }

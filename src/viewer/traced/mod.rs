@@ -96,6 +96,9 @@ pub struct TracedView {
     pub worker: TracedWorker,
     pub image: Option<Shown>,
     pub difference: Option<ShownDifference>,
+    /// What the current traced request was made from, and its key.
+    pub request: Option<(crate::scene::Camera, crate::RenderSettings, u64, Vec<crate::scene::Light>)>,
+    pub key: u64,
 }
 
 /// A traced image on screen.
@@ -120,7 +123,7 @@ fn color_image(image: &RgbaImage) -> egui::ColorImage {
 
 impl TracedView {
     pub fn new(wake: impl Fn() + Send + 'static) -> TracedView {
-        TracedView { worker: TracedWorker::start(wake), image: None, difference: None }
+        TracedView { worker: TracedWorker::start(wake), image: None, difference: None, request: None, key: 0 }
     }
 
     /// Uploads whatever the worker finished since the last frame; returns whether anything did.
