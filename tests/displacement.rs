@@ -162,3 +162,29 @@ fn a_huge_scale_and_a_level_past_the_bound_are_handled() {
     let summary = made.summary().expect("a summary");
     assert!(summary.contains("forced `ball` at level"), "{summary}");
 }
+
+/// The tessellation view (`bump.view = "tessellation"`) draws the displaced triangles' edges over
+/// the ball, finer at a finer level; the bump-mapped ball, which is no mesh, gets none.
+#[test]
+fn the_tessellation_view_shows_the_displaced_triangles() {
+    use mirador::settings::BumpView;
+    let edge_pixels = |method: BumpMethod, texels: f32| {
+        let mut scene = common::load("scenes/course/displacement-sphere.toml");
+        scene.settings.bump.method = method;
+        scene.settings.bump.displacement_texels = texels;
+        displacement::displace(&mut scene);
+        let mut settings = scene.settings.clone();
+        settings.bump.view = BumpView::Tessellation;
+        let image = common::raster(&scene, &settings);
+        // The edges' colour: green well above red and blue (neither the ball nor the sky is).
+        image.pixels().filter(|p| p.0[1] > 200 && p.0[0] < 200 && p.0[2] < 200).count()
+    };
+    let (coarse, fine, bumped) = (
+        edge_pixels(BumpMethod::Displacement, 8.0),
+        edge_pixels(BumpMethod::Displacement, 2.0),
+        edge_pixels(BumpMethod::Normal, 2.0),
+    );
+    eprintln!("edge pixels: level 1 {coarse}, level 3 {fine}, bump-mapped {bumped}");
+    assert_eq!(bumped, 0, "no mesh, no edges");
+    assert!(coarse > 2_000 && fine > coarse, "{coarse} then {fine}");
+}

@@ -113,7 +113,7 @@ fn shadow_method_code(settings: &RenderSettings, shadowed: bool) -> u32 {
 /// The `BUMP_VIEW` code.
 fn bump_view_code(view: BumpView) -> u32 {
     match view {
-        BumpView::Off => 0,
+        BumpView::Off | BumpView::Tessellation => 0,
         BumpView::Normals => BUMP_VIEW_NORMALS,
         BumpView::Tangents => BUMP_VIEW_TANGENTS,
     }

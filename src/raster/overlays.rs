@@ -32,6 +32,49 @@ pub struct Overlays {
 pub const FRUSTUM_COLOUR: Vec3 = Vec3::new(1.0, 0.8, 0.1);
 /// The colour of the volumes' grid wireframe.
 pub const WIREFRAME_COLOUR: Vec3 = Vec3::new(0.2, 0.85, 1.0);
+/// The colour of the meshes' triangle edges (`bump.view = "tessellation"`).
+pub const TESSELLATION_COLOUR: Vec3 = Vec3::new(0.1, 1.0, 0.3);
+/// The most edges the tessellation view draws: past them, a mesh's are skipped (said in the log).
+const MAX_EDGES: usize = 3_000_000;
+
+/// Every edge of every mesh object's triangles (a displaced surface is one), once, as world-space
+/// segments: the tessellation view (`bump.view = "tessellation"`). Analytic shapes are left out:
+/// the rasterizer tessellates them by their size on screen, frame by frame.
+pub fn mesh_edges(scene: &crate::Scene) -> Vec<Vec3> {
+    let mut lines = Vec::new();
+    for object in &scene.objects {
+        let crate::scene::Shape::Mesh(index) = object.shape else { continue };
+        let Some(mesh) = scene.meshes.get(index) else { continue };
+        let mut edges: Vec<(u32, u32)> = mesh
+            .indices
+            .chunks_exact(3)
+            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+            .map(|(a, b)| (a.min(b), a.max(b)))
+            .collect();
+        edges.sort_unstable();
+        edges.dedup();
+        if lines.len() / 2 + edges.len() > MAX_EDGES {
+            log::warn!("the tessellation view draws at most {MAX_EDGES} edges: `{}`'s are left out", object.name);
+            continue;
+        }
+        // Lifted off the surface along the normals by a thousandth of the mesh's size, so that the
+        // depth test keeps the edges in front of the triangles they bound (not half of them).
+        let (low, high) =
+            mesh.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| (l.min(*p), h.max(*p)));
+        let lift = 1e-3 * (high - low).length();
+        let world = |i: u32| {
+            let p = *mesh.positions.get(i as usize)?;
+            let n = mesh.normals.get(i as usize).copied().unwrap_or(Vec3::ZERO);
+            Some(object.world_from_local.transform_point3(p + lift * n))
+        };
+        for (a, b) in edges {
+            if let (Some(a), Some(b)) = (world(a), world(b)) {
+                lines.extend([a, b]);
+            }
+        }
+    }
+    lines
+}
 
 impl Overlays {
     pub fn new(device: &wgpu::Device, scene_layouts: &SceneLayouts) -> Overlays {

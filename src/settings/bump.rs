@@ -65,6 +65,9 @@ choices! {
         Normals,
         /// The tangent `t_u` as colour the same way: the frame the bumps are built in.
         Tangents,
+        /// The shaded image with the rasterizer's mesh triangles' edges drawn over it: how finely
+        /// displacement tessellated the relief (and any model's own mesh).
+        Tessellation,
     }
 }
 

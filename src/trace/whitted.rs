@@ -316,7 +316,7 @@ impl Whitted<'_> {
         // The teaching views show the nearest surface itself, blended or not.
         if depth == 0 {
             let shown = match self.bump.view {
-                BumpView::Off => None,
+                BumpView::Off | BumpView::Tessellation => None,
                 BumpView::Normals => Some(0.5 + 0.5 * self.shading_normal(material, hit, v)),
                 BumpView::Tangents => Some(0.5 + 0.5 * hit.dpdu.normalize_or_zero()),
             };

@@ -25,7 +25,7 @@ use super::environment::pass::EnvironmentPass;
 use super::inspect::{Inspector, RasterPixel, RecordKind};
 use super::mirror::MirrorPlane;
 use super::mirror::pass::{MirrorNode, MirrorPass, volumes as mirror_volumes};
-use super::overlays::{FRUSTUM_COLOUR, Overlays, WIREFRAME_COLOUR, box_edges};
+use super::overlays::{FRUSTUM_COLOUR, Overlays, TESSELLATION_COLOUR, WIREFRAME_COLOUR, box_edges, mesh_edges};
 use super::present::PresentPass;
 use super::refraction::{PreparedRefraction, RefractionPass};
 use super::scene_gpu::{DrawnAlone, SceneGpu, SceneLayouts, SurfaceLayout};
@@ -43,7 +43,7 @@ use crate::gpu::Gpu;
 use crate::gpu::mipmap::MipmapGenerator;
 use crate::output::OutputTransform;
 use crate::scene::Scene;
-use crate::settings::{MirrorView, RenderSettings};
+use crate::settings::{BumpView, MirrorView, RenderSettings};
 use crate::shaders::Wgsl;
 use crate::volume::WIREFRAME_CELLS;
 use plan::{FramePlan, plan};
@@ -402,6 +402,9 @@ impl Renderer {
             let lines: Vec<[Vec3; 2]> =
                 ctx.scene.volumes.iter().flat_map(|v| v.wireframe_lines(WIREFRAME_CELLS)).collect();
             self.overlays.record_lines(ctx, frame, main, lines.as_flattened(), WIREFRAME_COLOUR);
+        }
+        if settings.bump.view == BumpView::Tessellation {
+            self.overlays.record_lines(ctx, frame, main, &mesh_edges(ctx.scene), TESSELLATION_COLOUR);
         }
         if settings.mirrors.view == MirrorView::Camera {
             let edges = box_edges(&mirror_volumes(&plan.mirror_nodes));
