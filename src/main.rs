@@ -910,7 +910,9 @@ fn budget(args: SceneArgs, trace_args: TraceArgs, sheet: Option<&Path>, json: Op
     let mut clock = Stopwatch::default();
     let mut scene = prepare(&args, &mut clock)?;
     apply_trace_args(&mut scene.settings, &trace_args)?;
-    let traced_radiance = ray_trace(&scene, trace_args.threads, &mut clock, args.stats)?;
+    // Bump and parallax mapping are measured against the displaced surface they stand for.
+    let reference = mirador::budget::reference_scene(&scene, &scene.settings);
+    let traced_radiance = ray_trace(&reference, trace_args.threads, &mut clock, args.stats)?;
     let traced = traced_radiance.to_rgba8(mirador::output::OutputTransform::of(&scene.settings));
     let gpu = clock.time("device", Gpu::headless)?;
     gpu.check_image_size((scene.camera.width, scene.camera.height))?;

@@ -188,3 +188,28 @@ fn the_tessellation_view_shows_the_displaced_triangles() {
     assert_eq!(bumped, 0, "no mesh, no edges");
     assert!(coarse > 2_000 && fine > coarse, "{coarse} then {fine}");
 }
+
+/// What bump and parallax mapping cost, in the error budget: against the displaced surface they
+/// stand for (the reference is traced on it), swapping them for it removes nearly all of the
+/// difference on the grazing-lit plane, and with every approximation swapped nothing is left.
+#[test]
+fn the_budget_measures_bump_and_parallax_mapping_against_the_displaced_surface() {
+    let gpu = common::gpu();
+    for (method, least) in [(BumpMethod::Normal, 0.1), (BumpMethod::Parallax, 0.08)] {
+        let mut scene = common::load("scenes/course/displacement-plane.toml");
+        scene.settings.bump.method = method;
+        let settings = scene.settings.clone();
+        let reference = mirador::budget::reference_scene(&scene, &settings);
+        let traced = mirador::trace::render_image(&reference, &settings);
+        let budget = mirador::budget::budget(gpu, &scene, &settings, traced);
+        let relief = budget.items.iter().find(|i| i.name == "bump and parallax mapping").expect("the relief's row");
+        eprintln!("{method:?}: whole {:.4}, relief alone {:.4}, floor {:.4}", budget.whole, relief.alone, budget.floor);
+        assert!(relief.alone > least && relief.alone > 0.8 * budget.whole, "{method:?}: {}", budget.report());
+        assert!(budget.floor < 0.005, "{method:?}: {}", budget.report());
+    }
+    // The other side: displaced already, the scene makes no such approximation.
+    let mut scene = common::load("scenes/course/displacement-plane.toml");
+    scene.settings.bump.method = BumpMethod::Displacement;
+    let used = mirador::settings::Traced::Relief.row().in_use;
+    assert!(!used(&scene.facts(), &scene.settings));
+}

@@ -93,11 +93,31 @@ pub struct Budget {
     pub hybrid: RgbaImage,
 }
 
+/// The scene the budget's reference is traced on: `scene` itself, or, where it bump or parallax
+/// maps a height field, the displaced surface those stand for (the approximations table's
+/// `relief`, whose counterpart is geometry, not a traced term).
+pub fn reference_scene<'s>(scene: &'s Scene, settings: &RenderSettings) -> std::borrow::Cow<'s, Scene> {
+    if (Traced::Relief.row().in_use)(&scene.facts(), settings) {
+        std::borrow::Cow::Owned(crate::texture::displacement::displaced(scene))
+    } else {
+        std::borrow::Cow::Borrowed(scene)
+    }
+}
+
 /// The budget of `scene` with `settings`, drawn on `gpu`, against `traced` (the tracer's image
-/// of the scene with `settings`).
+/// of [`reference_scene`] with `settings`).
 pub fn budget(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, traced: RgbaImage) -> Budget {
+    // The relief's swap draws the displaced scene: a frame of its own.
+    let displaced = reference_scene(scene, settings);
     let mut headless = Headless::new(gpu, scene);
-    let mut raster = |settings: &RenderSettings| headless.render(gpu, scene, settings);
+    let mut relief: Option<Headless> = None;
+    let mut raster = |settings: &RenderSettings| {
+        if settings.hybrid.relief {
+            relief.get_or_insert_with(|| Headless::new(gpu, &displaced)).render(gpu, &displaced, settings)
+        } else {
+            headless.render(gpu, scene, settings)
+        }
+    };
     let facts = scene.facts();
     let used: Vec<Traced> = Traced::ALL.iter().copied().filter(|t| (t.row().in_use)(&facts, settings)).collect();
     let with = |traced_ones: &mut dyn Iterator<Item = &Traced>| {
@@ -150,11 +170,13 @@ impl Budget {
         if self.items.is_empty() {
             text += "the scene uses none of the approximations the hybrid can trace\n";
         } else {
-            text += &format!("{:<18} {:>8} {:>11}  swapped\n", "approximation", "alone", "left alone");
+            let width = self.items.iter().map(|i| i.name.chars().count()).max().unwrap_or(0).max(18);
+            text += &format!("{:<width$} {:>8} {:>11}  swapped\n", "approximation", "alone", "left alone");
             let mut items: Vec<&Item> = self.items.iter().collect();
             items.sort_by(|a, b| b.alone.total_cmp(&a.alone));
             for item in items {
-                text += &format!("{:<18} {:>8.4} {:>11.4}  {}\n", item.name, item.alone, item.left_alone, item.swap);
+                text +=
+                    &format!("{:<width$} {:>8.4} {:>11.4}  {}\n", item.name, item.alone, item.left_alone, item.swap);
             }
         }
         text += &format!("every approximation traced: FLIP {:.4}, the floor:\n", self.floor);

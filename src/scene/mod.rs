@@ -208,6 +208,10 @@ impl Scene {
             reflective: self.objects.iter().any(|o| material(o).reflects()),
             transparent: self.objects.iter().any(|o| material(o).is_transparent()),
             textured: self.objects.iter().any(|o| material(o).texture.is_some()),
+            heights: self
+                .objects
+                .iter()
+                .any(|o| material(o).height_map.is_some() || material(o).height_field.is_some()),
         }
     }
 

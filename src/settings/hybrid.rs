@@ -28,6 +28,8 @@ pub struct SceneFacts {
     pub transparent: bool,
     /// Whether some object's material has a colour texture.
     pub textured: bool,
+    /// Whether some object's material has a height field (a height map or a procedural one).
+    pub heights: bool,
 }
 
 /// One of the rasterizer's approximations with a traced counterpart: a row of the table.
@@ -182,6 +184,21 @@ approximations! {
         replaces: |_| {},
         layers: 1,
     },
+    /// The height fields' relief made as the displaced surface `p + k·f·n` (displacement
+    /// mapping, `bump.method = "displacement"`), in place of bump or parallax mapping, which
+    /// shade the smooth surface. Its counterpart is no traced term but geometry: the scene is
+    /// made again, displaced, for both renderers (`crate::texture::displacement`), and the
+    /// budget's reference is the tracer's image of the displaced surface.
+    relief: Relief {
+        budget: "bump and parallax mapping",
+        swap: "the smooth surface shaded as if bumped (or with the view ray marched) → the displaced surface",
+        sections: &["bump"],
+        in_use: |scene, settings| {
+            scene.heights && settings.bump.enabled && settings.bump.method != super::BumpMethod::Displacement
+        },
+        replaces: |settings| settings.bump.method = super::BumpMethod::Displacement,
+        layers: 0,
+    },
 }
 
 /// The layer of a view's traced image that holds the surface colour `C` and the object + 1 the
@@ -288,7 +305,7 @@ mod tests {
     #[test]
     fn bits_and_layers_are_numbered_from_the_rows() {
         assert_eq!(Traced::Shadows.bit(), 1);
-        assert_eq!(Traced::Lights.bit(), 1 << (APPROXIMATIONS.len() - 1));
+        assert_eq!(Traced::Relief.bit(), 1 << (APPROXIMATIONS.len() - 1));
         assert_eq!(Traced::Shadows.layer(), SURFACE_LAYER + 1);
         for pair in Traced::ALL.windows(2) {
             assert_eq!(pair[1].layer(), pair[0].layer() + pair[0].row().layers);

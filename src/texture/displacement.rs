@@ -30,7 +30,7 @@ use glam::{Mat4, Vec2, Vec3};
 
 use super::height::{HeightField, SineField, TextureHeight, ValueNoise};
 use crate::scene::{Material, Mesh, ProceduralHeight, Scene, Shape};
-use crate::settings::{BumpMethod, BumpSettings};
+use crate::settings::{BumpMethod, RenderSettings};
 
 /// The most triangles the displaced meshes of one scene may have together: about 100 MB of
 /// vertices and indices on the GPU, and a BVH the tracer builds in seconds.
@@ -85,9 +85,20 @@ fn thousands(n: usize) -> String {
     out
 }
 
-/// Whether `settings` ask for displaced geometry.
-pub fn wanted(settings: &BumpSettings) -> bool {
-    settings.enabled && settings.method == BumpMethod::Displacement
+/// Whether `settings` ask for displaced geometry: `bump.method = "displacement"`, or the hybrid's
+/// relief swapped for it (`hybrid.relief`, the approximations table's row).
+pub fn wanted(settings: &RenderSettings) -> bool {
+    settings.bump.enabled && (settings.bump.method == BumpMethod::Displacement || settings.hybrid.relief)
+}
+
+/// `scene` with its height fields displaced whatever its settings say: the surface bump and
+/// parallax mapping stand for, which the error budget's reference is traced on.
+pub fn displaced(scene: &Scene) -> Scene {
+    let mut displaced = scene.clone();
+    displaced.settings.bump.method = BumpMethod::Displacement;
+    displace(&mut displaced);
+    displaced.settings = scene.settings.clone();
+    displaced
 }
 
 /// Makes every object whose material has a height field (a `height_map` or a `height_field`)
@@ -98,7 +109,7 @@ pub fn wanted(settings: &BumpSettings) -> bool {
 pub fn displace(scene: &mut Scene) -> Displaced {
     let settings = scene.settings.bump;
     let mut report = Displaced::default();
-    if !wanted(&settings) {
+    if !wanted(&scene.settings) {
         return report;
     }
     let displaced: Vec<usize> =

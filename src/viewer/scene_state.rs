@@ -126,9 +126,9 @@ impl SceneState {
     pub fn displacement_changed(before: &RenderSettings, after: &RenderSettings) -> bool {
         use crate::texture::displacement::wanted;
         let (b, a) = (&before.bump, &after.bump);
-        wanted(b) != wanted(a)
-            || (wanted(a) && (b.scale != a.scale || b.displacement_texels != a.displacement_texels))
-            || (wanted(a) && before.sphere_segments != after.sphere_segments)
+        wanted(before) != wanted(after)
+            || (wanted(after) && (b.scale != a.scale || b.displacement_texels != a.displacement_texels))
+            || (wanted(after) && before.sphere_segments != after.sphere_segments)
     }
 
     /// Reloads the scene when its file changed on disk since it was loaded (polled, cheap);
