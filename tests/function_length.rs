@@ -175,18 +175,7 @@ fn no_function_in_src_runs_over_100_lines() {
 /// (`shaders/common/surface.wgsl`).
 #[test]
 fn no_wgsl_function_runs_over_100_lines_and_the_shading_over_80() {
-    let mut files = Vec::new();
-    let mut folders = vec![Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders")];
-    while let Some(folder) = folders.pop() {
-        for entry in std::fs::read_dir(&folder).expect("the shaders folder") {
-            let path = entry.expect("an entry").path();
-            if path.is_dir() {
-                folders.push(path);
-            } else if path.extension().is_some_and(|e| e == "wgsl") {
-                files.push(path);
-            }
-        }
-    }
+    let files = common::sources(&Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders"), "wgsl");
     assert!(files.len() > 15, "found {} files", files.len());
     let mut long = Vec::new();
     let mut shading = None;

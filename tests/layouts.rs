@@ -5,6 +5,8 @@
 //! pass sets is an `override` of its shader. So padding and codes are checked here instead of
 //! being kept in step by hand in two places.
 
+mod common;
+
 use std::mem::{offset_of, size_of};
 
 use mirador::raster::keys::{FrameKey, MaterialKey, shadow_filter_code};
@@ -241,7 +243,11 @@ fn shared_constants_are_written_once_in_rust() {
         .map(|rest| rest.split([':', ' ']).next().unwrap())
         .collect();
     assert!(names.len() >= 75, "{} constants in the prelude", names.len());
-    let files = wgsl_files(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders")));
+    let files: Vec<(String, String)> =
+        common::sources(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/shaders")), "wgsl")
+            .into_iter()
+            .map(|path| (path.display().to_string(), std::fs::read_to_string(&path).expect("a WGSL file")))
+            .collect();
     let declares = |text: &str, name: &str| text.lines().any(|l| l.trim_start().starts_with(&format!("const {name}:")));
     for (path, text) in &files {
         for name in &names {
@@ -270,20 +276,6 @@ fn shared_constants_are_written_once_in_rust() {
     let present = parse(&shaders::compose(shaders::PRESENT));
     let code = mirador::raster::present::tone_map_code(mirador::settings::ToneMap::Aces);
     assert_eq!(constant(std::slice::from_ref(&present), "TONE_MAP_ACES"), f64::from(code));
-}
-
-/// Every `.wgsl` file under `dir`, with its text.
-fn wgsl_files(dir: &std::path::Path) -> Vec<(String, String)> {
-    let mut files = Vec::new();
-    for entry in std::fs::read_dir(dir).expect("the shaders folder") {
-        let path = entry.expect("a folder entry").path();
-        if path.is_dir() {
-            files.extend(wgsl_files(&path));
-        } else if path.extension().is_some_and(|e| e == "wgsl") {
-            files.push((path.display().to_string(), std::fs::read_to_string(&path).expect("a WGSL file")));
-        }
-    }
-    files
 }
 
 /// The surface passes' own files, by name.

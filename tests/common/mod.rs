@@ -273,6 +273,11 @@ pub fn run_probe<I: bytemuck::Pod, O: bytemuck::Pod>(
 /// Every `.rs` file under `dir`, for the tests that read the source tree (its layers, its
 /// functions' lengths).
 pub fn rust_sources(dir: &Path) -> Vec<PathBuf> {
+    sources(dir, "rs")
+}
+
+/// Every file under `dir` whose name ends in `.{extension}`.
+pub fn sources(dir: &Path, extension: &str) -> Vec<PathBuf> {
     let mut files = Vec::new();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(dir) = stack.pop() {
@@ -280,7 +285,7 @@ pub fn rust_sources(dir: &Path) -> Vec<PathBuf> {
             let path = entry.expect("a directory entry").path();
             if path.is_dir() {
                 stack.push(path);
-            } else if path.extension().is_some_and(|e| e == "rs") {
+            } else if path.extension().is_some_and(|e| e == extension) {
                 files.push(path);
             }
         }
