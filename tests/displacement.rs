@@ -213,3 +213,32 @@ fn the_budget_measures_bump_and_parallax_mapping_against_the_displaced_surface()
     let used = mirador::settings::Traced::Relief.row().in_use;
     assert!(!used(&scene.facts(), &scene.settings));
 }
+
+/// `mirador explain` on a bump-mapped ball says what the relief would change at the pixel: at
+/// the outline, the relief standing out of the smooth circle; inside it, how much nearer the
+/// displaced surface is met. Displaced already, or with no height field, it says nothing.
+#[test]
+fn explain_names_what_bump_mapping_leaves_out() {
+    let gpu = common::gpu();
+    let scene = common::load("scenes/course/displacement-sphere.toml");
+    let explained = |scene: &Scene, pixel| {
+        mirador::explain::explain(gpu, scene, &scene.settings, pixel).expect("the pixel is explained").relief
+    };
+    // Where the displaced ball covers the sky the bump-mapped one leaves (found on row 150).
+    let traced = mirador::trace::render_image(&displacement::displaced(&scene), &scene.settings);
+    let bumped = mirador::trace::render_image(&scene, &scene.settings);
+    let sky = *bumped.get_pixel(0, 0);
+    let is_sky = |p: &image::Rgba<u8>| p.0.iter().zip(sky.0).take(3).all(|(a, b)| a.abs_diff(b) <= 2);
+    let outline = (0..scene.camera.width)
+        .find(|&x| is_sky(bumped.get_pixel(x, 150)) && !is_sky(traced.get_pixel(x, 150)))
+        .expect("a pixel of relief outside the circle");
+    let said = explained(&scene, (outline, 150)).expect("the relief is named at the outline");
+    assert!(said.contains("the relief stands out of the smooth outline"), "{said}");
+    let said = explained(&scene, (230, 230)).expect("the relief is named inside");
+    assert!(said.contains("nearer than the smooth one"), "{said}");
+    // The other side: displaced already, and a scene without height fields.
+    let displaced = with_method("scenes/course/displacement-sphere.toml", BumpMethod::Displacement);
+    assert_eq!(explained(&displaced, (230, 230)), None);
+    let plain = common::load("scenes/seed-simple.toml");
+    assert_eq!(explained(&plain, (100, 100)), None);
+}

@@ -326,3 +326,54 @@ fn largest(raster: &RasterSide, trace: &TraceSide) -> String {
         biggest(&trace.terms).unwrap_or_else(|| "none".into()),
     )
 }
+
+/// What bump or parallax mapping leaves out at a pixel, from the ray through it traced on the
+/// smooth surface the renderers shaded and on the displaced surface `p + k·f·n` it stands for:
+/// the outline (one hits, the other not), the distance (the displaced surface met nearer or
+/// farther), and the relief's own shadows (a light the smooth surface sees that the displaced
+/// one does not). `None` where the two rays meet alike.
+pub fn relief(smooth: &RayNode, displaced: &RayNode) -> Option<String> {
+    const LEAD: &str = "Bump mapping moves no geometry";
+    let blocked = |node: &RayNode| {
+        node.children.iter().filter(|c| c.kind == RayKind::Shadow && c.radiance.max_element() <= 0.0).count()
+    };
+    let stands_out = |object: Option<&str>| {
+        format!(
+            "{LEAD}: the relief stands out of the smooth outline here; the displaced surface covers this pixel \
+             (`{}`), the smooth one leaves it to what lies behind (bump.method = \"displacement\" draws it).",
+            object.unwrap_or("an isosurface")
+        )
+    };
+    let sinks = format!(
+        "{LEAD}: the displaced surface sinks inside the smooth outline here and leaves this pixel to what lies \
+         behind it (bump.method = \"displacement\" draws it)."
+    );
+    match (&smooth.hit, &displaced.hit) {
+        (None, Some(hit)) => Some(stands_out(hit.object.as_deref())),
+        (Some(_), None) => Some(sinks),
+        // Another surface: the relief in front of what the smooth one shows, or gone from it.
+        (Some(a), Some(b)) if a.object != b.object => {
+            Some(if b.distance < a.distance { stands_out(b.object.as_deref()) } else { sinks })
+        }
+        (Some(a), Some(b)) => {
+            let nearer = a.distance - b.distance;
+            let shadows = blocked(displaced).saturating_sub(blocked(smooth));
+            if shadows > 0 {
+                Some(format!(
+                    "{LEAD}: the displaced surface shadows itself here ({shadows} light(s) hidden by its relief) where \
+                     the smooth surface is lit; bump mapping casts no shadow of a bump."
+                ))
+            } else if nearer.abs() > 1e-3 * a.distance.max(1e-3) {
+                Some(format!(
+                    "{LEAD}: the tracer's ray meets the displaced surface {:.3} {} than the smooth one both \
+                     renderers shaded.",
+                    nearer.abs(),
+                    if nearer > 0.0 { "nearer" } else { "farther" }
+                ))
+            } else {
+                None
+            }
+        }
+        (None, None) => None,
+    }
+}

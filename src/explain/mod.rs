@@ -52,6 +52,10 @@ pub struct Explanation {
     /// On a planar mirror: what its mirrored camera saw at this pixel (the surface, its terms
     /// and lights), the rasterizer's counterpart of the tracer's reflected ray.
     pub through_mirror: Option<Box<RasterSide>>,
+    /// Where the scene bump or parallax maps a height field: what the displaced surface those
+    /// stand for is at this pixel, against the smooth one both renderers shaded
+    /// ([`diagnosis::relief`]).
+    pub relief: Option<String>,
 }
 
 /// A pixel near an agreeing one where the two renderers' displayed colours differ. FLIP's error
@@ -257,7 +261,21 @@ impl<'s> Explainer<'s> {
             Some(_) => None,
             None => self.nearest_difference(gpu, (x, y))?,
         };
-        Ok(Explanation { pixel: [x, y], raster, trace, diagnosis, nearest, through_mirror })
+        let relief = self.relief((x, y), &trace.rays);
+        Ok(Explanation { pixel: [x, y], raster, trace, diagnosis, nearest, through_mirror, relief })
+    }
+
+    /// Where the scene bump or parallax maps a height field (the approximations table's
+    /// `relief`): the pixel traced again on the displaced surface, and what that changes.
+    fn relief(&self, pixel: (u32, u32), smooth: &RayNode) -> Option<String> {
+        let settings = &self.settings;
+        let used = crate::settings::Traced::Relief.row().in_use;
+        if !used(&self.scene.facts(), settings) {
+            return None;
+        }
+        let displaced = crate::texture::displacement::displaced(self.scene);
+        let rays = trace_pixel(&Tracer::new(&displaced, settings), pixel);
+        diagnosis::relief(smooth, &rays)
     }
 
     /// Where the inspected pixel shows a planar mirror: one more inspected frame, recorded by

@@ -343,6 +343,10 @@ pub fn render(explanation: &Explanation) -> String {
             wrap(&sentence, 2 * COLUMN).iter().for_each(|l| out.push_str(&format!("  {l}\n")));
         }
     }
+    if let Some(sentence) = &explanation.relief {
+        out.push_str("\nwhat the relief would change\n");
+        wrap(sentence, 2 * COLUMN).iter().for_each(|l| out.push_str(&format!("  {l}\n")));
+    }
     out.push_str("\nthe tracer's ray tree\n");
     out.push_str(&ray_tree(&trace.rays));
     out
