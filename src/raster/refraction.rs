@@ -45,7 +45,7 @@ use super::inspect::{GpuInspectFragment, INSPECT_REFRACTION, Part, RecordKind};
 use super::keys::{FrameKey, MaterialKey, constants, pipeline_constants};
 use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::scene_pass::scissor;
-use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
+use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT, PerTarget};
 use super::view::FrameView;
 use crate::gpu::depth_copy::{DepthCopy, DepthImageCopy};
 use crate::gpu::layout;
@@ -128,7 +128,7 @@ pub struct RefractionPass {
     front: HashMap<FrontKey, wgpu::RenderPipeline>,
     /// The images of each view's targets (by the targets' depth image), kept while those targets
     /// are drawn into.
-    images: Vec<(wgpu::TextureView, RefractionImages)>,
+    images: PerTarget<RefractionImages>,
     depth_copy: DepthCopy,
 }
 
@@ -162,7 +162,7 @@ impl RefractionPass {
             layout,
             back: HashMap::new(),
             front: HashMap::new(),
-            images: Vec::new(),
+            images: PerTarget::default(),
             depth_copy: DepthCopy::new(device, DEPTH_FORMAT),
         }
     }
@@ -185,7 +185,7 @@ impl RefractionPass {
             return None;
         }
         let mode = ctx.settings.transparency.refraction;
-        self.images.retain(|(depth, _)| views.iter().any(|(_, t)| t.depth.view == *depth));
+        self.images.keep_drawn(views.iter().map(|(_, t)| *t));
         for &(view, targets) in views {
             for &index in &objects {
                 let object = &ctx.scene_gpu.geometry.transparent[index];
@@ -196,10 +196,8 @@ impl RefractionPass {
                 let layout = &self.layout;
                 self.front.entry(front).or_insert_with(|| front_pipeline(ctx, (layout, &self.module), front));
             }
-            if !self.images.iter().any(|(depth, _)| *depth == targets.depth.view) {
-                let images = RefractionImages::new(ctx.device(), (&self.group_layout, &self.depth_copy), targets);
-                self.images.push((targets.depth.view.clone(), images));
-            }
+            let (layout, copy) = (&self.group_layout, &self.depth_copy);
+            self.images.index_or_insert_with(targets, || RefractionImages::new(ctx.device(), (layout, copy), targets));
         }
         Some(PreparedRefraction { pass: self, objects, mode })
     }
@@ -243,8 +241,7 @@ impl PreparedRefraction<'_> {
         if objects.is_empty() {
             return;
         }
-        let images = self.pass.images.iter().find(|(depth, _)| *depth == targets.depth.view);
-        let images = &images.expect("RefractionPass::prepare made images for every view").1;
+        let images = self.pass.images.get(targets).expect("RefractionPass::prepare made images for every view");
         let view_offset = [scene_gpu.views.offset(view.slot)];
         {
             let mut pass = frame.encoder.begin_render_pass(&layout::pass(

@@ -123,3 +123,44 @@ pub fn drawn_size(output: (u32, u32), render_scale: f32) -> (u32, u32) {
     let scaled = |n: u32| ((n as f32 * render_scale).round() as u32).clamp(1, n.max(1));
     (scaled(output.0), scaled(output.1))
 }
+
+/// What a pass keeps for each view's targets (a copy of its depth, the peels' depths, refraction's
+/// images), found by the targets' depth image: made the first frame a view draws into them, and
+/// dropped the first frame none does.
+pub struct PerTarget<T> {
+    entries: Vec<(wgpu::TextureView, T)>,
+}
+
+impl<T> Default for PerTarget<T> {
+    fn default() -> Self {
+        PerTarget { entries: Vec::new() }
+    }
+}
+
+impl<T> PerTarget<T> {
+    /// What is kept for `targets`, if anything.
+    pub fn get(&self, targets: &FrameTargets) -> Option<&T> {
+        self.entries.iter().find(|(depth, _)| *depth == targets.depth.view).map(|(_, kept)| kept)
+    }
+
+    /// The index of what is kept for `targets` ([`Self::at`]), made by `make` if nothing is.
+    pub fn index_or_insert_with(&mut self, targets: &FrameTargets, make: impl FnOnce() -> T) -> usize {
+        match self.entries.iter().position(|(depth, _)| *depth == targets.depth.view) {
+            Some(index) => index,
+            None => {
+                self.entries.push((targets.depth.view.clone(), make()));
+                self.entries.len() - 1
+            }
+        }
+    }
+
+    /// What [`Self::index_or_insert_with`] gave `index` for.
+    pub fn at(&self, index: usize) -> &T {
+        &self.entries[index].1
+    }
+
+    /// Drops what is kept for targets no view of `drawn` draws into.
+    pub fn keep_drawn<'t>(&mut self, drawn: impl IntoIterator<Item = &'t FrameTargets> + Clone) {
+        self.entries.retain(|(depth, _)| drawn.clone().into_iter().any(|t| t.depth.view == *depth));
+    }
+}

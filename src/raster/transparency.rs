@@ -67,7 +67,7 @@ use super::keys::{FrameKey, MaterialKey, constants};
 use super::refraction::refracts;
 use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::scene_pass::scissor;
-use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
+use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT, PerTarget};
 use super::uniforms::{ALPHA_BLEND, GpuInstance, Vertex};
 use super::view::{FrameView, ViewSlot};
 use super::volume::{RaySpan, VolumeSet};
@@ -149,7 +149,7 @@ pub struct TransparencyPass {
     peel_pipelines: HashMap<(FrameKey, MaterialKey), wgpu::RenderPipeline>,
     /// Peel depths of each view's targets (by the targets' depth image), kept while those
     /// targets are drawn into.
-    peels: Vec<(wgpu::TextureView, PeelTargets)>,
+    peels: PerTarget<PeelTargets>,
     triangles: Option<TriangleList>,
 }
 
@@ -175,7 +175,7 @@ impl TransparencyPass {
             peel_layout,
             pipelines: HashMap::new(),
             peel_pipelines: HashMap::new(),
-            peels: Vec::new(),
+            peels: PerTarget::default(),
             triangles: None,
         }
     }
@@ -192,7 +192,7 @@ impl TransparencyPass {
         let geometry = &ctx.scene_gpu.geometry;
         let (mut sorted, mut sort_time) = (false, Duration::ZERO);
         let mut prepared = Vec::new();
-        self.peels.retain(|(depth, _)| views.iter().any(|(_, t)| t.depth.view == *depth));
+        self.peels.keep_drawn(views.iter().map(|(_, t)| *t));
         for &(view, targets) in views {
             // An environment cube's views leave out the object they are drawn from, sorted per
             // object (the triangle list has no room for a left-out object).
@@ -245,14 +245,8 @@ impl TransparencyPass {
 
     /// The index in `self.peels` of the peel depths for `targets`, made if they have none.
     fn peel_index(&mut self, device: &wgpu::Device, targets: &FrameTargets) -> usize {
-        match self.peels.iter().position(|(depth, _)| *depth == targets.depth.view) {
-            Some(index) => index,
-            None => {
-                let peel = PeelTargets::new(device, &self.peel_group_layout, targets);
-                self.peels.push((targets.depth.view.clone(), peel));
-                self.peels.len() - 1
-            }
-        }
+        let layout = &self.peel_group_layout;
+        self.peels.index_or_insert_with(targets, || PeelTargets::new(device, layout, targets))
     }
 
     /// Sorts the transparent triangles for `view`, unless its order is still right; rebuilds the
@@ -486,7 +480,7 @@ impl PreparedTransparency<'_> {
     ) -> u64 {
         let scene_gpu = ctx.scene_gpu;
         let objects: Vec<&TransparentObject> = drawn(ctx, view).map(|i| &scene_gpu.geometry.transparent[i]).collect();
-        let peel = &self.pass.peels[peel].1;
+        let peel = self.pass.peels.at(peel);
         let view_offset = [scene_gpu.views.offset(view.slot)];
         let mut recorded = 0;
         let layers = ctx.settings.transparency.peel_layers as usize;

@@ -34,7 +34,7 @@ use super::inspect::{INSPECT_ISOSURFACE, INSPECT_VOLUME, Part, RecordKind, no_te
 use super::keys::{FrameKey, MaterialKey, constants, pipeline_constants};
 use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::scene_pass::scissor;
-use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
+use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT, PerTarget};
 use super::view::FrameView;
 use crate::gpu::Gpu;
 use crate::gpu::depth_copy::{DepthCopy, DepthImageCopy};
@@ -225,7 +225,7 @@ pub struct VolumePass {
     volumes: Vec<VolumeGpu>,
     /// A copy of each view's depth (by the view's depth image), which isosurfaces read while
     /// they write the depth itself; kept while those targets are drawn into.
-    depth_copies: Vec<(wgpu::TextureView, DepthImageCopy)>,
+    depth_copies: PerTarget<DepthImageCopy>,
     depth_copy: DepthCopy,
 }
 
@@ -261,7 +261,7 @@ impl VolumePass {
             nearest: sampler("volume::nearest", wgpu::FilterMode::Nearest),
             trilinear: sampler("volume::trilinear", wgpu::FilterMode::Linear),
             volumes: Vec::new(),
-            depth_copies: Vec::new(),
+            depth_copies: PerTarget::default(),
             depth_copy: DepthCopy::new(device, DEPTH_FORMAT),
         }
     }
@@ -347,11 +347,10 @@ impl VolumePass {
                     |isosurface, limits| (view.key, VolumeKey::new(settings, limits), isosurface, view.view.mirrored);
                 if isosurfaces {
                     self.pipeline(ctx, key(true, (false, false)));
-                    if !self.depth_copies.iter().any(|(depth, _)| *depth == targets.depth.view) {
-                        let source = &targets.depth.view;
-                        let copy = self.depth_copy.image_for(ctx.device(), "volume::depth_copy", source, targets.size);
-                        self.depth_copies.push((source.clone(), copy));
-                    }
+                    let (copies, copier) = (&mut self.depth_copies, &self.depth_copy);
+                    copies.index_or_insert_with(targets, || {
+                        copier.image_for(ctx.device(), "volume::depth_copy", &targets.depth.view, targets.size)
+                    });
                 }
                 if renderings.contains(&Rendering::Composite) {
                     for limits in [(false, false), (false, true), (true, true), (true, false)] {
@@ -360,7 +359,7 @@ impl VolumePass {
                 }
             }
         }
-        self.depth_copies.retain(|(depth, _)| views.iter().any(|(_, t)| t.depth.view == *depth));
+        self.depth_copies.keep_drawn(views.iter().map(|(_, t)| *t));
         PreparedVolumes { pass: self, renderings, drawn }
     }
 }
@@ -423,8 +422,7 @@ impl PreparedVolumes<'_> {
         if !self.drawn || isosurfaces.is_empty() {
             return;
         }
-        let copy = self.pass.depth_copies.iter().find(|(depth, _)| *depth == targets.depth.view);
-        let copy = &copy.expect("VolumePass::prepare made a copy for every view").1;
+        let copy = self.pass.depth_copies.get(targets).expect("VolumePass::prepare made a copy for every view");
         self.pass.depth_copy.record(&mut frame.encoder, copy);
         let copy = &copy.image.view;
         let groups: Vec<wgpu::BindGroup> =
