@@ -14,7 +14,7 @@ use super::scene_gpu::SceneLayouts;
 use super::shadow::ShadowMaps;
 use super::shadow::views::ShadowLayout;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
-use super::view::FrameView;
+use super::view::ViewTargets;
 use crate::gpu::layout;
 use crate::gpu::uniform::UniformBuffer;
 use crate::settings::ShadowView;
@@ -89,7 +89,7 @@ impl Overlays {
         &self,
         ctx: &FrameContext,
         frame: &mut FrameEncoder,
-        (view, targets): (&FrameView, &FrameTargets),
+        (view, targets): ViewTargets<'_>,
         (layout, maps): (&ShadowLayout, &ShadowMaps),
     ) {
         let settings = &ctx.settings.shadows;
@@ -118,7 +118,7 @@ impl Overlays {
         &self,
         ctx: &FrameContext,
         frame: &mut FrameEncoder,
-        (view, targets): (&FrameView, &FrameTargets),
+        (view, targets): ViewTargets<'_>,
         lines: &[Vec3],
         colour: Vec3,
     ) {
@@ -255,7 +255,7 @@ impl Lines {
         &self,
         ctx: &FrameContext,
         frame: &mut FrameEncoder,
-        (view, targets): (&FrameView, &FrameTargets),
+        (view, targets): ViewTargets<'_>,
         lines: &[Vec3],
         colour: Vec3,
     ) {

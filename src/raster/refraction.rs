@@ -46,7 +46,7 @@ use super::keys::{FrameKey, MaterialKey, constants, pipeline_constants};
 use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::scene_pass::scissor;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT, PerTarget};
-use super::view::FrameView;
+use super::view::{FrameView, ViewTargets};
 use crate::gpu::depth_copy::{DepthCopy, DepthImageCopy};
 use crate::gpu::layout;
 use crate::gpu::texture::GpuTexture;
@@ -175,11 +175,7 @@ impl RefractionPass {
 
     /// Compiles the pipelines the views need and makes each view's images; `None` when no glass
     /// is refracted.
-    pub fn prepare<'p>(
-        &'p mut self,
-        ctx: &FrameContext,
-        views: &[(&FrameView, &FrameTargets)],
-    ) -> Option<PreparedRefraction<'p>> {
+    pub fn prepare<'p>(&'p mut self, ctx: &FrameContext, views: &[ViewTargets<'_>]) -> Option<PreparedRefraction<'p>> {
         let objects = RefractionPass::objects(ctx);
         if objects.is_empty() {
             return None;

@@ -32,7 +32,7 @@ use super::keys::{FrameKey, MaterialKey, constants};
 use super::scene_gpu::{SceneGpu, SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT};
 use super::uniforms::ALPHA_MASK;
-use super::view::{FrameView, ViewSlot};
+use super::view::{FrameView, ViewSlot, ViewTargets};
 use crate::gpu::layout;
 use crate::shaders;
 
@@ -172,7 +172,7 @@ impl ScenePass {
     pub fn prepare<'p>(
         &'p mut self,
         ctx: &FrameContext,
-        views: &[(&FrameView, &FrameTargets)],
+        views: &[ViewTargets<'_>],
         mirrors: bool,
     ) -> PreparedScene<'p> {
         let scene = ctx.scene_gpu;

@@ -20,7 +20,7 @@ use glam::{Vec2, Vec3, Vec4};
 use super::context::{Figure, FrameEncoder};
 use super::shadow::views::{MAX_SHADOWED_LIGHTS, ShadowLayout};
 use super::targets::{FrameTargets, ViewImage};
-use super::view::{FrameView, View, ViewKind, ViewSlot};
+use super::view::{FrameView, View, ViewKind, ViewSlot, ViewTargets};
 use crate::base::Ray;
 use crate::scene::{Camera, Scene};
 use crate::settings::RenderSettings;
@@ -64,7 +64,7 @@ pub fn prepare(
     frame: &mut FrameEncoder,
     (wanted, stride): (Wanted, u32),
     lights: &ShadowLayout,
-    views: &[(&FrameView, &FrameTargets)],
+    views: &[ViewTargets<'_>],
 ) -> PreparedTraced {
     let tracer = Tracer::new(scene, settings);
     let slots: Vec<usize> =

@@ -69,7 +69,7 @@ use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::scene_pass::scissor;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT, PerTarget};
 use super::uniforms::{ALPHA_BLEND, GpuInstance, Vertex};
-use super::view::{FrameView, ViewSlot};
+use super::view::{FrameView, ViewSlot, ViewTargets};
 use super::volume::{RaySpan, VolumeSet};
 use crate::gpu::layout;
 use crate::gpu::texture::GpuTexture;
@@ -186,7 +186,7 @@ impl TransparencyPass {
         &'p mut self,
         ctx: &FrameContext,
         frame: &mut FrameEncoder,
-        views: &[(&FrameView, &FrameTargets)],
+        views: &[ViewTargets<'_>],
     ) -> PreparedTransparency<'p> {
         let settings = &ctx.settings.transparency;
         let geometry = &ctx.scene_gpu.geometry;
@@ -382,7 +382,7 @@ impl PreparedTransparency<'_> {
         &self,
         ctx: &FrameContext,
         frame: &mut FrameEncoder,
-        (view, targets): (&FrameView, &FrameTargets),
+        (view, targets): ViewTargets<'_>,
         composite: &mut Composite,
     ) {
         let prepared = self.views.iter().find(|v| v.slot == view.slot);
@@ -473,7 +473,7 @@ impl PreparedTransparency<'_> {
         &self,
         ctx: &FrameContext,
         frame: &mut FrameEncoder,
-        (view, targets): (&FrameView, &FrameTargets),
+        (view, targets): ViewTargets<'_>,
         prepared: &ViewSteps,
         peel: usize,
         composite: &mut Composite,

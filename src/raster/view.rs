@@ -8,8 +8,13 @@
 
 use glam::{Mat4, Vec3, Vec4};
 
+use super::targets::FrameTargets;
 use super::uniforms::GpuView;
 use crate::scene::{Camera, Projection};
+
+/// One view of the frame and the targets it draws into: what every phase of a view is given
+/// (`record_view`), and what the passes' `prepare` is given one of per view.
+pub type ViewTargets<'a> = (&'a FrameView, &'a FrameTargets);
 
 /// A camera for one pass: where it looks from and how it projects.
 #[derive(Clone, Copy, Debug, PartialEq)]

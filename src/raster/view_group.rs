@@ -13,8 +13,8 @@
 //! image is a variant of [`ViewImage`] and a row of the table (with its `var` in the WGSL); the
 //! targets then carry it and every view's group binds the view's own.
 
-use super::targets::{FrameTargets, ViewImage, ViewImages};
-use super::view::{FrameView, ViewSlot};
+use super::targets::{ViewImage, ViewImages};
+use super::view::{FrameView, ViewSlot, ViewTargets};
 
 /// Where a binding of the view group comes from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -246,7 +246,7 @@ impl ViewGroups {
         device: &wgpu::Device,
         layout: &wgpu::BindGroupLayout,
         inputs: &FrameInputs,
-        views: &[(&FrameView, &FrameTargets)],
+        views: &[ViewTargets<'_>],
     ) {
         let frame_images = inputs.images();
         let mut last = std::mem::take(&mut self.kept);

@@ -35,7 +35,7 @@ use super::keys::{FrameKey, MaterialKey, constants, pipeline_constants};
 use super::scene_gpu::{SceneLayouts, SurfaceLayout, SurfaceModule};
 use super::scene_pass::scissor;
 use super::targets::{DEPTH_FORMAT, FrameTargets, HDR_FORMAT, PerTarget};
-use super::view::FrameView;
+use super::view::{FrameView, ViewTargets};
 use crate::gpu::Gpu;
 use crate::gpu::depth_copy::{DepthCopy, DepthImageCopy};
 use crate::gpu::layout;
@@ -333,7 +333,7 @@ impl VolumePass {
 
     /// Writes each volume's uniform for the frame's settings, compiles the pipelines `views`
     /// need and makes the depth copies of their targets.
-    pub fn prepare<'p>(&'p mut self, ctx: &FrameContext, views: &[(&FrameView, &FrameTargets)]) -> PreparedVolumes<'p> {
+    pub fn prepare<'p>(&'p mut self, ctx: &FrameContext, views: &[ViewTargets<'_>]) -> PreparedVolumes<'p> {
         let settings = &ctx.settings.volume;
         let drawn = settings.enabled && !self.volumes.is_empty();
         let renderings: Vec<Rendering> = ctx.scene.volumes.iter().map(|v| v.rendering(settings)).collect();

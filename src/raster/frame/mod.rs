@@ -36,7 +36,7 @@ use super::shadow::{ShadowMaps, ShadowPass};
 use super::targets::{FrameTargets, ViewImage, drawn_size};
 use super::traced::{self, PreparedTraced};
 use super::transparency::{PreparedTransparency, TransparencyPass};
-use super::view::{FrameView, ViewKind};
+use super::view::{ViewKind, ViewTargets};
 use super::view_group::{FrameInputs, ViewGroups};
 use super::volume::{PreparedVolumes, RaySpan, VolumePass, VolumeSet};
 use crate::gpu::Gpu;
@@ -272,7 +272,7 @@ impl Renderer {
         self.shadow.record(gpu, &mut frame, &self.scene_gpu, layers, &settings.shadows);
         let maps = self.shadow.maps();
         let (mirrors, environment) = (&self.mirrors, &self.environment);
-        let views: Vec<(&FrameView, &FrameTargets)> = plan
+        let views: Vec<ViewTargets<'_>> = plan
             .views()
             .map(|view| match view.kind {
                 ViewKind::Main => (view, targets),
@@ -440,7 +440,7 @@ fn record_view(
     ctx: &FrameContext,
     frame: &mut FrameEncoder,
     phases: &Phases,
-    (view, targets): (&FrameView, &FrameTargets),
+    (view, targets): ViewTargets<'_>,
     mirrors: &MirrorImages,
 ) {
     let transparent_later = phases.transparency.is_some();
