@@ -47,6 +47,33 @@ mirador compare "$course/mipmaps-floor.toml" "${mid[@]}" -o "$out/mipmaps-level-
 example bump_mapping bump_mapping.png
 mirador compare assets/scenes/bumps.toml "${mid[@]}" -o "$out/bump-compare.png"
 
+# 4b. Displacement and parallax mapping: the ball and the plane with each method, side by side
+# (bump | parallax | displacement, all rasterized), composed with Pillow.
+relief=$(mktemp -d)
+for scene in sphere plane; do
+    for method in normal parallax displacement; do
+        mirador render "$course/displacement-$scene.toml" --width 240 --height 135 \
+            -o "$relief/$scene-$method.png" --set "bump.method=\"$method\""
+    done
+done
+if python3 -c 'import PIL' 2>/dev/null; then
+    python3 - "$relief" "$out/displacement.png" <<'PY'
+import sys
+from PIL import Image
+folder, out = sys.argv[1:]
+rows = [[Image.open(f"{folder}/{scene}-{method}.png").convert("RGB") for method in ("normal", "parallax", "displacement")] for scene in ("sphere", "plane")]
+w, h = rows[0][0].size
+sheet = Image.new("RGB", (3 * w, 2 * h))
+for j, row in enumerate(rows):
+    for i, image in enumerate(row):
+        sheet.paste(image, (i * w, j * h))
+sheet.save(out)
+PY
+else
+    echo "Pillow not found: displacement.png is not made"
+fi
+rm -rf "$relief"
+
 # 5. Cast shadows
 example shadows shadows.png
 mirador compare "$course/shadows-methods.toml" "${mid[@]}" -o "$out/shadows-compare.png"
