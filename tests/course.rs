@@ -9,7 +9,9 @@
 //! - the code cites the course, not the team's working notes (`TECHNIQUES.md`);
 //! - every scene of the exercises (`assets/scenes/course/`) loads, is used by a chapter, and every
 //!   scene a chapter names exists;
-//! - every image of the course is linked from a chapter and made by `docs/course/images.sh`.
+//! - every image of the course is linked from a chapter and made by `docs/course/images.sh`;
+//! - every function, type or constant a document names by a link to its file
+//!   (``[`bump_normal`](../../src/texture/bump.rs)``) is declared in that file.
 //!
 //! Nothing here needs a GPU.
 
@@ -541,4 +543,71 @@ fn the_link_parser_reads_what_github_reads() {
             (1, "docs/course/01-camera.md".to_string(), None)
         ]
     );
+}
+
+/// The names a text links to source files by, ``[`NAME`](PATH)`` with NAME an identifier or a
+/// path of them (`Type::method`) and PATH a `.rs` or `.wgsl` file: (line, name, target).
+fn named_declarations(text: &str) -> Vec<(usize, String, String)> {
+    let mut found = Vec::new();
+    for (number, line) in prose_lines(text) {
+        let mut rest = line;
+        while let Some(start) = rest.find("[`") {
+            rest = &rest[start + 2..];
+            let Some(end) = rest.find("`](") else { break };
+            let name = rest[..end].trim_end_matches("()").to_owned();
+            let after = &rest[end + 3..];
+            let Some(close) = after.find(')') else { break };
+            let target = after[..close].split('#').next().unwrap_or("").to_owned();
+            let identifier = !name.is_empty()
+                && name.split("::").all(|part| {
+                    part.chars().next().is_some_and(|c| c.is_alphabetic() || c == '_')
+                        && part.chars().all(|c| c.is_alphanumeric() || c == '_')
+                });
+            if identifier && (target.ends_with(".rs") || target.ends_with(".wgsl")) {
+                found.push((number, name, target));
+            }
+            rest = &after[close..];
+        }
+    }
+    found
+}
+
+/// Whether `source` declares `name`'s last part (a function, type, trait, constant, macro or
+/// module item) and, for `Type::item`, mentions `Type`.
+fn declares(source: &str, name: &str) -> bool {
+    let parts: Vec<&str> = name.split("::").collect();
+    let last = parts[parts.len() - 1];
+    let keywords =
+        ["fn", "struct", "enum", "trait", "type", "const", "static", "mod", "macro_rules!", "var", "override", "alias"];
+    let declared = source.lines().any(|line| {
+        let words: Vec<&str> =
+            line.split(|c: char| !(c.is_alphanumeric() || c == '_' || c == '!')).filter(|w| !w.is_empty()).collect();
+        words.windows(2).any(|w| keywords.contains(&w[0]) && w[1] == last)
+    });
+    declared && parts[..parts.len() - 1].iter().all(|part| source.contains(part))
+}
+
+#[test]
+fn every_declaration_a_document_links_to_its_file_is_there() {
+    let mut problems = Vec::new();
+    let mut checked = 0;
+    for document in documentation() {
+        for (line, name, target) in named_declarations(&read(&document)) {
+            let file = normalized(&document.parent().expect("a folder").join(&target));
+            checked += 1;
+            match fs::read_to_string(&file) {
+                Ok(source) if declares(&source, &name) => {}
+                Ok(_) => problems.push(format!("{}:{line}: `{name}` is not declared in {target}", shown(&document))),
+                Err(_) => problems.push(format!("{}:{line}: {target} does not exist", shown(&document))),
+            }
+        }
+    }
+    assert!(checked >= 15, "{checked} names checked");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    // The check can fail: a name its file does not declare, and a method of a type it never names.
+    let source = "pub struct MipChain;\nimpl MipChain {\n    pub fn sample(&self) {}\n}\n";
+    assert!(declares(source, "MipChain::sample") && declares(source, "MipChain"));
+    assert!(!declares(source, "MipChain::sampled") && !declares(source, "Other::sample"));
+    let text = "see [`bump_normal`](../../src/texture/bump.rs) and [`a link`](x.rs)";
+    assert_eq!(named_declarations(text), [(1, "bump_normal".to_owned(), "../../src/texture/bump.rs".to_owned())]);
 }
