@@ -99,6 +99,7 @@ builtin_files!(
     "assets/labs/bump/lab.toml",
     "assets/labs/environment-maps/lab.toml",
     "assets/labs/mipmaps/lab.toml",
+    "assets/labs/parallax/lab.toml",
     "assets/labs/planar-mirrors/lab.toml",
     "assets/labs/refraction/lab.toml",
     "assets/labs/shadow-map/lab.toml",

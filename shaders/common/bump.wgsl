@@ -91,6 +91,31 @@ fn sine_height_gradient(uv: vec2f, frequency: vec2f, amplitude: f32) -> vec2f {
     return amplitude * vec2f(w.x * cos(a.x) * sin(a.y), w.y * sin(a.x) * cos(a.y));
 }
 
+// Parallax mapping's two pure steps (the march itself is parallax_uv in surface.wgsl; Rust twins
+// in src/texture/parallax.rs). How fast the texture coordinates change along the view ray d over
+// the surface of normal n and tangents t_u = ∂p/∂u, t_v = ∂p/∂v: the part of d in the surface's
+// plane, d − (d·n)·n, written as du/ds·t_u + dv/ds·t_v by the 2×2 normal equations (the tangents
+// need not be orthogonal or unit). Zero where they are degenerate.
+fn parallax_rate(d: vec3f, n: vec3f, tu: vec3f, tv: vec3f) -> vec2f {
+    let a = dot(tu, tu);
+    let b = dot(tu, tv);
+    let c = dot(tv, tv);
+    let det = a * c - b * b;
+    if !(abs(det) > 1e-12) {
+        return vec2f(0.0);
+    }
+    let along = d - dot(d, n) * n;
+    let x = dot(along, tu);
+    let y = dot(along, tv);
+    return vec2f(c * x - b * y, a * y - b * x) / det;
+}
+
+// The secant step between two points (s, gap) of the march, the gap > 0 above the relief and ≤ 0
+// below it: where the line through them crosses zero.
+fn secant_crossing(above: vec2f, below: vec2f) -> f32 {
+    return above.x + (below.x - above.x) * (above.y / (above.y - below.y));
+}
+
 struct SurfaceTangents {
     tu: vec3f,
     tv: vec3f,

@@ -283,23 +283,15 @@ fn height_range() -> vec2f {
 // its bottom find the first under the relief, PARALLAX_REFINEMENTS secant steps the crossing.
 fn parallax_uv(uv: vec2f, n: vec3f, tangents: SurfaceTangents, d: vec3f) -> vec2f {
     let k = material.bump_scale * frame.bump_scale;
-    let tu = tangents.tu;
-    let tv = tangents.tv;
     let dn = dot(d, n);
-    let a = dot(tu, tu);
-    let b = dot(tu, tv);
-    let c = dot(tv, tv);
-    let det = a * c - b * b;
-    if !(dn < -1e-4) || k == 0.0 || !(abs(det) > 1e-12) || !tangents.valid {
+    if !(dn < -1e-4) || k == 0.0 || !tangents.valid {
         return uv;
     }
     let range = height_range();
     let h_low = min(k * range.x, k * range.y);
     let h_high = max(k * range.x, k * range.y);
-    let along = d - dn * n;
-    let x = dot(along, tu);
-    let y = dot(along, tv);
-    let duv_ds = vec2f(c * x - b * y, a * y - b * x) / det;
+    // Degenerate tangents give no rate: the march stays at uv.
+    let duv_ds = parallax_rate(d, n, tangents.tu, tangents.tv);
     let s_top = h_high / dn;
     let s_bottom = h_low / dn;
     var before = vec2f(s_top, parallax_gap(uv, duv_ds, s_top, dn, k));
@@ -325,7 +317,7 @@ fn parallax_crossing(above_start: vec2f, below_start: vec2f, uv: vec2f, duv_ds: 
     var above = above_start;
     var below = below_start;
     for (var i = 0u; i < PARALLAX_REFINEMENTS; i++) {
-        let s = above.x + (below.x - above.x) * (above.y / (above.y - below.y));
+        let s = secant_crossing(above, below);
         let at = vec2f(s, parallax_gap(uv, duv_ds, s, dn, k));
         if at.y > 0.0 {
             above = at;
@@ -333,7 +325,7 @@ fn parallax_crossing(above_start: vec2f, below_start: vec2f, uv: vec2f, duv_ds: 
             below = at;
         }
     }
-    return above.x + (below.x - above.x) * (above.y / (above.y - below.y));
+    return secant_crossing(above, below);
 }
 
 // What shading a fragment found: the radiance leaving it towards the viewer, and for the

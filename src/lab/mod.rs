@@ -198,6 +198,7 @@ pub fn chapter_file(number: u32) -> Option<&'static str> {
 const LABS: &[&str] = &[
     include_str!("../../assets/labs/mipmaps/lab.toml"),
     include_str!("../../assets/labs/bump/lab.toml"),
+    include_str!("../../assets/labs/parallax/lab.toml"),
     include_str!("../../assets/labs/shadow-map/lab.toml"),
     include_str!("../../assets/labs/transparency/lab.toml"),
     include_str!("../../assets/labs/refraction/lab.toml"),

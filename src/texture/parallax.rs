@@ -31,16 +31,13 @@ pub const REFINEMENTS: u32 = 4;
 /// are degenerate.
 pub fn parallax_uv(field: &dyn HeightField, k: f32, uv: Vec2, (n, tu, tv): (Vec3, Vec3, Vec3), d: Vec3) -> Vec2 {
     let dn = d.dot(n);
-    let (a, b, c) = (tu.dot(tu), tu.dot(tv), tv.dot(tv));
-    let det = a * c - b * b;
-    if !(dn < -1e-4) || k == 0.0 || !(det.abs() > 1e-12) {
+    if !(dn < -1e-4) || k == 0.0 {
         return uv;
     }
     let (low, high) = field.range();
     let (h_low, h_high) = ((k * low).min(k * high), (k * low).max(k * high));
-    let along = d - dn * n;
-    let (x, y) = (along.dot(tu), along.dot(tv));
-    let duv_ds = Vec2::new(c * x - b * y, a * y - b * x) / det;
+    // Degenerate tangents give no rate: the march stays at uv.
+    let duv_ds = rate(d, n, tu, tv);
     let (s_top, s_bottom) = (h_high / dn, h_low / dn);
     let gap = |s: f32| s * dn - k * field.height(uv + s * duv_ds);
     let mut before = (s_top, gap(s_top));
@@ -55,10 +52,30 @@ pub fn parallax_uv(field: &dyn HeightField, k: f32, uv: Vec2, (n, tu, tv): (Vec3
     uv + s_bottom * duv_ds
 }
 
+/// How fast the texture coordinates change along `d` over the surface of normal `n` and tangents
+/// `tu`, `tv`: the part of `d` in the surface's plane, `d − (d·n)·n`, written as
+/// `du/ds·t_u + dv/ds·t_v` by the 2×2 normal equations (the tangents need not be orthogonal or
+/// unit). Zero where they are degenerate. (WGSL twin: `parallax_rate`.)
+pub fn rate(d: Vec3, n: Vec3, tu: Vec3, tv: Vec3) -> Vec2 {
+    let (a, b, c) = (tu.dot(tu), tu.dot(tv), tv.dot(tv));
+    let det = a * c - b * b;
+    if !(det.abs() > 1e-12) {
+        return Vec2::ZERO;
+    }
+    let along = d - d.dot(n) * n;
+    let (x, y) = (along.dot(tu), along.dot(tv));
+    Vec2::new(c * x - b * y, a * y - b * x) / det
+}
+
+/// Where the line through two points `(s, gap)` of the march, `above` (gap > 0) and `below`
+/// (gap ≤ 0), crosses zero. (WGSL twin: `secant_crossing`.)
+pub fn secant(above: (f32, f32), below: (f32, f32)) -> f32 {
+    above.0 + (below.0 - above.0) * (above.1 / (above.1 - below.1))
+}
+
 /// The `s` where the gap crosses zero between `above` (gap > 0) and `below` (gap ≤ 0), by
 /// [`REFINEMENTS`] secant steps, each keeping the pair that brackets the crossing.
 fn crossing(mut above: (f32, f32), mut below: (f32, f32), gap: impl Fn(f32) -> f32) -> f32 {
-    let secant = |a: (f32, f32), b: (f32, f32)| a.0 + (b.0 - a.0) * (a.1 / (a.1 - b.1));
     for _ in 0..REFINEMENTS {
         let s = secant(above, below);
         let at = (s, gap(s));
