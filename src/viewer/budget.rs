@@ -22,13 +22,13 @@ use std::time::Duration;
 /// cores) draws the showcase's flat-colour floor at about 23 frames a second in a 950×720 view;
 /// aiming at 30 keeps orbiting under the cost of that floor (docs/performance.md), and where the
 /// frames are cheaper the scale rises to meet it.
-pub const DEFAULT_MOTION_FPS: f32 = 30.0;
+pub(in crate::viewer) const DEFAULT_MOTION_FPS: f32 = 30.0;
 /// The frame rates the panel offers (0, outside it, turns the target off).
-pub const MOTION_FPS: std::ops::RangeInclusive<f32> = 5.0..=120.0;
+pub(in crate::viewer) const MOTION_FPS: std::ops::RangeInclusive<f32> = 5.0..=120.0;
 /// The lowest render scale while moving, by default: a quarter of the pixels in each direction.
-pub const DEFAULT_MOTION_SCALE: f32 = 0.25;
+pub(in crate::viewer) const DEFAULT_MOTION_SCALE: f32 = 0.25;
 /// The lowest render scales the panel offers.
-pub const MOTION_SCALES: std::ops::RangeInclusive<f32> = 0.1..=1.0;
+pub(in crate::viewer) const MOTION_SCALES: std::ops::RangeInclusive<f32> = 0.1..=1.0;
 
 /// The scales the budget picks from are multiples of this.
 pub const STEP: f32 = 0.05;
@@ -42,7 +42,7 @@ const WEIGHT: f32 = 0.3;
 
 /// The render scale for moving frames.
 #[derive(Clone, Debug)]
-pub struct FrameBudget {
+pub(in crate::viewer) struct FrameBudget {
     /// The running mean of the scale the frames asked for.
     wanted: f32,
     /// The scale frames are drawn at: a multiple of [`STEP`] near `wanted`.
@@ -78,7 +78,7 @@ impl FrameBudget {
 /// The frames' pace: the render scale moving frames are drawn at, when the camera last moved (plus
 /// the settling time), and when the last frame started and whether it asked for the next at once.
 #[derive(Clone, Debug, Default)]
-pub struct Pace {
+pub(in crate::viewer) struct Pace {
     pub scale: FrameBudget,
     pub moving_until: Option<web_time::Instant>,
     pub last_frame: Option<(web_time::Instant, bool)>,

@@ -19,7 +19,7 @@ use glam::{Quat, Vec2, Vec3};
 use crate::scene::{Camera, Projection};
 
 /// Radians of orbit or look per pixel of mouse drag.
-pub const RADIANS_PER_PIXEL: f32 = 0.008;
+pub(in crate::viewer) const RADIANS_PER_PIXEL: f32 = 0.008;
 /// The closest the view direction may come to `up` or `−up`, in radians.
 const POLE_MARGIN: f32 = 0.02;
 /// Distance factor per wheel step.
@@ -64,7 +64,7 @@ fn clamp_pitch(offset: Vec3, up: Vec3, pitch: f32) -> f32 {
 }
 
 /// The world size of one pixel at the distance of `center`.
-pub fn world_per_pixel(camera: &Camera) -> f32 {
+pub(in crate::viewer) fn world_per_pixel(camera: &Camera) -> f32 {
     let window_height = match camera.projection {
         Projection::Perspective => {
             2.0 * (camera.eye - camera.center).length() * (camera.fovy_degrees.to_radians() / 2.0).tan()
@@ -106,7 +106,7 @@ pub fn fly(camera: &Camera, local: Vec3) -> Camera {
 /// Keeps the view direction and fits the box `(min, max)` in view: `center` at its centre, `eye`
 /// back along `ze` until the box's bounding sphere fits the narrower field of view; `near` and
 /// `far` widened when the sphere would be clipped.
-pub fn frame_bounds(camera: &Camera, (min, max): (Vec3, Vec3)) -> Camera {
+pub(in crate::viewer) fn frame_bounds(camera: &Camera, (min, max): (Vec3, Vec3)) -> Camera {
     let middle = (min + max) / 2.0;
     let radius = ((max - min).length() / 2.0).max(1e-3);
     let ze = camera.frame().ze;

@@ -56,7 +56,7 @@ impl Default for ViewerConfig {
 }
 
 /// `$XDG_CONFIG_HOME/mirador/viewer.toml`, else `$HOME/.config/mirador/viewer.toml`.
-pub fn config_path() -> Option<PathBuf> {
+pub(in crate::viewer) fn config_path() -> Option<PathBuf> {
     let base = std::env::var_os("XDG_CONFIG_HOME")
         .filter(|v| !v.is_empty())
         .map(PathBuf::from)
@@ -66,7 +66,7 @@ pub fn config_path() -> Option<PathBuf> {
 
 /// The key a scene's remembered settings are kept under: its file's full path, or
 /// `(built in)` for the showcase.
-pub fn scene_key(source: Option<&Path>) -> String {
+pub(in crate::viewer) fn scene_key(source: Option<&Path>) -> String {
     match source {
         Some(path) => std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()).display().to_string(),
         None => "(built in)".to_string(),
@@ -141,7 +141,7 @@ fn flatten(settings: &RenderSettings) -> Vec<(String, toml::Value)> {
 }
 
 /// The settings that differ from `defaults`, as a flat table of dotted keys.
-pub fn changed_settings(settings: &RenderSettings, defaults: &RenderSettings) -> toml::Table {
+pub(in crate::viewer) fn changed_settings(settings: &RenderSettings, defaults: &RenderSettings) -> toml::Table {
     let before = flatten(defaults);
     flatten(settings)
         .into_iter()
@@ -151,7 +151,10 @@ pub fn changed_settings(settings: &RenderSettings, defaults: &RenderSettings) ->
 
 /// `defaults` with the remembered `changes` applied one by one through `RenderSettings::set`;
 /// returns a warning for each change that no longer applies.
-pub fn apply_settings(defaults: &RenderSettings, changes: &toml::Table) -> (RenderSettings, Vec<String>) {
+pub(in crate::viewer) fn apply_settings(
+    defaults: &RenderSettings,
+    changes: &toml::Table,
+) -> (RenderSettings, Vec<String>) {
     let mut settings = defaults.clone();
     let mut warnings = Vec::new();
     let mut flat = Vec::new();
@@ -168,7 +171,7 @@ pub fn apply_settings(defaults: &RenderSettings, changes: &toml::Table) -> (Rend
 /// key, and the settings and the scene's own the panel's list of changed settings was made from,
 /// with the list.
 #[derive(Clone, Debug, Default)]
-pub struct Remembered {
+pub(in crate::viewer) struct Remembered {
     pub scenes: BTreeMap<String, toml::Table>,
     pub changed: (RenderSettings, RenderSettings, Vec<String>),
 }

@@ -9,7 +9,7 @@ pub(super) const BUDGET_WIDTH: u32 = 480;
 /// The last error budget measured, as the report `mirador budget` prints, and whether one is due
 /// once the view has its size.
 #[derive(Default)]
-pub struct ErrorBudget {
+pub(in crate::viewer) struct ErrorBudget {
     pub report: Option<String>,
     pub next: bool,
 }

@@ -4,7 +4,7 @@
 use std::time::Duration;
 
 /// The keys, as the help window lists them.
-pub const KEYS: &[(&str, &str)] = &[
+pub(in crate::viewer) const KEYS: &[(&str, &str)] = &[
     ("left drag", "orbit around the target (fly mode: look around)"),
     ("right or middle drag", "pan: eye and target move together"),
     ("wheel", "zoom towards the target"),
@@ -24,7 +24,7 @@ pub const KEYS: &[(&str, &str)] = &[
     ("drop a file", "open a scene (.toml) or a model (.gltf, .glb, .obj, .ply)"),
 ];
 
-pub fn help_window(ctx: &egui::Context, open: &mut bool) {
+pub(in crate::viewer) fn help_window(ctx: &egui::Context, open: &mut bool) {
     egui::Window::new("Keys").open(open).resizable(false).collapsible(false).show(ctx, |ui| {
         egui::Grid::new("keys").num_columns(2).striped(true).show(ui, |ui| {
             for (key, what) in KEYS {
@@ -97,7 +97,7 @@ impl FrameStats {
 
     /// The last frame's times: what the overlay shows. Frames are drawn only when something
     /// changes, so this is what the last change cost, not a rate.
-    pub fn overlay_text(&self) -> String {
+    pub(in crate::viewer) fn overlay_text(&self) -> String {
         let t = &self.last;
         let mut text = format!("frame {:.1} ms", ms(t.frame));
         if let Some(interval) = t.interval {

@@ -18,13 +18,13 @@ use crate::settings::RenderSettings;
 use crate::shaders::Wgsl;
 use crate::trace::explain::{RayKind, RayNode};
 
-pub const PRIMARY: Color32 = Color32::WHITE;
-pub const REFLECTED: Color32 = Color32::from_rgb(0, 220, 255);
-pub const REFRACTED: Color32 = Color32::from_rgb(80, 255, 120);
-pub const CONTINUED: Color32 = Color32::from_gray(160);
-pub const SHADOW_LIT: Color32 = Color32::from_rgb(255, 220, 0);
-pub const SHADOW_BLOCKED: Color32 = Color32::from_rgb(255, 40, 40);
-pub const STAND_IN: Color32 = Color32::from_rgb(255, 0, 255);
+pub(in crate::viewer) const PRIMARY: Color32 = Color32::WHITE;
+pub(in crate::viewer) const REFLECTED: Color32 = Color32::from_rgb(0, 220, 255);
+pub(in crate::viewer) const REFRACTED: Color32 = Color32::from_rgb(80, 255, 120);
+pub(in crate::viewer) const CONTINUED: Color32 = Color32::from_gray(160);
+pub(in crate::viewer) const SHADOW_LIT: Color32 = Color32::from_rgb(255, 220, 0);
+pub(in crate::viewer) const SHADOW_BLOCKED: Color32 = Color32::from_rgb(255, 40, 40);
+pub(in crate::viewer) const STAND_IN: Color32 = Color32::from_rgb(255, 0, 255);
 
 /// An inspected pixel: its explanation and where the scene's lights are.
 pub struct Inspection {
@@ -220,7 +220,7 @@ impl Projector<'_> {
 /// The inspect tool's state: the inspected pixel's explanation, and a pixel to inspect once the
 /// view has its size (a click, the I key, the step `inspect`).
 #[derive(Default)]
-pub struct InspectTool {
+pub(in crate::viewer) struct InspectTool {
     pub shown: Option<Inspection>,
     pub next: Option<glam::Vec2>,
 }

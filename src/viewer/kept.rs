@@ -23,7 +23,7 @@ impl<I: PartialEq, T> Kept<I, T> {
     }
 
     /// Whether the kept value is the one [`Self::update`] would make from `inputs`.
-    pub fn is_current(&self, inputs: &Option<I>) -> bool {
+    pub(in crate::viewer) fn is_current(&self, inputs: &Option<I>) -> bool {
         *inputs == self.inputs
     }
 

@@ -176,7 +176,7 @@ impl Checking {
     }
 
     /// The finished check's report, once: for the page's script and the terminal.
-    pub fn take_finished(&mut self) -> Option<crate::lab::report::Report> {
+    pub(in crate::viewer) fn take_finished(&mut self) -> Option<crate::lab::report::Report> {
         (self.progress.done() && !self.handed_on).then(|| {
             self.handed_on = true;
             self.progress.report()
@@ -263,7 +263,7 @@ impl LabView {
     }
 
     /// Whether the shader the view draws with changed since the last call.
-    pub fn take_changed(&mut self) -> bool {
+    pub(in crate::viewer) fn take_changed(&mut self) -> bool {
         std::mem::take(&mut self.compiled.changed)
     }
 
@@ -304,7 +304,7 @@ impl LabView {
     /// In the difference view, the error map between the reference's image and the student's of
     /// `scene` (at the view's size) unless it already shows them: at once natively, over the
     /// next frames in the page.
-    pub fn update_difference(
+    pub(in crate::viewer) fn update_difference(
         &mut self,
         gpu: &crate::gpu::Gpu,
         ctx: &egui::Context,
@@ -441,7 +441,7 @@ mod native {
         }
 
         /// Runs the lab's tests on the file as saved now (the panel's Check button).
-        pub fn start_check(&mut self, gpu: &Gpu) {
+        pub(in crate::viewer) fn start_check(&mut self, gpu: &Gpu) {
             match std::fs::read_to_string(&self.file) {
                 Ok(text) => self.view.checking = Some(super::Checking::start(gpu, &self.lab, &text)),
                 Err(e) => self.view.compiled.problems = vec![format!("{}: {e}", self.file.display())],
@@ -499,7 +499,7 @@ mod page {
         }
 
         /// A whole new text (a file the student opened): checked at once.
-        pub fn replace_text(&mut self, text: String) {
+        pub(in crate::viewer) fn replace_text(&mut self, text: String) {
             self.text = text;
             self.edited = None;
             self.check();
@@ -542,7 +542,7 @@ mod page {
         }
 
         /// Runs the lab's tests on the editor's text (the panel's Check button).
-        pub fn start_check(&mut self, gpu: &crate::gpu::Gpu) {
+        pub(in crate::viewer) fn start_check(&mut self, gpu: &crate::gpu::Gpu) {
             self.view.checking = Some(super::Checking::start(gpu, &self.lab, &self.text));
         }
     }

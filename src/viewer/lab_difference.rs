@@ -20,7 +20,7 @@ use crate::shaders::Wgsl;
 
 /// The difference view of a lab mode: what it shows, and what is being drawn for it.
 #[derive(Default)]
-pub struct DifferenceView {
+pub(in crate::viewer) struct DifferenceView {
     shown: Option<Shown>,
     /// The renderers, between two draws (a draw under way holds them).
     renderers: Rc<RefCell<Option<Renderers>>>,

@@ -103,7 +103,7 @@ impl ViewerOptions {
 
 /// Why the viewer cannot start.
 #[derive(Debug, thiserror::Error)]
-pub enum ViewerError {
+pub(in crate::viewer) enum ViewerError {
     #[error(
         "no display to open a window on (DISPLAY and WAYLAND_DISPLAY are unset); `mirador render [SCENE] -o \
          out.png` renders without one"

@@ -26,7 +26,7 @@ fn tooltip(key: &str) -> FieldDoc {
 
 /// Draws the settings, one section per technique; returns the assignments (`key=value`) the user
 /// made this frame, to be applied with `RenderSettings::set`.
-pub fn settings_ui(ui: &mut egui::Ui, settings: &RenderSettings) -> Vec<String> {
+pub(in crate::viewer) fn settings_ui(ui: &mut egui::Ui, settings: &RenderSettings) -> Vec<String> {
     let mut changes = Vec::new();
     let Ok(table) = toml::Table::try_from(settings) else {
         ui.colored_label(ui.visuals().error_fg_color, "the settings cannot be shown");

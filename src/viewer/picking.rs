@@ -11,7 +11,7 @@ use crate::trace::accel::{self, AccelKind, Accelerator};
 use crate::trace::geometry::{Primitive, scene_primitives};
 
 /// The scene's primitives and a BVH over them, built on the first click after a (re)load.
-pub struct Picker {
+pub(in crate::viewer) struct Picker {
     primitives: Vec<Primitive>,
     accelerator: Box<dyn Accelerator>,
 }
@@ -49,7 +49,7 @@ impl Picker {
     /// The direction the environment is seen in at image point `pixel`: `r = reflect(d, n)` at
     /// the surface the primary ray `d` hits there (its shading normal turned to the viewer, as
     /// the shaders turn it), or `d` itself where the ray hits nothing and the world is drawn.
-    pub fn seen_direction(&self, scene: &Scene, pixel: Vec2) -> SeenDirection {
+    pub(in crate::viewer) fn seen_direction(&self, scene: &Scene, pixel: Vec2) -> SeenDirection {
         let ray = scene.camera.ray_through(pixel.x, pixel.y);
         let Some(hit) = self.accelerator.closest(&self.primitives, &ray, 0.0, f32::INFINITY) else {
             return SeenDirection { direction: ray.direction, object: None };

@@ -32,7 +32,7 @@ use crate::{RenderSettings, Scene};
 /// The format egui samples the image from ([`Composition::Textured`]).
 const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-pub struct RasterView {
+pub(in crate::viewer) struct RasterView {
     renderer: Renderer,
     /// What the device's shaders may use (the page's labs need it).
     device_profile: Profile,
@@ -95,7 +95,7 @@ struct SizedTargets {
 
 /// What [`RasterView::render`] did.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Drawn {
+pub(in crate::viewer) enum Drawn {
     /// Nothing changed: the image is the last one.
     Kept,
     /// A new image, in this time from submission to completion.
@@ -144,14 +144,14 @@ impl RasterView {
 
     /// Draws from now on with passes compiled from `wgsl` (lab mode: the student's functions
     /// saved, or the reference shown), `scene` of `revision` loaded into them.
-    pub fn set_wgsl(&mut self, gpu: &Gpu, (scene, revision): (&Scene, u64), wgsl: Wgsl) {
+    pub(in crate::viewer) fn set_wgsl(&mut self, gpu: &Gpu, (scene, revision): (&Scene, u64), wgsl: Wgsl) {
         self.renderer = Renderer::with_wgsl(gpu, scene, self.format, wgsl, false);
         self.revision = revision;
         self.drawn = None;
     }
 
     /// The displayed image's egui id ([`Composition::Textured`]).
-    pub fn texture_id(&self) -> egui::TextureId {
+    pub(in crate::viewer) fn texture_id(&self) -> egui::TextureId {
         self.texture_id
     }
 
@@ -224,7 +224,7 @@ impl RasterView {
     }
 
     /// Whether the image shown has traced terms still to refine: the viewer draws again at once.
-    pub fn refining(&self) -> bool {
+    pub(in crate::viewer) fn refining(&self) -> bool {
         self.traced_stride > 1 && self.drawn.as_ref().is_some_and(|d| d.settings.hybrid.any())
     }
 
@@ -268,7 +268,7 @@ impl RasterView {
     /// The last rendered image, read back (sRGB RGBA8, as `mirador render` writes it): asked for
     /// by the first call after a frame is drawn and handed over by a later one once the GPU has
     /// copied it (natively by the same call, which waits; in the browser a frame or two later).
-    pub fn read_back(&mut self, gpu: &Gpu) -> Option<image::RgbaImage> {
+    pub(in crate::viewer) fn read_back(&mut self, gpu: &Gpu) -> Option<image::RgbaImage> {
         let frame = self.frame.as_ref()?;
         if self.readback.is_none() {
             self.readback = Some(PendingImage::start(gpu, &frame.image.texture).ok()?);
@@ -280,7 +280,7 @@ impl RasterView {
     }
 
     /// Whether a readback is under way: the next frame is asked for, to take it.
-    pub fn reading_back(&self) -> bool {
+    pub(in crate::viewer) fn reading_back(&self) -> bool {
         self.readback.is_some()
     }
 }

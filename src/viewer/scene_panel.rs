@@ -53,7 +53,7 @@ fn colour_ui(ui: &mut egui::Ui, name: &str, c: &mut Vec3, tip: &str) -> bool {
 
 /// The camera's parameters; returns whether a valid change was made. `error` keeps the reason an
 /// edit was refused.
-pub fn camera_ui(ui: &mut egui::Ui, camera: &mut Camera, error: &mut Option<String>) -> bool {
+pub(in crate::viewer) fn camera_ui(ui: &mut egui::Ui, camera: &mut Camera, error: &mut Option<String>) -> bool {
     let mut edited = camera.clone();
     let mut changed = false;
     changed |= vec3_ui(ui, "eye", &mut edited.eye, 0.05, "Where the eye is: the origin of the primary rays.");
@@ -114,7 +114,7 @@ fn with_kind(kind: &LightKind, name: &str) -> LightKind {
 }
 
 /// Every light's type, position, direction, colour and intensity; returns whether any changed.
-pub fn lights_ui(ui: &mut egui::Ui, lights: &mut [Light]) -> bool {
+pub(in crate::viewer) fn lights_ui(ui: &mut egui::Ui, lights: &mut [Light]) -> bool {
     let mut changed = false;
     for (index, light) in lights.iter_mut().enumerate() {
         let title = if light.name.is_empty() { format!("light {index}") } else { light.name.clone() };
@@ -183,7 +183,7 @@ fn direction_ui(ui: &mut egui::Ui, direction: &mut Vec3, tip: &str) -> bool {
 
 /// The illumination model's coefficients and colours of one material; returns whether any
 /// changed.
-pub fn material_ui(ui: &mut egui::Ui, material: &mut Material) -> bool {
+pub(in crate::viewer) fn material_ui(ui: &mut egui::Ui, material: &mut Material) -> bool {
     let mut changed = false;
     changed |=
         colour_ui(ui, "colour C", &mut material.color, "C: the surface colour (times its texture) in ka·C and kd·C.");
@@ -234,7 +234,7 @@ pub fn material_ui(ui: &mut egui::Ui, material: &mut Material) -> bool {
 }
 
 /// Applies `key=value` to a material, for scripts (`material kd=0.2`). Colours are `[r, g, b]`.
-pub fn set_material(material: &mut Material, assignment: &str) -> Result<(), String> {
+pub(in crate::viewer) fn set_material(material: &mut Material, assignment: &str) -> Result<(), String> {
     let (key, value) = assignment.split_once('=').ok_or("expected key=value")?;
     let (key, value) = (key.trim(), value.trim());
     let number =

@@ -17,7 +17,7 @@ use crate::scene::Camera;
 impl Viewer {
     /// Reloads the scene when its file changed on disk (polled between frames, without drawing
     /// one); returns whether it did, so the window is drawn again.
-    pub fn poll_file(&mut self) -> bool {
+    pub(in crate::viewer) fn poll_file(&mut self) -> bool {
         let reloaded = self.scene.reload_if_changed(&self.settings);
         if reloaded {
             let what = if self.scene.error.is_some() { "it does not load; the last scene is kept" } else { "reloaded" };
@@ -58,7 +58,7 @@ impl Viewer {
     }
 
     /// The settings that differ from the scene file's own.
-    pub fn changed_settings(&self) -> toml::Table {
+    pub(in crate::viewer) fn changed_settings(&self) -> toml::Table {
         super::config::changed_settings(&self.settings, &self.scene.seed_settings)
     }
 
@@ -117,7 +117,7 @@ impl Viewer {
     }
 
     /// Applies render settings given on the command line (checked already).
-    pub fn apply_settings(&mut self, assignments: &[String]) {
+    pub(in crate::viewer) fn apply_settings(&mut self, assignments: &[String]) {
         for assignment in assignments {
             self.set(assignment);
         }

@@ -123,7 +123,7 @@ impl SceneState {
 
     /// Whether going from `before` to `after` changes the displaced geometry: the scene must be
     /// made again from its file (`bump.method = "displacement"` and what it reads).
-    pub fn displacement_changed(before: &RenderSettings, after: &RenderSettings) -> bool {
+    pub(in crate::viewer) fn displacement_changed(before: &RenderSettings, after: &RenderSettings) -> bool {
         use crate::texture::displacement::wanted;
         let (b, a) = (&before.bump, &after.bump);
         wanted(before) != wanted(after)
@@ -133,7 +133,7 @@ impl SceneState {
 
     /// Reloads the scene when its file changed on disk since it was loaded (polled, cheap);
     /// returns whether the window changes: the scene, or the error of a file saved broken.
-    pub fn reload_if_changed(&mut self, settings: &RenderSettings) -> bool {
+    pub(in crate::viewer) fn reload_if_changed(&mut self, settings: &RenderSettings) -> bool {
         let Some(watch) = &mut self.watch else { return false };
         if watch.checked.elapsed() < WATCH_PERIOD {
             return false;
@@ -159,7 +159,7 @@ impl SceneState {
     /// Overrides one of the scene file's own values (`camera.fovy=30`, `lights.key.intensity=0.5`)
     /// and reads the file again with it, keeping `settings`; an override the file refuses is
     /// dropped and its error shown, the scene as it was.
-    pub fn set_value(&mut self, assignment: &str, settings: &RenderSettings) -> bool {
+    pub(in crate::viewer) fn set_value(&mut self, assignment: &str, settings: &RenderSettings) -> bool {
         let Some(path) = self.scene.source.clone() else {
             self.error = Some(format!("`{assignment}`: this scene has no file to override"));
             return false;
@@ -186,13 +186,13 @@ impl SceneState {
 
     /// The direction the environment is seen in at `pixel` of an image of `size` pixels taken
     /// by the current camera.
-    pub fn seen_direction(&mut self, pixel: glam::Vec2, size: (u32, u32)) -> SeenDirection {
+    pub(in crate::viewer) fn seen_direction(&mut self, pixel: glam::Vec2, size: (u32, u32)) -> SeenDirection {
         self.with_picker(size, |picker, scene| picker.seen_direction(scene, pixel))
     }
 
     /// Runs `f` with the picker (built once per scene) and the scene, its camera taking images
     /// of `size` pixels (the view's, not the render size the camera was loaded with).
-    pub fn with_picker<T>(&mut self, size: (u32, u32), f: impl FnOnce(&Picker, &Scene) -> T) -> T {
+    pub(in crate::viewer) fn with_picker<T>(&mut self, size: (u32, u32), f: impl FnOnce(&Picker, &Scene) -> T) -> T {
         let picker = self.picker.get_or_insert_with(|| Picker::new(&self.scene));
         let (width, height) = (self.scene.camera.width, self.scene.camera.height);
         (self.scene.camera.width, self.scene.camera.height) = size;

@@ -58,7 +58,7 @@ pub struct Screen {
 }
 
 /// Where a screenshot goes instead of a PNG file: given the name it was asked for and its pixels.
-pub type ScreenshotSink = Box<dyn Fn(&Path, &image::RgbaImage)>;
+pub(in crate::viewer) type ScreenshotSink = Box<dyn Fn(&Path, &image::RgbaImage)>;
 
 /// The side panel's pixels and the shapes they were drawn from.
 struct PanelCache {
@@ -198,7 +198,7 @@ impl Screen {
 
     /// The format the 3D view's image must have: the surface's own bytes to copy in, else what
     /// egui samples from (see `raster_view`).
-    pub fn image_format(&self) -> wgpu::TextureFormat {
+    pub(in crate::viewer) fn image_format(&self) -> wgpu::TextureFormat {
         match self.composition {
             Composition::Copied => self.config.format.add_srgb_suffix(),
             Composition::Textured => crate::raster::OUTPUT_FORMAT,
@@ -230,7 +230,7 @@ impl Screen {
     }
 
     /// The surface's error once it has failed every frame for a while: the viewer stops with it.
-    pub fn surface_failing(&self) -> Option<String> {
+    pub(in crate::viewer) fn surface_failing(&self) -> Option<String> {
         let (since, error) = self.failing.as_ref()?;
         (since.elapsed() >= FAILING_FOR).then(|| format!("the window's surface keeps failing: {error}"))
     }
@@ -242,7 +242,7 @@ impl Screen {
 
     /// egui's input since the last frame. `egui_winit::State::take_egui_input` would do, but it
     /// asks the window its size (see the module's header).
-    pub fn take_input(&mut self) -> egui::RawInput {
+    pub(in crate::viewer) fn take_input(&mut self) -> egui::RawInput {
         let pixels_per_point = egui_winit::pixels_per_point(&self.egui, &self.window);
         let native = self.window.scale_factor() as f32;
         let (width, height) = self.size();
@@ -434,7 +434,7 @@ impl Screen {
 
     /// Writes the screenshots whose pixels have arrived: as PNG files (atomically), or to the
     /// [`Screen::screenshot_sink`] when one is set.
-    pub fn write_screenshots(&mut self) -> anyhow::Result<()> {
+    pub(in crate::viewer) fn write_screenshots(&mut self) -> anyhow::Result<()> {
         let mut waiting = Vec::new();
         for (path, pending) in std::mem::take(&mut self.screenshots) {
             match pending.take(&self.gpu) {
@@ -454,7 +454,7 @@ impl Screen {
     }
 
     /// Whether a screenshot waits for its pixels (the browser's): the next frame is asked for.
-    pub fn screenshots_pending(&self) -> bool {
+    pub(in crate::viewer) fn screenshots_pending(&self) -> bool {
         !self.screenshots.is_empty()
     }
 }
@@ -535,7 +535,7 @@ struct Copies<'a> {
 /// How many of egui's shapes, from the front, draw only left of `edge` (in points): the side
 /// panel's, which egui lists first. The first shape that reaches into the view ends them, so
 /// whatever egui draws later (windows, tooltips, overlays) stays above them.
-pub fn panel_shapes(shapes: &[egui::epaint::ClippedShape], edge: f32) -> usize {
+pub(in crate::viewer) fn panel_shapes(shapes: &[egui::epaint::ClippedShape], edge: f32) -> usize {
     shapes
         .iter()
         .take_while(|clipped| {
@@ -548,7 +548,7 @@ pub fn panel_shapes(shapes: &[egui::epaint::ClippedShape], edge: f32) -> usize {
 
 /// An 8-bit RGBA or BGRA texture (sRGB or not: the bytes are the encoded values) as an opaque
 /// RGBA image, read back without waiting ([`readback::Pending`]).
-pub struct PendingImage {
+pub(in crate::viewer) struct PendingImage {
     pending: readback::Pending,
     bgra: bool,
 }
@@ -582,7 +582,7 @@ impl PendingImage {
 /// egui's fonts with its monospace face (Hack) as the proportional face's first fallback: the
 /// course's notation in the panel's tooltips (`A ⊗ C`, `‖n‖`) is in Hack, not in Ubuntu-Light,
 /// and showed as empty boxes.
-pub fn course_fonts() -> egui::FontDefinitions {
+pub(in crate::viewer) fn course_fonts() -> egui::FontDefinitions {
     let mut fonts = egui::FontDefinitions::default();
     if let Some(proportional) = fonts.families.get_mut(&egui::FontFamily::Proportional) {
         proportional.insert(1.min(proportional.len()), "Hack".to_owned());

@@ -22,7 +22,7 @@ struct Inputs {
 
 /// The marker's direction, with the pixel it was found at.
 #[derive(Default)]
-pub struct CursorDirection {
+pub(in crate::viewer) struct CursorDirection {
     kept: Kept<Inputs, (Vec2, SeenDirection)>,
 }
 
@@ -35,7 +35,12 @@ impl CursorDirection {
     }
 
     /// Whether the kept direction is the one [`Self::update`] would find now.
-    pub fn is_current(&self, scene: &SceneState, settings: &RenderSettings, at: Option<(Vec2, (u32, u32))>) -> bool {
+    pub(in crate::viewer) fn is_current(
+        &self,
+        scene: &SceneState,
+        settings: &RenderSettings,
+        at: Option<(Vec2, (u32, u32))>,
+    ) -> bool {
         self.kept.is_current(&inputs(scene, settings, at))
     }
 

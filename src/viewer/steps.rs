@@ -21,7 +21,7 @@ pub(super) const TRACE_TIMEOUT: Duration = Duration::from_secs(600);
 
 impl Viewer {
     /// Whether every scripted step has run and every screenshot asked for is written.
-    pub fn script_done(&self) -> bool {
+    pub(in crate::viewer) fn script_done(&self) -> bool {
         self.script.steps.is_empty()
             && self.script.wait_frames == 0
             && self.script.wait_until.is_none()
@@ -66,7 +66,7 @@ impl Viewer {
     }
 
     /// Asks for a screenshot of the window at the end of this frame.
-    pub fn request_screenshot(&mut self, path: PathBuf) {
+    pub(in crate::viewer) fn request_screenshot(&mut self, path: PathBuf) {
         self.script.screenshot = Some(path);
     }
 

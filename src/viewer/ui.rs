@@ -488,7 +488,7 @@ fn camera_input(ui: &egui::Ui, response: &egui::Response, rect: Rect, ppp: f32, 
 }
 
 /// The colour of the lat–long view's marker: no sky, ground or environment map is magenta.
-pub const MARKER_COLOUR: Color32 = Color32::from_rgb(255, 0, 255);
+pub(in crate::viewer) const MARKER_COLOUR: Color32 = Color32::from_rgb(255, 0, 255);
 
 /// On the inset lat–long view (`environment.view = "latlong"`, `environment.inset`), marks `seen`,
 /// the direction the environment is seen in at view pixel `pixel` (found before the layout,

@@ -11,7 +11,7 @@
 
 use crate::gpu::layout;
 
-pub struct Upscale {
+pub(in crate::viewer) struct Upscale {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
@@ -20,7 +20,7 @@ pub struct Upscale {
 }
 
 /// A rectangle of the target, in pixels: `x, y, width, height`.
-pub type Viewport = [u32; 4];
+pub(in crate::viewer) type Viewport = [u32; 4];
 
 impl Upscale {
     /// A pass writing targets of `format`, which must be a plain (not sRGB) format, like the
@@ -94,7 +94,7 @@ fn image_pipeline(
 /// The 3D view's sRGB image drawn, byte for byte, into the plain texture egui shows, where the
 /// device cannot copy between the two (WebGL2: `glCopyTexSubImage2D` refuses an sRGB source for
 /// a plain target). Elsewhere a copy does it.
-pub struct Reencode {
+pub(in crate::viewer) struct Reencode {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,

@@ -22,7 +22,7 @@ impl ViewMode {
     pub const ALL: [ViewMode; 4] = [ViewMode::Raster, ViewMode::Traced, ViewMode::Split, ViewMode::Difference];
 
     /// Whether this mode shows the ray-traced image (so the background tracer must run).
-    pub fn needs_traced(self) -> bool {
+    pub(in crate::viewer) fn needs_traced(self) -> bool {
         self != ViewMode::Raster
     }
 

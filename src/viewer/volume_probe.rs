@@ -156,7 +156,7 @@ const CROSSING_COLOUR: Color32 = Color32::from_rgb(255, 0, 255);
 /// Where the probe is asked for: a pixel of the 3D view (the cursor's or a script's), and the
 /// view's size, both in pixels.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ProbeAt {
+pub(in crate::viewer) struct ProbeAt {
     pub pixel: Vec2,
     pub size: (u32, u32),
 }
@@ -182,7 +182,7 @@ struct Inputs {
 /// The probe the view shows, made before the UI is laid out and kept while its inputs stay the
 /// same.
 #[derive(Default)]
-pub struct CursorProbe {
+pub(in crate::viewer) struct CursorProbe {
     kept: Kept<Inputs, Shown>,
 }
 
@@ -197,7 +197,12 @@ impl CursorProbe {
     }
 
     /// Whether the kept probe is the one [`CursorProbe::update`] would make now.
-    pub fn is_current(&self, scene: &SceneState, settings: &RenderSettings, at: Option<ProbeAt>) -> bool {
+    pub(in crate::viewer) fn is_current(
+        &self,
+        scene: &SceneState,
+        settings: &RenderSettings,
+        at: Option<ProbeAt>,
+    ) -> bool {
         self.kept.is_current(&inputs(scene, settings, at))
     }
 
@@ -347,7 +352,7 @@ fn probe_ui(ui: &mut egui::Ui, probe: &Probe, output: OutputTransform) {
 
 /// What the volume ray through `pixel` of an image of `size` pixels taken by the current camera
 /// does: `None` where it enters no volume in front of the surfaces.
-pub fn probe_at(
+pub(in crate::viewer) fn probe_at(
     scene: &mut SceneState,
     pixel: glam::Vec2,
     size: (u32, u32),
@@ -365,7 +370,7 @@ pub fn probe_at(
 /// What the viewer shows of what is under the cursor: the volume ray's samples, the direction the
 /// environment is seen in (the lat–long view's marker), and the cursor the last layout saw.
 #[derive(Default)]
-pub struct CursorTools {
+pub(in crate::viewer) struct CursorTools {
     pub probe: CursorProbe,
     pub seen: super::seen::CursorDirection,
     pub at: Option<Vec2>,

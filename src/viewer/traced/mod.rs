@@ -36,9 +36,9 @@ pub(crate) use recipe::SceneRecipe;
 #[cfg(target_arch = "wasm32")]
 pub(crate) use slices::OwnedTracer;
 #[cfg(target_arch = "wasm32")]
-pub use slices::TracedWorker;
+pub(in crate::viewer) use slices::TracedWorker;
 #[cfg(not(target_arch = "wasm32"))]
-pub use thread::TracedWorker;
+pub(in crate::viewer) use thread::TracedWorker;
 
 /// The coarsest level of progressive refinement: one ray per `START_BLOCK²` pixels.
 const START_BLOCK: u32 = 16;

@@ -129,7 +129,7 @@ impl TracedWorker {
 
     /// Starts the workers, once (the page calls it after its first frame: started with the page,
     /// they made that frame about 0.1 s later on two cores).
-    pub fn start_workers(&mut self) {
+    pub(in crate::viewer) fn start_workers(&mut self) {
         if !self.pool_tried {
             self.pool_tried = true;
             self.pool = Pool::start(self.wake.clone());
