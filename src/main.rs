@@ -916,8 +916,9 @@ fn budget(args: SceneArgs, trace_args: TraceArgs, sheet: Option<&Path>, json: Op
     let traced = traced_radiance.to_rgba8(mirador::output::OutputTransform::of(&scene.settings));
     let gpu = clock.time("device", Gpu::headless)?;
     gpu.check_image_size((scene.camera.width, scene.camera.height))?;
-    let budget =
-        gpu.checked(|| clock.time("raster frames", || mirador::budget::budget(&gpu, &scene, &scene.settings, traced)))?;
+    let budget = gpu.checked(|| {
+        clock.time("raster frames", || mirador::budget::budget(&gpu, (&scene, &reference), &scene.settings, traced))
+    })?;
     let text = serde_json::to_string_pretty(&budget.json()).expect("the budget serialises");
     match json {
         Some(path) if path.as_os_str() == "-" => println!("{text}"),

@@ -205,8 +205,7 @@ impl Wgsl {
     fn compose_after<'a>(&self, shared: impl Iterator<Item = &'a (&'a str, &'a str)>, pass: &str) -> String {
         let mut source = String::new();
         let (profile, profile_text) = self.profile.wgsl();
-        let prelude = constants::prelude();
-        let first = [("constants (src/shaders/constants.rs)", prelude.as_str()), (profile, profile_text)];
+        let first = [("constants (src/shaders/constants.rs)", constants::prelude()), (profile, profile_text)];
         for (name, text) in first.into_iter().chain(shared.map(|&(name, text)| (name, text))) {
             source.push_str("// ---- ");
             source.push_str(name);

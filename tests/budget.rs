@@ -14,7 +14,8 @@ fn traced(scene: &Scene, settings: &RenderSettings) -> image::RgbaImage {
 }
 
 fn budget_of(scene: &Scene, settings: &RenderSettings) -> Budget {
-    let budget = budget(common::gpu(), scene, settings, traced(scene, settings));
+    let reference = mirador::budget::reference_scene(scene, settings);
+    let budget = budget(common::gpu(), (scene, &reference), settings, traced(&reference, settings));
     eprintln!("{}", budget.report());
     budget
 }

@@ -201,7 +201,7 @@ fn the_budget_measures_bump_and_parallax_mapping_against_the_displaced_surface()
         let settings = scene.settings.clone();
         let reference = mirador::budget::reference_scene(&scene, &settings);
         let traced = mirador::trace::render_image(&reference, &settings);
-        let budget = mirador::budget::budget(gpu, &scene, &settings, traced);
+        let budget = mirador::budget::budget(gpu, (&scene, &reference), &settings, traced);
         let relief = budget.items.iter().find(|i| i.name == "bump and parallax mapping").expect("the relief's row");
         eprintln!("{method:?}: whole {:.4}, relief alone {:.4}, floor {:.4}", budget.whole, relief.alone, budget.floor);
         assert!(relief.alone > least && relief.alone > 0.8 * budget.whole, "{method:?}: {}", budget.report());

@@ -127,8 +127,9 @@ fn chapter_9_exercise_2_every_accelerator_draws_the_same_image() {
 /// Chapter 12's budget of an exercise scene with `sets`: each approximation's cost alone, by name.
 fn budget_alone(relative: &str, sets: &[&str]) -> std::collections::BTreeMap<&'static str, f32> {
     let (scene, settings) = scene_with(relative, sets);
-    let traced = mirador::trace::render_image(&scene, &settings);
-    let budget = mirador::budget::budget(common::gpu(), &scene, &settings, traced);
+    let reference = mirador::budget::reference_scene(&scene, &settings);
+    let traced = mirador::trace::render_image(&reference, &settings);
+    let budget = mirador::budget::budget(common::gpu(), (&scene, &reference), &settings, traced);
     eprintln!("{relative} {sets:?}\n{}", budget.report());
     budget.items.iter().map(|i| (i.name, i.alone)).collect()
 }

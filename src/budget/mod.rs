@@ -104,16 +104,15 @@ pub fn reference_scene<'s>(scene: &'s Scene, settings: &RenderSettings) -> std::
     }
 }
 
-/// The budget of `scene` with `settings`, drawn on `gpu`, against `traced` (the tracer's image
-/// of [`reference_scene`] with `settings`).
-pub fn budget(gpu: &Gpu, scene: &Scene, settings: &RenderSettings, traced: RgbaImage) -> Budget {
-    // The relief's swap draws the displaced scene: a frame of its own.
-    let displaced = reference_scene(scene, settings);
+/// The budget of `scene` with `settings`, drawn on `gpu`, against `traced`: the tracer's image of
+/// `reference` ([`reference_scene`]) with `settings`.
+pub fn budget(gpu: &Gpu, (scene, reference): (&Scene, &Scene), settings: &RenderSettings, traced: RgbaImage) -> Budget {
+    // The relief's swap draws the displaced scene, the reference: a frame of its own.
     let mut headless = Headless::new(gpu, scene);
     let mut relief: Option<Headless> = None;
     let mut raster = |settings: &RenderSettings| {
         if settings.hybrid.relief {
-            relief.get_or_insert_with(|| Headless::new(gpu, &displaced)).render(gpu, &displaced, settings)
+            relief.get_or_insert_with(|| Headless::new(gpu, reference)).render(gpu, reference, settings)
         } else {
             headless.render(gpu, scene, settings)
         }

@@ -163,9 +163,10 @@ impl Checker {
             list.iter().map(|m| (m.clone(), source::student(lab, &lab.mistaken(m)))).collect()
         };
         let (mistakes, alternatives) = (compiled(&lab.mistakes), compiled(&lab.alternatives));
+        let (student, poisoned) = source::student_and_poisoned(lab, text);
         Checker {
             harness: Harness::new(&gpu),
-            student: source::student(lab, text),
+            student,
             reference: source::reference(lab),
             mistakes,
             alternatives,
@@ -175,7 +176,7 @@ impl Checker {
             agreement: Default::default(),
             student_values: Default::default(),
             tripped: Default::default(),
-            poisoned: source::poisoned(lab, text),
+            poisoned,
             gpu,
         }
     }

@@ -72,12 +72,13 @@ pub fn student(lab: &Lab, student: &str) -> Wgsl {
     compiled(lab, &isolated(lab, student))
 }
 
-/// [`student`] with the slots' values NaN wherever the loop guard cut the student's loops off
-/// ([`Isolated::poisoned`]): drawn beside [`student`], the images differ where the guard decided
-/// a value. `None` when the student's file has no loop (or no slot that returns floats).
-pub fn poisoned(lab: &Lab, student: &str) -> Option<Wgsl> {
+/// [`student`], and beside it the same with the slots' values NaN wherever the loop guard cut the
+/// student's loops off ([`Isolated::poisoned`]): drawn beside it, the images differ where the
+/// guard decided a value. `None` when the student's file has no loop (or no slot that returns
+/// floats). The text is isolated once for both.
+pub fn student_and_poisoned(lab: &Lab, student: &str) -> (Wgsl, Option<Wgsl>) {
     let isolated = isolated(lab, student);
-    isolated.poisoned().map(|text| routed(lab, text, &isolated))
+    (compiled(lab, &isolated), isolated.poisoned().map(|text| routed(lab, text, &isolated)))
 }
 
 /// [`student`] of a text already isolated.

@@ -35,12 +35,6 @@ pub fn wanted(settings: &RenderSettings) -> Option<Wanted> {
     Some(settings.hybrid.traced()).filter(|wanted| !wanted.is_empty())
 }
 
-/// The settings the rasterizer's own passes draw with: what each traced term replaces left out
-/// (each row of the approximations table says what, `crate::settings::hybrid`).
-pub fn raster_settings(settings: &RenderSettings) -> Option<RenderSettings> {
-    settings.hybrid.raster_settings(settings)
-}
-
 /// Every view's traced terms, ready to be copied into its image: each view's buffer holds the
 /// layers traced, one after another, each the view's window.
 pub struct PreparedTraced {

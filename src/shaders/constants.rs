@@ -144,8 +144,15 @@ wgsl_constants! {
 
 /// The WGSL `const`s of [`ALL`] and of the approximations table: `TRACED_NAME`, the row's bit in
 /// the `TRACED` pipeline constant, and `TRACED_NAME_LAYER`, its term's first layer in the view's
-/// traced image (after `TRACED_SURFACE_LAYER`).
-pub fn prelude() -> String {
+/// traced image (after `TRACED_SURFACE_LAYER`). Written once, the first time a module is
+/// composed.
+pub fn prelude() -> &'static str {
+    static PRELUDE: std::sync::LazyLock<String> = std::sync::LazyLock::new(written);
+    &PRELUDE
+}
+
+/// The text of [`prelude`].
+fn written() -> String {
     let mut out = String::from("// Written by src/shaders/constants.rs from the Rust constants: edit them there.\n");
     for (name, doc, ty, value) in ALL {
         for line in *doc {
@@ -189,6 +196,6 @@ mod tests {
         assert!(prelude.contains("const ENV_LAYER_NONE: i32 = -2;"));
         assert!(prelude.contains("const MIP_PALETTE_LAST: u32 = 7u;"));
         assert!(prelude.contains("const TRACED_REFLECTIONS: u32 = 2u;"));
-        naga::front::wgsl::parse_str(&prelude).unwrap_or_else(|e| panic!("{}", e.emit_to_string(&prelude)));
+        naga::front::wgsl::parse_str(prelude).unwrap_or_else(|e| panic!("{}", e.emit_to_string(prelude)));
     }
 }

@@ -28,8 +28,8 @@ use std::collections::HashMap;
 
 use glam::{Mat4, Vec2, Vec3};
 
-use super::height::{HeightField, SineField, TextureHeight, ValueNoise};
-use crate::scene::{Material, Mesh, ProceduralHeight, Scene, Shape};
+use super::height::{HeightField, TextureHeight, with_material_field};
+use crate::scene::{Material, Mesh, Scene, Shape};
 use crate::settings::{BumpMethod, RenderSettings};
 
 /// The most triangles the displaced meshes of one scene may have together: about 100 MB of
@@ -160,16 +160,8 @@ fn has_height(material: &Material) -> bool {
 /// `f` of `material`'s height field: its procedural one, or its height map read as the tracer
 /// reads it (level 0, bilinear, repeat).
 fn with_field<T>(scene: &Scene, material: &Material, f: impl FnOnce(&dyn HeightField) -> T) -> Option<T> {
-    match material.height_field {
-        Some(ProceduralHeight::Sine { frequency, amplitude }) => Some(f(&SineField { amplitude, frequency })),
-        Some(ProceduralHeight::Noise { seed, cells, octaves, amplitude }) => {
-            Some(f(&ValueNoise { seed, cells, octaves, amplitude }))
-        }
-        None => {
-            let texture = scene.textures.get(material.height_map?.0)?;
-            Some(f(&TextureHeight::new(texture)))
-        }
-    }
+    let map = material.height_map.and_then(|id| scene.textures.get(id.0)).map(TextureHeight::new);
+    with_material_field(material, map.as_ref(), f)
 }
 
 /// The subdivision `n` that keeps every new edge within `texels` steps of `field` (its
@@ -445,6 +437,7 @@ fn face_normals(mesh: &Mesh) -> Vec<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::texture::height::SineField;
 
     fn flat(amplitude: f32) -> SineField {
         SineField { amplitude, frequency: Vec2::new(2.0, 2.0) }

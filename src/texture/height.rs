@@ -26,7 +26,7 @@ use std::f32::consts::TAU;
 use glam::Vec2;
 
 use super::mipmap::MipLevel;
-use crate::scene::Texture;
+use crate::scene::{Material, ProceduralHeight, Texture};
 
 /// A scalar height over texture coordinates.
 pub trait HeightField: Sync {
@@ -45,6 +45,22 @@ pub trait HeightField: Sync {
     /// The least and the greatest height the field can take: the slab parallax mapping marches
     /// through (WGSL twin: `height_range` in `shaders/common/surface.wgsl`).
     fn range(&self) -> (f32, f32);
+}
+
+/// `f` of `material`'s height field: its procedural one, or `map`, its height map as a
+/// [`TextureHeight`]; `None` with neither. (A material has one or the other.)
+pub fn with_material_field<T>(
+    material: &Material,
+    map: Option<&TextureHeight>,
+    f: impl FnOnce(&dyn HeightField) -> T,
+) -> Option<T> {
+    match material.height_field {
+        Some(ProceduralHeight::Sine { frequency, amplitude }) => Some(f(&SineField { amplitude, frequency })),
+        Some(ProceduralHeight::Noise { seed, cells, octaves, amplitude }) => {
+            Some(f(&ValueNoise { seed, cells, octaves, amplitude }))
+        }
+        None => map.map(|h| f(h)),
+    }
 }
 
 /// A grey-level texture as a height field: the red channel of level 0, bilinear, repeat.

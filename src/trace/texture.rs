@@ -63,13 +63,14 @@ use glam::{Vec2, Vec3, Vec4};
 use super::geometry::SurfaceHit;
 use crate::base::TextureId;
 use crate::output::srgb_decode;
-use crate::scene::{ColorSpace, Material, ProceduralHeight, Scene, Texture};
+use crate::scene::{ColorSpace, Material, Scene, Texture};
 use crate::settings::{BumpSettings, TextureFilter, TextureSettings, TracerLod};
+use crate::texture::height::with_material_field;
 use crate::texture::parallax::parallax_uv;
 use crate::texture::tangents::normal_map_normal;
 use crate::texture::{
-    BumpParams, Filter, HeightField, MipChain, RayCone, SineField, TextureHeight, ValueNoise, bump_normal,
-    height_gradient, lod_from_distance, lod_from_footprint,
+    BumpParams, Filter, HeightField, MipChain, RayCone, TextureHeight, bump_normal, height_gradient, lod_from_distance,
+    lod_from_footprint,
 };
 
 /// The linear RGB value of `texture` at `uv`, bilinearly filtered with repeat wrapping: level 0
@@ -314,13 +315,7 @@ impl SceneTextures {
 
     /// `f` of the material's height field (procedural, or its height map), if it has one.
     fn with_height_field<T>(&self, material: &Material, f: impl FnOnce(&dyn HeightField) -> T) -> Option<T> {
-        match material.height_field {
-            Some(ProceduralHeight::Sine { frequency, amplitude }) => Some(f(&SineField { amplitude, frequency })),
-            Some(ProceduralHeight::Noise { seed, cells, octaves, amplitude }) => {
-                Some(f(&ValueNoise { seed, cells, octaves, amplitude }))
-            }
-            None => material.height_map.and_then(|id| self.height(id)).map(|h| f(h)),
-        }
+        with_material_field(material, material.height_map.and_then(|id| self.height(id)), f)
     }
 }
 

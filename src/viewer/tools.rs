@@ -40,9 +40,10 @@ impl Viewer {
         let mut scene = self.scene.scene.clone();
         let width = size.0.min(BUDGET_WIDTH);
         (scene.camera.width, scene.camera.height) = (width, (size.1 * width).div_ceil(size.0.max(1)).max(1));
-        let traced =
-            crate::trace::render_image(&crate::budget::reference_scene(&scene, &self.settings), &self.settings);
-        let measured = screen.gpu.checked(|| crate::budget::budget(&screen.gpu, &scene, &self.settings, traced));
+        let reference = crate::budget::reference_scene(&scene, &self.settings);
+        let traced = crate::trace::render_image(&reference, &self.settings);
+        let measured =
+            screen.gpu.checked(|| crate::budget::budget(&screen.gpu, (&scene, &reference), &self.settings, traced));
         let budget = match measured {
             Ok(budget) => budget,
             Err(e) => return self.notice(format!("cannot measure the error budget: {e:#}")),

@@ -249,7 +249,8 @@ impl Renderer {
         output: &wgpu::TextureView,
     ) -> FrameReport {
         // Where the hybrid traces a term, the passes draw without what it replaces.
-        let raster_settings = traced::raster_settings(settings);
+        // What each traced term replaces left out (each row of the approximations table says what).
+        let raster_settings = settings.hybrid.raster_settings(settings);
         let settings = raster_settings.as_ref().unwrap_or(settings);
         let wanted = traced::wanted(settings);
         let out = output.texture().size();
