@@ -11,7 +11,10 @@
 //!   scene a chapter names exists;
 //! - every image of the course is linked from a chapter and made by `docs/course/images.sh`;
 //! - every function, type or constant a document names by a link to its file
-//!   (``[`bump_normal`](../../src/texture/bump.rs)``) is declared in that file.
+//!   (``[`bump_normal`](../../src/texture/bump.rs)``) is declared in that file;
+//! - every formula of a chapter (a ```` ```math ```` block of `docs/course/NN-name.md`) names the
+//!   code that computes it: the paragraph before it or the text after it links a function of
+//!   `src/` or `shaders/` that the linked file declares, or says that no function computes it.
 //!
 //! Nothing here needs a GPU.
 
@@ -610,4 +613,177 @@ fn every_declaration_a_document_links_to_its_file_is_there() {
     assert!(!declares(source, "MipChain::sampled") && !declares(source, "Other::sample"));
     let text = "see [`bump_normal`](../../src/texture/bump.rs) and [`a link`](x.rs)";
     assert_eq!(named_declarations(text), [(1, "bump_normal".to_owned(), "../../src/texture/bump.rs".to_owned())]);
+}
+
+/// Whether a line of prose is an ATX heading (`#` to `######`, then a space or nothing).
+fn is_heading(line: &str) -> bool {
+    let trimmed = line.trim_start();
+    let hashes = trimmed.chars().take_while(|&c| c == '#').count();
+    let after = &trimmed[hashes.min(trimmed.len())..];
+    (1..=6).contains(&hashes) && line.len() - trimmed.len() < 4 && (after.is_empty() || after.starts_with([' ', '\t']))
+}
+
+/// The ```` ```math ```` blocks of a Markdown text, each as (the line of its opening fence, the
+/// lines around it that must say what computes it): from the paragraph just before the block to
+/// the line before the next heading or the next math block. Lines are numbered from 1.
+fn formula_contexts(text: &str) -> Vec<(usize, std::ops::RangeInclusive<usize>)> {
+    let lines: Vec<&str> = text.lines().collect();
+    // Whether each line is a heading outside a fence, and the math blocks as (open, close) indices.
+    let mut heading = vec![false; lines.len()];
+    let mut math_opens = vec![false; lines.len()];
+    let mut blocks = Vec::new();
+    let mut open: Option<(usize, bool)> = None;
+    for (i, line) in lines.iter().enumerate() {
+        if is_fence(line) {
+            match open {
+                None => {
+                    let math = line.trim_start().trim_start_matches(['`', '~']).trim() == "math";
+                    math_opens[i] = math;
+                    open = Some((i, math));
+                }
+                Some((start, math)) => {
+                    if math {
+                        blocks.push((start, i));
+                    }
+                    open = None;
+                }
+            }
+        } else if open.is_none() {
+            heading[i] = is_heading(line);
+        }
+    }
+    blocks
+        .into_iter()
+        .map(|(start, close)| {
+            // The paragraph before: back over blank lines, then over the lines of prose above them.
+            let mut first = start;
+            let mut k = start;
+            while k > 0 && lines[k - 1].trim().is_empty() {
+                k -= 1;
+            }
+            while k > 0 && !lines[k - 1].trim().is_empty() && !heading[k - 1] && !is_fence(lines[k - 1]) {
+                k -= 1;
+                first = k;
+            }
+            let last = (close + 1..lines.len()).find(|&j| heading[j] || math_opens[j]).unwrap_or(lines.len()) - 1;
+            (start + 1, first + 1..=last + 1)
+        })
+        .collect()
+}
+
+/// The formulas of `document` (a chapter at that path, text `text`) whose surroundings link no
+/// function of `src/` or `shaders/` that the linked file declares, and do not say that no
+/// function computes them: one message each, naming the chapter and the block's line. Also the
+/// number of formulas read.
+fn formulas_without_code(document: &Path, text: &str) -> (Vec<String>, usize) {
+    let named = named_declarations(text);
+    let code = [root().join("src"), root().join("shaders")];
+    let contexts = formula_contexts(text);
+    let lines: Vec<&str> = text.lines().collect();
+    let problems = contexts
+        .iter()
+        .filter(|(_, around)| {
+            let prose = lines[around.start() - 1..*around.end()].join("\n");
+            if prose.contains("no function computes it") {
+                return false;
+            }
+            !named.iter().any(|(line, name, target)| {
+                let file = normalized(&document.parent().expect("a folder").join(target));
+                around.contains(line)
+                    && code.iter().any(|dir| file.starts_with(dir))
+                    && fs::read_to_string(&file).is_ok_and(|source| declares(&source, name))
+            })
+        })
+        .map(|(line, _)| {
+            format!(
+                "{}:{line}: this formula names no function that computes it: link one in the paragraph before it \
+                 or the text after it, as [`name`](../../src/…/file.rs) or (../../shaders/…/file.wgsl), or say \
+                 that no function computes it",
+                shown(document)
+            )
+        })
+        .collect();
+    (problems, contexts.len())
+}
+
+#[test]
+fn every_formula_names_the_code_that_computes_it() {
+    let mut problems = Vec::new();
+    let mut formulas = 0;
+    for chapter in course_chapters() {
+        let name = chapter.file_name().expect("a name").to_string_lossy().to_string();
+        // The numbered chapters: docs/course/NN-name.md.
+        if !(name.len() > 3 && name.as_bytes()[..2].iter().all(u8::is_ascii_digit) && name.as_bytes()[2] == b'-') {
+            continue;
+        }
+        let (found, count) = formulas_without_code(&chapter, &read(&chapter));
+        problems.extend(found);
+        formulas += count;
+    }
+    assert!(
+        formulas >= 30,
+        "the check found only {formulas} ```math blocks in the chapters: is it still reading them?"
+    );
+    assert!(problems.is_empty(), "{} formulas name no code:\n{}", problems.len(), problems.join("\n"));
+
+    // The check can fail, and reads what it should: the paragraph before a formula and the text
+    // after it, up to a heading (not a `#` line in a code block) or the next formula.
+    let chapter = root().join("docs").join("course").join("00-example.md");
+    let text = [
+        "# A",                                                        // 1
+        "",                                                           // 2
+        "Snell's law, by [`refract`](../../src/scene/optics.rs):",    // 3: before block 1
+        "",                                                           // 4
+        "```math",                                                    // 5: block 1, passes
+        "x",                                                          // 6
+        "```",                                                        // 7
+        "",                                                           // 8
+        "```math",                                                    // 9: block 2, passes by what follows
+        "y",                                                          // 10
+        "```",                                                        // 11
+        "",                                                           // 12
+        "```text",                                                    // 13
+        "# not a heading",                                            // 14
+        "```",                                                        // 15
+        "",                                                           // 16
+        "Computed by [`fresnel`](../../shaders/common/optics.wgsl).", // 17
+        "## B",                                                       // 18
+        "",                                                           // 19
+        "By [`refracted`](../../src/scene/optics.rs).",               // 20: not declared there
+        "",                                                           // 21
+        "```math",                                                    // 22: block 3, fails
+        "z",                                                          // 23
+        "```",                                                        // 24
+        "",                                                           // 25
+        "By [`read`](../../tests/course.rs), which is not the code.", // 26
+        "",                                                           // 27
+        "```math",                                                    // 28: block 4, fails
+        "w",                                                          // 29
+        "```",                                                        // 30
+        "",                                                           // 31
+        "## C",                                                       // 32
+        "",                                                           // 33
+        "Too late: [`refract`](../../src/scene/optics.rs).",          // 34
+        "",                                                           // 35
+        "```math",                                                    // 36: block 5, passes
+        "v",                                                          // 37
+        "```",                                                        // 38
+        "## D",                                                       // 39
+        "",                                                           // 40
+        "```math",                                                    // 41: block 6, passes
+        "u",                                                          // 42
+        "```",                                                        // 43
+        "",                                                           // 44
+        "A definition; no function computes it alone.",               // 45
+    ]
+    .join("\n");
+    let (found, count) = formulas_without_code(&chapter, &text);
+    assert_eq!(count, 6);
+    let lines: Vec<&str> = found.iter().map(|f| f.split(": ").next().unwrap_or("")).collect();
+    assert_eq!(lines, ["docs/course/00-example.md:22", "docs/course/00-example.md:28"], "{found:?}");
+    let contexts = formula_contexts(&text);
+    assert_eq!(contexts[0], (5, 3..=8));
+    assert_eq!(contexts[1], (9, 9..=17));
+    assert_eq!(contexts[3], (28, 26..=31));
+    assert_eq!(contexts[5], (41, 41..=45));
 }

@@ -90,6 +90,10 @@ fn latlong_direction(uv: vec2f) -> vec3f {
 fn sphere_map_uv(r: vec3f) -> vec2f {
     let n = normalize(r);
     let m = 2.0 * sqrt(n.x * n.x + n.y * n.y + (n.z + 1.0) * (n.z + 1.0));
+    // Straight back at the viewer (r = −z): the whole rim, as the tracer's `sphere_map_uv` reads it.
+    if m < 1e-12 {
+        return vec2f(0.5, 0.0);
+    }
     return vec2f(n.x / m + 0.5, 0.5 - n.y / m);
 }
 
