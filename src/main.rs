@@ -9,6 +9,7 @@ use anyhow::{Context, bail};
 use clap::{Parser, Subcommand};
 
 use mirador::compare::sheet::{Panel, flip_legend, sheet, with_footer};
+use mirador::course::{Linked, PageLink};
 use mirador::gpu::texture::GpuTexture;
 use mirador::gpu::{Gpu, Stopwatch, readback};
 use mirador::linear_output::LinearImage;
@@ -139,6 +140,24 @@ enum Command {
         #[arg(long, value_name = "FILE.json")]
         json: Option<PathBuf>,
     },
+    /// Print the address of Mirador's page that shows what a command shows: its scene, its
+    /// settings and its view. `mirador link render assets/scenes/course/mirror-pair.toml --set
+    /// mirrors.depth=2` prints `?scene=course/mirror-pair.toml&set=mirrors.depth%3D2&view=raster`;
+    /// the course's site (web/site.sh) puts one under every command of its chapters.
+    Link {
+        /// What to print before the query: the page's address (`https://…/mirador/`).
+        #[arg(long, value_name = "URL", default_value = "")]
+        page: String,
+        /// The command, as after `mirador`.
+        #[arg(required = true, trailing_var_arg = true, allow_hyphen_values = true)]
+        command: Vec<String>,
+    },
+    /// The course site's mdBook preprocessor (web/site.sh runs mdBook, which runs this).
+    #[command(hide = true)]
+    Book {
+        /// `supports RENDERER`, as mdBook asks first.
+        args: Vec<String>,
+    },
     /// Copy a scene and every file it reads (textures, maps, models, volumes) into a folder of
     /// your own, the copy naming them there: do an exercise on the copy, the course stays as it
     /// was. Nothing in the folder is overwritten.
@@ -251,7 +270,7 @@ enum LabCommand {
     },
 }
 
-#[derive(clap::Args)]
+#[derive(clap::Args, Clone)]
 struct SceneArgs {
     /// Scene file (TOML, or a .gltf/.glb/.obj/.ply model). Default: the built-in showcase.
     scene: Option<PathBuf>,
@@ -328,7 +347,7 @@ fn parse_size(text: &str) -> Result<[u32; 2], String> {
     }
 }
 
-#[derive(clap::Args)]
+#[derive(clap::Args, Default)]
 struct TraceArgs {
     /// Anti-aliasing (default: the scene's `trace.anti_aliasing`, else one ray per pixel centre).
     #[arg(long, value_enum)]
@@ -368,6 +387,14 @@ fn main() -> ExitCode {
             diff(&reference, &test, mask.as_deref(), json.as_deref())
         }
         Some(Command::Copy { scene, dir }) => copy(&scene, &dir),
+        Some(Command::Link { page, command }) => page_link(&command).and_then(|linked| match linked {
+            Linked::Page(link) => {
+                println!("{page}{}", link.query());
+                Ok(())
+            }
+            Linked::CommandLine(why) => bail!("the page cannot show this: {why}"),
+        }),
+        Some(Command::Book { args }) => return book(&args),
         None => view(ViewArgs::default()),
     };
     match result {
@@ -394,6 +421,109 @@ fn stop_quietly_when_the_reader_stops() {
         }
         default(info);
     }));
+}
+
+/// The page's address for a command's words after `mirador`, made by the CLI's own parser:
+/// `render` is the raster view, `trace` the traced one, `compare` and `explain` the split view,
+/// `budget` the budget's panel; the trace options become the settings they set. The image's size
+/// is not said: the page draws at its window's. A command the page cannot show (a scene of the
+/// student's own, `diff`, `lab`) is said why; one that Mirador itself refuses (an unknown option,
+/// a setting the scene does not take) is an error.
+fn page_link(words: &[String]) -> anyhow::Result<Linked> {
+    let cli = Cli::try_parse_from(std::iter::once("mirador").chain(words.iter().map(String::as_str))).map_err(|e| {
+        // Clap's message, up to its usage lines.
+        let text = e.to_string();
+        let message: Vec<&str> = text.lines().take_while(|l| !l.is_empty()).map(str::trim).collect();
+        anyhow::anyhow!("{}", message.join(" ").trim_start_matches("error: "))
+    })?;
+    let (args, trace, view) = match cli.command {
+        None => return Ok(Linked::Page(PageLink::default())),
+        Some(Command::View(args)) if args.lab.is_some() => {
+            return Ok(Linked::CommandLine(
+                "a lab's folder of your own: the page opens its labs from the Lab menu".into(),
+            ));
+        }
+        Some(Command::View(args)) => {
+            let scene = SceneArgs { scene: args.scene, width: None, height: None, set: args.set, stats: false };
+            (scene, TraceArgs::default(), None)
+        }
+        Some(Command::Render { scene, .. }) => (scene, TraceArgs::default(), Some("raster")),
+        Some(Command::Trace { scene, trace, .. }) => (scene, trace, Some("traced")),
+        Some(Command::Compare { scene, trace, .. } | Command::Explain { scene, trace, .. }) => {
+            (scene, trace, Some("split"))
+        }
+        Some(Command::Budget { scene, trace, .. }) => (scene, trace, None),
+        Some(_) => return Ok(Linked::CommandLine("the page has no such command".into())),
+    };
+    let scene = match args.scene.as_deref().map(PageLink::builtin_scene) {
+        None => "showcase.toml".to_owned(),
+        Some(Ok(scene)) => scene,
+        Some(Err(why)) => return Ok(Linked::CommandLine(why)),
+    };
+    let mut set = args.set.clone();
+    set.extend(trace_settings(&args, &trace).context(words.join(" "))?);
+    let budget = matches!(words.first().map(String::as_str), Some("budget"));
+    let then = match words.first().map(String::as_str) {
+        Some("explain") => Some("inspect the pixel (I, then a click on it)".to_owned()),
+        _ => None,
+    };
+    Ok(Linked::Page(PageLink { scene: Some(scene), set, view, budget, then }))
+}
+
+/// The scene loaded with `--set` as the command would load it (so that a setting it refuses is
+/// an error here too), and its trace options as the settings they change, `trace.KEY=VALUE`: the
+/// settings before and after [`apply_trace_args`], compared field by field.
+fn trace_settings(args: &SceneArgs, trace: &TraceArgs) -> anyhow::Result<Vec<String>> {
+    let scene = prepare(&SceneArgs { stats: false, ..args.clone() }, &mut Stopwatch::default())?;
+    let mut after = scene.settings.clone();
+    apply_trace_args(&mut after, trace)?;
+    let table = |settings: &RenderSettings| toml::Value::try_from(&settings.trace).map_err(anyhow::Error::from);
+    let (before, after) = (table(&scene.settings)?, table(&after)?);
+    let (Some(before), Some(after)) = (before.as_table(), after.as_table()) else {
+        bail!("the trace settings are no table")
+    };
+    Ok(after
+        .iter()
+        .filter(|(key, value)| before.get(*key) != Some(value))
+        .map(|(key, value)| format!("trace.{key}={value}"))
+        .collect())
+}
+
+/// `mirador book`: mdBook's preprocessor protocol. `supports RENDERER` answers by the exit
+/// status; otherwise the book comes as JSON on standard input and goes back on standard output,
+/// and the repository files the chapters link are copied into the book's `source/`.
+fn book(args: &[String]) -> ExitCode {
+    if let [verb, renderer] = args
+        && verb == "supports"
+    {
+        return if renderer == "html" { ExitCode::SUCCESS } else { ExitCode::FAILURE };
+    }
+    match preprocess_book() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("error: mirador book: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn preprocess_book() -> anyhow::Result<()> {
+    use std::io::Read as _;
+    let mut input = String::new();
+    std::io::stdin().read_to_string(&mut input).context("reading the book from mdBook")?;
+    let context: serde_json::Value = serde_json::from_str(&input).context("mdBook's input is not JSON")?;
+    let root = PathBuf::from(context[0]["root"].as_str().unwrap_or("."));
+    let config = &context[0]["config"]["preprocessor"]["mirador"];
+    let repository = config["repository"].as_str().map_or_else(|| root.clone(), |r| root.join(r));
+    let source = config["source"].as_str().filter(|s| !s.is_empty()).map(str::to_owned);
+    // The chapters' commands name their files from the repository's root, as a student runs them.
+    std::env::set_current_dir(&repository).with_context(|| format!("{}: the repository", repository.display()))?;
+    let options = mirador::course::book::Options { repository: repository.clone(), source, link_of: &page_link };
+    let rewritten = mirador::course::book::preprocess(&input, &options)?;
+    let book_src = root.join(context[0]["config"]["book"]["src"].as_str().unwrap_or("src"));
+    rewritten.write_copies(&repository, &book_src)?;
+    println!("{}", rewritten.book);
+    Ok(())
 }
 
 /// `mirador copy SCENE DIR`.

@@ -4,7 +4,7 @@
 //! - the crate's layers, each importing only from those below it:
 //!   `settings | files | base` ← `output | compare | settings_doc | volume`
 //!   ← `scene | linear_output` ← `texture` ← `shaders` ← `trace | gpu` ← `raster` ← `budget | explain | lab`
-//!   ← `viewer`
+//!   ← `viewer | course`
 //!   ← `web` (← `main.rs`), where modules of one layer never import each other: `base` holds
 //!   what `scene` and `volume` share (the ray, the material and texture indices), so the scene
 //!   holds volumes and reads their files while `volume` knows nothing of the scene;
@@ -41,6 +41,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("explain", 7),
     ("lab", 7),
     ("viewer", 8),
+    ("course", 8),
     ("web", 9),
 ];
 

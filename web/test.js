@@ -142,3 +142,24 @@ async function check(mirador, name, text) {
   for (const step of name === "lab-wrong" ? CHECK : CHECK.slice(0, 2)) mirador.step(step);
   await count();
 }
+
+// web/site-test.sh's check of one of the course's links (`…&test=link&capture=NAME`): the
+// page has queued the address's steps (web/index.html); once they have run and the view is drawn
+// (the traced image too, where the view shows it), its screenshot is posted as NAME.png, then
+// `done`. tests/web_page.rs holds it against the native command the link was made from.
+export function runLink(mirador, params) {
+  const name = params.get("capture");
+  window.miradorScreenshot = async (shot, png, view) => {
+    await post(`/capture/${shot}`, png, view);
+    await post("/capture/done", "done");
+  };
+  // The first problem is the cause (a device the browser took away); what fails after it, its effect.
+  let failed = false;
+  window.miradorError = (text) => {
+    if (!failed) post("/capture/failed", text);
+    failed = true;
+  };
+  const traced = ["traced", "split", "difference"].includes(params.get("view"));
+  const steps = ["overlay off", "panel off", "wait 2s", ...(traced ? ["wait traced", "wait 1s"] : []), `screenshot ${name}.png`];
+  for (const step of steps) mirador.step(step);
+}

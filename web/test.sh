@@ -11,18 +11,12 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-missing=()
-command -v chromium >/dev/null || missing+=(chromium)
-command -v xvfb-run >/dev/null || missing+=(xvfb)
-command -v python3 >/dev/null || missing+=(python3)
-if [ ${#missing[@]} -gt 0 ]; then
-    apt-get update && apt-get install -y "${missing[@]}"
-fi
+. web/browser.sh
+install_browser
 bash web/build.sh
 
 work=$(mktemp -d)
 port=${MIRADOR_WEB_PORT:-8765}
-. web/browser.sh
 serve_page web/dist "$work" "$port"
 browser=
 trap 'kill $server $browser 2>/dev/null || true; rm -rf "$work/profile" "$work/site"' EXIT

@@ -77,7 +77,8 @@ pub struct FrameEnd {
 /// what is drawn otherwise, and what cannot run, with why.
 const WEBGL2_NOTICE: &str = "drawn with WebGL2 (no WebGPU here): every technique runs; the dynamic environment \
      cubes are six 2D layers each, so their lookups do not filter across a face's edge; clicking a pixel \
-     to inspect it needs storage buffers, which WebGL2 lacks (WebGPU or Vulkan have them)";
+     to inspect it needs storage buffers, which WebGL2 lacks (WebGPU or Vulkan have them); the shadow map's own \
+     view (shadows.view = \"map\") is black, as WebGL2 cannot read a depth texture's texels";
 
 impl Viewer {
     pub fn new(

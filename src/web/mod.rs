@@ -106,6 +106,15 @@ impl App {
             ),
             other => other.into(),
         })?;
+        // A device the browser takes away (its GPU process stopped: most often a frame longer
+        // than the browser's GPU watchdog allows, on a GPU in software) draws nothing more: the
+        // page says so, rather than a readback's failure later. WebGL2's lost context is heard
+        // by the page (web/index.html).
+        gpu.device.set_device_lost_callback(|reason, message| {
+            if reason != wgpu::DeviceLostReason::Destroyed {
+                page::device_lost(&message);
+            }
+        });
         let mut screen = Screen::new(window, gpu, surface, true)?;
         screen.screenshot_sink = Some(Box::new(page::screenshot_taken));
         let scene = self.scene.take().ok_or_else(|| anyhow::anyhow!("the viewer starts once"))?;

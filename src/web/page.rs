@@ -164,6 +164,18 @@ fn call_page(name: &str, arguments: &[JsValue]) {
     }
 }
 
+/// Says that the browser took the GPU device away (WebGPU's device lost, src/web/mod.rs; WebGL2's
+/// context lost, which the page hears from the canvas): nothing more is drawn, and the page says
+/// why it most likely happened and what to ask for instead.
+#[wasm_bindgen]
+pub fn device_lost(why: &str) {
+    show_error(&format!(
+        "The browser stopped Mirador's GPU device ({why}). A frame most likely took longer than the browser \
+         allows, as it can on a GPU in software (SwiftShader) with a fine volume.step, many rays or a large \
+         window: reload the page, and ask for less (a coarser setting, raster.render_scale below 1)."
+    ));
+}
+
 /// Shows an error on the page (`window.miradorError(message)`) and in the console.
 pub(super) fn show_error(message: &str) {
     log::error!("{message}");

@@ -292,3 +292,23 @@ pub fn sources(dir: &Path, extension: &str) -> Vec<PathBuf> {
     }
     files
 }
+
+/// An address's `%XX` escapes read back (the course site's links, tests/site.rs and
+/// tests/web_page.rs).
+pub fn percent_decoded(text: &str) -> String {
+    let bytes = text.as_bytes();
+    let (mut out, mut i) = (Vec::new(), 0);
+    while i < bytes.len() {
+        match bytes[i] {
+            b'%' if i + 3 <= bytes.len() => {
+                out.push(u8::from_str_radix(&text[i + 1..i + 3], 16).expect("two hexadecimal digits after %"));
+                i += 3;
+            }
+            byte => {
+                out.push(byte);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8(out).expect("UTF-8")
+}
