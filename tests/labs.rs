@@ -673,6 +673,10 @@ const EQUIVALENT_MUTANTS: &[(&str, &str)] = &[
     ("parallax", "if !(abs(det) >= 1e-12) {"),
     // α = 0 exactly gives u = 1, the same column as u = 0 (the map repeats).
     ("environment-maps", "if alpha <= 0.0 {"),
+    // m is never negative, and m = 1e-12 exactly is never met.
+    ("environment-maps", "if m <= 1e-12 {"),
+    // The rim's bottom instead of its top: at −Z every point of the rim is right.
+    ("environment-maps", "return vec2f(0.5, 1.0);"),
     // n is normalized: n.y stays in [−1, 1].
     ("environment-maps", "return vec2f(alpha / (2.0 * PI), acos(clamp(n.y, -2.0, 1.0)) / PI);"),
     ("environment-maps", "return vec2f(alpha / (2.0 * PI), acos(clamp(n.y, -1.0, 2.0)) / PI);"),
