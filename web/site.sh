@@ -42,6 +42,7 @@ cache=${XDG_CACHE_HOME:-$HOME/.cache}/mirador
 katex=$cache/katex-$KATEX_VERSION.tgz
 if ! echo "$KATEX_SHA256  $katex" | sha256sum --check --status 2>/dev/null; then
     mkdir -p "$cache"
+    command -v curl >/dev/null || { apt-get update && apt-get install -y curl; }
     curl -fsSL -o "$katex.partial" "https://registry.npmjs.org/katex/-/katex-$KATEX_VERSION.tgz"
     echo "$KATEX_SHA256  $katex.partial" | sha256sum --check --quiet
     mv "$katex.partial" "$katex"
