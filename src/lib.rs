@@ -12,7 +12,8 @@
 //! - [`budget`]: what each of the rasterizer's approximations costs, each swapped for its traced
 //!   counterpart (the hybrid).
 //! - [`compare`]: image metrics for golden images and raster-vs-trace comparisons.
-//! - [`course`]: the course as a site: the page's address for each command a chapter prints.
+//! - [`course`] (native only): the course as a site: the page's address for each command a chapter
+//!   prints.
 //! - [`viewer`]: the interactive window (winit + egui) over both renderers.
 //! - [`volume`]: scalar fields on voxel grids, classified and ray-cast by both renderers.
 //! - [`files`]: where the files a scene names are read from (the disk, or the page's files).
@@ -26,6 +27,7 @@ pub mod base;
 #[cfg(not(target_arch = "wasm32"))]
 pub mod budget;
 pub mod compare;
+#[cfg(not(target_arch = "wasm32"))]
 pub mod course;
 pub mod explain;
 pub mod files;

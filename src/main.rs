@@ -436,7 +436,10 @@ fn page_link(words: &[String]) -> anyhow::Result<Linked> {
         let message: Vec<&str> = text.lines().take_while(|l| !l.is_empty()).map(str::trim).collect();
         anyhow::anyhow!("{}", message.join(" ").trim_start_matches("error: "))
     })?;
-    let (args, trace, view) = match cli.command {
+    let inspect = || Some("inspect the pixel (I, then a click on it)".to_owned());
+    // The scene's arguments, the trace options, the view, whether to measure the budget, and
+    // what to do in the page after.
+    let (args, trace, view, budget, then) = match cli.command {
         None => return Ok(Linked::Page(PageLink::default())),
         Some(Command::View(args)) if args.lab.is_some() => {
             return Ok(Linked::CommandLine(
@@ -445,14 +448,13 @@ fn page_link(words: &[String]) -> anyhow::Result<Linked> {
         }
         Some(Command::View(args)) => {
             let scene = SceneArgs { scene: args.scene, width: None, height: None, set: args.set, stats: false };
-            (scene, TraceArgs::default(), None)
+            (scene, TraceArgs::default(), None, false, None)
         }
-        Some(Command::Render { scene, .. }) => (scene, TraceArgs::default(), Some("raster")),
-        Some(Command::Trace { scene, trace, .. }) => (scene, trace, Some("traced")),
-        Some(Command::Compare { scene, trace, .. } | Command::Explain { scene, trace, .. }) => {
-            (scene, trace, Some("split"))
-        }
-        Some(Command::Budget { scene, trace, .. }) => (scene, trace, None),
+        Some(Command::Render { scene, .. }) => (scene, TraceArgs::default(), Some("raster"), false, None),
+        Some(Command::Trace { scene, trace, .. }) => (scene, trace, Some("traced"), false, None),
+        Some(Command::Compare { scene, trace, .. }) => (scene, trace, Some("split"), false, None),
+        Some(Command::Explain { scene, trace, .. }) => (scene, trace, Some("split"), false, inspect()),
+        Some(Command::Budget { scene, trace, .. }) => (scene, trace, None, true, None),
         Some(_) => return Ok(Linked::CommandLine("the page has no such command".into())),
     };
     let scene = match args.scene.as_deref().map(PageLink::builtin_scene) {
@@ -462,11 +464,6 @@ fn page_link(words: &[String]) -> anyhow::Result<Linked> {
     };
     let mut set = args.set.clone();
     set.extend(trace_settings(&args, &trace).context(words.join(" "))?);
-    let budget = matches!(words.first().map(String::as_str), Some("budget"));
-    let then = match words.first().map(String::as_str) {
-        Some("explain") => Some("inspect the pixel (I, then a click on it)".to_owned()),
-        _ => None,
-    };
     Ok(Linked::Page(PageLink { scene: Some(scene), set, view, budget, then }))
 }
 

@@ -18,6 +18,7 @@ use anyhow::{Context as _, bail};
 use serde_json::Value;
 
 use super::{Linked, PageLink, commands};
+use crate::lab::summary::escape;
 
 /// The teachers' answers: a page of the book only when web/site.sh is given `--answers`.
 const ANSWERS: &str = "docs/course/answers.md";
@@ -400,11 +401,6 @@ fn normalize(path: &Path) -> Option<PathBuf> {
         }
     }
     Some(out)
-}
-
-/// Text made safe inside HTML.
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
 #[cfg(test)]

@@ -275,7 +275,8 @@ pub fn markdown(summary: &Summary) -> String {
     out
 }
 
-fn escape(text: &str) -> String {
+/// Text made safe inside HTML (the course's site writes its links with it too).
+pub(crate) fn escape(text: &str) -> String {
     text.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
 }
 
