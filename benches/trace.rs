@@ -12,7 +12,12 @@
 //! count less; multi-threaded passes by the wall clock. Run with `cargo bench --bench trace` (about
 //! 30 s on two cores); `cargo bench --bench trace -- obvhs` runs Mirador and the named peers only,
 //! `-- none` Mirador alone, and `--repeats=9` takes the best of nine passes rather than three (runs
-//! of three vary by about 10 % on the project's machine).
+//! of three vary by about 10 % on the project's machine). `--half-angle=9` narrows the camera until
+//! every primary ray hits the sphere; `--dump=FOLDER` writes the mesh and the primary rays for
+//! `benches/embree.py`, which runs Embree 4 on the same work.
+//!
+//! The row `wide, packets` traces the same primary rays in packets of 16 (4 × 4 pixels,
+//! `mirador::trace::accel::wide::packets`), as the tracer does for centre-sampled images.
 //!
 //! The peers use their own idioms: obvhs its two-sided Möller–Trumbore `Triangle::intersect`
 //! with the triangles reordered into leaf order (as its examples recommend) and its
@@ -81,7 +86,7 @@ fn primary_rays() -> Vec<Query> {
     let forward = (Vec3::ZERO - eye).normalize();
     let right = forward.cross(Vec3::Y).normalize();
     let up = right.cross(forward);
-    let half = (22.0f32).to_radians().tan();
+    let half = half_angle().to_radians().tan();
     (0..WIDTH * HEIGHT)
         .map(|k| {
             let (x, y) = ((k % WIDTH) as f32 + 0.5, (k / WIDTH) as f32 + 0.5);
@@ -150,6 +155,42 @@ fn repeats() -> usize {
         }
         asked
     })
+}
+
+/// The camera's half field of view in degrees: `--half-angle=DEG`, else 22°, which sees the whole
+/// sphere (about half the rays miss it); 9° sees only the sphere (every ray hits).
+fn half_angle() -> f32 {
+    let asked = std::env::args().skip(1).find_map(|a| a.strip_prefix("--half-angle=").map(String::from));
+    match asked.map(|a| a.parse::<f32>()) {
+        None => 22.0,
+        Some(Ok(degrees)) if degrees > 0.0 && degrees < 90.0 => degrees,
+        Some(_) => {
+            eprintln!("trace bench: --half-angle=DEG: expected degrees between 0 and 90");
+            std::process::exit(2);
+        }
+    }
+}
+
+/// `--dump=FOLDER`: writes the mesh (`triangles.f32`, nine little-endian `f32` a triangle) and
+/// the primary rays (`primary.f32`, origin and direction, six a ray) for another library's run
+/// on the same work (`benches/embree.py`).
+fn dump(tris: &[[Vec3; 3]], primary: &[Query]) {
+    let Some(folder) = std::env::args().skip(1).find_map(|a| a.strip_prefix("--dump=").map(String::from)) else {
+        return;
+    };
+    let bytes = |values: &mut dyn Iterator<Item = f32>| values.flat_map(f32::to_le_bytes).collect::<Vec<u8>>();
+    let folder = std::path::Path::new(&folder);
+    let written = std::fs::create_dir_all(folder)
+        .and_then(|_| std::fs::write(folder.join("triangles.f32"), bytes(&mut tris.iter().flatten().flat_map(|v| v.to_array()))))
+        .and_then(|_| {
+            let rays = primary.iter().flat_map(|q| q.origin.to_array().into_iter().chain(q.direction.to_array()));
+            std::fs::write(folder.join("primary.f32"), bytes(&mut { rays }))
+        });
+    if let Err(e) = written {
+        eprintln!("trace bench: --dump={}: {e}", folder.display());
+        std::process::exit(2);
+    }
+    println!("wrote the mesh and the primary rays to {}", folder.display());
 }
 
 /// The best of [`repeats`] passes of `run`, which returns a count to check.
@@ -238,6 +279,44 @@ fn mirador_row<A: Accelerator>(
     }
 }
 
+/// The primary rays in blocks of 4 × 4 pixels, as the tracer hands them to packets.
+fn in_blocks(primary: &[Query]) -> Vec<Query> {
+    let mut blocks = Vec::with_capacity(primary.len());
+    for by in (0..HEIGHT).step_by(4) {
+        for bx in (0..WIDTH).step_by(4) {
+            for y in by..by + 4 {
+                blocks.extend((bx..bx + 4).map(|x| primary[(y * WIDTH + x) as usize]));
+            }
+        }
+    }
+    blocks
+}
+
+/// The wide BVH tracing the primary rays 16 at a time (`closest_packets`); shadow rays one by one,
+/// as the row above (measured again).
+fn packets_row(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Row {
+    let prims: Vec<Primitive> = tris.iter().copied().map(Primitive::flat_triangle).collect();
+    let (build_time, accel) = timed(true, || Wide::build(&prims));
+    let blocks = in_blocks(primary);
+    let rays: Vec<Ray> = blocks.iter().map(|q| Ray { origin: q.origin, direction: q.direction }).collect();
+    let trace = |rays: &[Ray]| {
+        let mut hits = vec![None; rays.len()];
+        accel.closest_packets(&prims, rays, 0.0, f32::INFINITY, &mut hits);
+        hits.iter().filter(|h| h.is_some()).count()
+    };
+    let _ = rays.par_chunks(256).take(80).map(trace).sum::<usize>();
+    let (single_time, hits) = best_of(true, || rays.chunks(256).map(trace).sum());
+    let (parallel_time, _) = best_of(false, || rays.par_chunks(256).map(trace).sum());
+    let rate = |t: Duration| rays.len() as f64 / t.as_secs_f64();
+    let shadow = throughput(shadow, |q| accel.occluded(&prims, &Ray { origin: q.origin, direction: q.direction }, q.t_min, q.t_max));
+    Row {
+        name: "wide, packets",
+        build: build_time,
+        primary: Throughput { single: rate(single_time), parallel: rate(parallel_time), hits },
+        shadow,
+    }
+}
+
 fn obvhs_rows(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Vec<Row> {
     use obvhs::ray::{Ray as ORay, RayHit};
     let triangles: Vec<obvhs::triangle::Triangle> =
@@ -309,6 +388,7 @@ fn main() {
     let total = Instant::now();
     let tris = displaced_sphere();
     let primary = primary_rays();
+    dump(&tris, &primary);
     // Shadow rays from Mirador's primary hits toward a point light.
     let shadow: Vec<Query> = {
         let prims: Vec<Primitive> = tris.iter().copied().map(Primitive::flat_triangle).collect();
@@ -345,6 +425,7 @@ fn main() {
     let wanted = |name: &str| filters.is_empty() || filters.iter().any(|f| name.contains(f.as_str()));
     let mut rows = vec![
         mirador_row("mirador wide", Wide::build, &tris, &primary, &shadow),
+        packets_row(&tris, &primary, &shadow),
         mirador_row("wide without AVX", Wide::build_without_avx, &tris, &primary, &shadow),
         mirador_row("mirador bvh", Bvh::build, &tris, &primary, &shadow),
     ];

@@ -141,8 +141,9 @@ enum Command {
         json: Option<PathBuf>,
     },
     /// Print the address of Mirador's page that shows what a command shows: its scene, its
-    /// settings and its view. `mirador link render assets/scenes/course/mirror-pair.toml --set
-    /// mirrors.depth=2` prints `?scene=course/mirror-pair.toml&set=mirrors.depth%3D2&view=raster`;
+    /// settings and its view. `mirador link render assets/scenes/course/mirror-pair.toml -o
+    /// pair.png --set mirrors.depth=2` prints
+    /// `?scene=course/mirror-pair.toml&set=mirrors.depth%3D2&view=raster`;
     /// the course's site (web/site.sh) puts one under every command of its chapters.
     Link {
         /// What to print before the query: the page's address (`https://…/mirador/`).

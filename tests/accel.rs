@@ -775,3 +775,65 @@ fn analytic_texture_coordinates_follow_the_rasterizer_tessellation() {
     let rounded = Shape::RoundedBox { half: Vec3::new(0.6, 0.4, 0.5), radius: 0.2 };
     assert_uv_matches_tessellation("rounded box", rounded, 1e-2, false, 0.0, false);
 }
+
+/// Rays from `eye` through a `side × side` grid of points on a square `size` wide around
+/// `target`, in blocks of 4 × 4 as the tracer hands a packet its pixels: coherent rays.
+fn fan(eye: Vec3, target: Vec3, size: f32, side: usize) -> Vec<Ray> {
+    let forward = (target - eye).normalize();
+    let right = forward.cross(Vec3::Y).try_normalize().unwrap_or(Vec3::X);
+    let up = right.cross(forward);
+    let mut rays = Vec::new();
+    for by in (0..side).step_by(4) {
+        for bx in (0..side).step_by(4) {
+            for y in by..(by + 4).min(side) {
+                for x in bx..(bx + 4).min(side) {
+                    let (s, t) = ((x as f32 + 0.5) / side as f32 - 0.5, (y as f32 + 0.5) / side as f32 - 0.5);
+                    rays.push(ray(eye, target + size * (s * right + t * up) - eye));
+                }
+            }
+        }
+    }
+    rays
+}
+
+/// Packets of coherent rays (`Accelerator::closest_packets`) against the same rays one by one:
+/// the same hits, ties at shared vertices and edges aside as between the two BVHs (equally near,
+/// both real); and on AVX and two halves of four alike. Incoherent rays, rays along the axes
+/// (walked alone inside a packet) and rays that miss are mixed in, and the last packet is short.
+#[test]
+fn packets_find_the_single_ray_walks_hits() {
+    let mut rng = Pcg::new(16);
+    let sphere = mesh_primitives(welded_sphere(96, 48), Mat4::IDENTITY);
+    let showcase = scene_primitives(&Scene::load(&mirador::scene::builtin_path("showcase.toml")).unwrap());
+    let mut awkward = triangle_soup(&mut rng, 300);
+    awkward.extend(scene_primitives(&analytic_scene()));
+    let mut packets_tested = 0;
+    for (name, prims) in [("sphere mesh", sphere), ("showcase", showcase), ("soup and analytic", awkward)] {
+        let focus = bounds_of(&prims);
+        let focus =
+            if focus.extent().max_element() > 50.0 { Aabb::new(Vec3::splat(-5.0), Vec3::splat(5.0)) } else { focus };
+        let centre = (focus.min + focus.max) / 2.0;
+        let reach = focus.extent().max_element();
+        let mut rays = fan(centre + Vec3::new(0.3, 0.4, 1.6) * reach, centre, reach, 37);
+        rays.extend(random_queries(&mut rng, &focus, 500).into_iter().map(|(r, _, _)| r));
+        rays.extend(axis_rays(&prims, &mut rng, 60).into_iter().map(|(r, _, _)| r));
+        rays.push(ray(centre + Vec3::splat(10.0 * reach), Vec3::ONE));
+        for t_max in [f32::INFINITY, 1.2 * reach] {
+            for (way, wide) in [("AVX where present", Wide::build(&prims)), ("two halves", Wide::build_without_avx(&prims))] {
+                let mut hits = vec![None; rays.len()];
+                wide.closest_packets(&prims, &rays, 0.0, t_max, &mut hits);
+                for (r, got) in rays.iter().zip(&hits) {
+                    let want = wide.closest(&prims, r, 0.0, t_max);
+                    let tie = |h: &Hit| prims[h.primitive as usize].intersect(r, 0.0, t_max).map(f32::to_bits) == Some(h.t.to_bits());
+                    let same_distance = matches!((got, want), (Some(g), Some(w)) if g.t == w.t);
+                    assert!(
+                        *got == want || same_distance && got.as_ref().is_some_and(tie) && want.as_ref().is_some_and(tie),
+                        "{name} ({way}, t_max {t_max}): {r:?} in a packet hits {got:?}, alone {want:?}"
+                    );
+                }
+                packets_tested += rays.len().div_ceil(16);
+            }
+        }
+    }
+    assert!(packets_tested > 300);
+}

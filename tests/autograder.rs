@@ -179,3 +179,36 @@ fn classrooms_workflow_has_one_step_per_test_worth_its_points() {
     assert!(dir.join(".mirador/hidden/README.md").is_file());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A hidden image test names its own scene by a path under the hidden folder: the grading
+/// folder gets every file of it, subfolders too, so the grader finds the scene (before, only the
+/// tests' `*.toml` files were copied, and such a test was skipped as the teacher's error).
+#[test]
+fn the_hidden_tests_scenes_go_with_them() {
+    let root = temporary("hidden-scenes");
+    let hidden = root.join("hidden");
+    std::fs::create_dir_all(hidden.join("scenes")).unwrap();
+    let scene = std::fs::read_to_string(mirador::scene::builtin_path("course/shadows-bias.toml")).unwrap();
+    std::fs::write(hidden.join("scenes/my-scene.toml"), &scene).unwrap();
+    std::fs::write(
+        hidden.join("more.toml"),
+        "[[image]]\nname = \"my scene\"\nscene = \"scenes/my-scene.toml\"\nsize = [64, 36]\nagainst = \"reference\"\nmean = 0.01\nregion = 0.05\npoints = 1\n",
+    )
+    .unwrap();
+    let source = root.join("source");
+    let output = mirador(&[
+        "lab",
+        "autograder",
+        "shadow-map",
+        &source.display().to_string(),
+        "--for",
+        "prairielearn",
+        "--tests",
+        &hidden.display().to_string(),
+    ]);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    assert!(source.join("lab/hidden/more.toml").is_file(), "the hidden test is copied");
+    let copied = std::fs::read_to_string(source.join("lab/hidden/scenes/my-scene.toml")).expect("its scene is copied");
+    assert_eq!(copied, scene);
+    let _ = std::fs::remove_dir_all(&root);
+}

@@ -75,10 +75,12 @@ pub fn write(lab: &Lab, options: &Options) -> Result<Vec<PathBuf>, String> {
     // scripts name it).
     file(lab_dir.join("hidden/README.md"), HIDDEN_README.as_bytes(), false)?;
     if let Some(hidden) = &options.hidden {
-        for path in super::run::hidden_files(hidden)? {
+        // Every file of the folder, not only its tests: a hidden image test names its own scene
+        // (and the scene its textures) by a path relative to the folder.
+        for path in files_under(hidden)? {
             let text = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-            let name = path.file_name().expect("a listed file has a name");
-            file(lab_dir.join("hidden").join(name), &text, false)?;
+            let relative = path.strip_prefix(hidden).expect("a file listed under the folder");
+            file(lab_dir.join("hidden").join(relative), &text, false)?;
         }
     }
     if options.service == Service::Classroom
@@ -109,6 +111,25 @@ pub fn write(lab: &Lab, options: &Options) -> Result<Vec<PathBuf>, String> {
         }
     }
     Ok(written)
+}
+
+/// Every file under `folder`, its subfolders' too, in order of their paths (links are followed).
+fn files_under(folder: &Path) -> Result<Vec<PathBuf>, String> {
+    let mut files = Vec::new();
+    let mut folders = vec![folder.to_path_buf()];
+    while let Some(next) = folders.pop() {
+        let entries = std::fs::read_dir(&next).map_err(|e| format!("{}: {e}", next.display()))?;
+        for entry in entries {
+            let path = entry.map_err(|e| format!("{}: {e}", next.display()))?.path();
+            if path.is_dir() {
+                folders.push(path);
+            } else {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    Ok(files)
 }
 
 const HIDDEN_README: &str = "# Hidden tests\n\nThe teacher's hidden tests: `*.toml` files in the lab's own format \

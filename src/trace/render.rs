@@ -11,6 +11,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::Tracer;
+use crate::base::Ray;
 use super::sampling::{jittered_offsets, regular_offsets, subdivide, uses_corner_grid};
 use super::whitted::RayCounts;
 use crate::settings::AntiAliasing;
@@ -113,12 +114,17 @@ impl Tracer<'_> {
                 }
                 let mut tile_counts = RayCounts::default();
                 let (x1, y1) = ((x0 + TILE).min(width), (y0 + TILE).min(height));
-                let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-                for j in y0..y1 {
-                    for i in x0..x1 {
-                        pixels.push(self.pixel(i, j, corners.as_ref(), &mut tile_counts));
+                let pixels = if self.settings.anti_aliasing == AntiAliasing::Center {
+                    self.centred_tile(x0..x1, y0..y1, &mut tile_counts)
+                } else {
+                    let mut pixels = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+                    for j in y0..y1 {
+                        for i in x0..x1 {
+                            pixels.push(self.pixel(i, j, corners.as_ref(), &mut tile_counts));
+                        }
                     }
-                }
+                    pixels
+                };
                 bar.inc(1);
                 Some((x0, y0, pixels, tile_counts))
             })
@@ -154,6 +160,33 @@ impl Tracer<'_> {
             }
         }
         (pixels, counts)
+    }
+
+    /// A tile's pixels, row by row, each sampled at its centre: the primary rays traced in
+    /// packets of 4 × 4 neighbours ([`crate::trace::accel::wide::packets`]), which find the same
+    /// hits as ray by ray, so the image is the one [`Self::pixel`] makes.
+    fn centred_tile(&self, columns: Range<u32>, rows: Range<u32>, counts: &mut RayCounts) -> Vec<Vec3> {
+        let (width, block) = (columns.len(), 4);
+        let mut order = Vec::with_capacity(width * rows.len());
+        for by in rows.clone().step_by(block) {
+            for bx in columns.clone().step_by(block) {
+                for j in by..(by + block as u32).min(rows.end) {
+                    order.extend((bx..(bx + block as u32).min(columns.end)).map(|i| (i, j)));
+                }
+            }
+        }
+        let camera = &self.scene.camera;
+        let rays: Vec<Ray> = order.iter().map(|&(i, j)| camera.ray_through(i as f32 + 0.5, j as f32 + 0.5)).collect();
+        let mut hits = vec![None; rays.len()];
+        let whitted = &self.whitted;
+        whitted.accelerator.closest_packets(&whitted.primitives, &rays, 0.0, f32::INFINITY, &mut hits);
+        counts.primary += rays.len() as u64;
+        let mut pixels = vec![Vec3::ZERO; order.len()];
+        for ((&(i, j), ray), hit) in order.iter().zip(&rays).zip(hits) {
+            let at = (j - rows.start) as usize * width + (i - columns.start) as usize;
+            pixels[at] = whitted.radiance_from_hit(ray, self.primary_cone, hit, counts);
+        }
+        pixels
     }
 
     /// One pixel's radiance under the configured anti-aliasing.

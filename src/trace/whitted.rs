@@ -58,7 +58,7 @@
 
 use glam::Vec3;
 
-use super::accel::Accelerator;
+use super::accel::{Accelerator, Hit};
 use super::explain::{Observer, RayKind, SurfaceState, Unobserved, VolumeState};
 use super::geometry::{Primitive, SurfaceHit};
 use super::texture::SceneTextures;
@@ -148,6 +148,19 @@ impl Whitted<'_> {
     /// is the ray's footprint, for texture filtering.
     pub fn radiance(&self, ray: &Ray, cone: RayCone, depth: u32, counts: &mut RayCounts) -> Vec3 {
         self.radiance_observed(ray, cone, (depth, RayKind::Primary), counts, &mut Unobserved)
+    }
+
+    /// [`Self::radiance`] of a primary ray whose nearest hit is `first`, found already (in a
+    /// packet of neighbouring pixels' rays, `super::render`). Where the scene has volumes the
+    /// hit is found again, among the volumes' isosurfaces.
+    pub fn radiance_from_hit(&self, ray: &Ray, cone: RayCone, first: Option<Hit>, counts: &mut RayCounts) -> Vec3 {
+        if !self.volumes.is_empty() {
+            return self.radiance(ray, cone, 0, counts);
+        }
+        match self.nearest_surface_from(ray, cone, first, |_, _| false) {
+            Some((surface, moved, cone)) => self.shade(&moved, cone, &surface, 0, counts, &mut Unobserved),
+            None => self.scene.environment_radiance(ray.direction),
+        }
     }
 
     /// [`Self::radiance`], reporting what it does to `observer` (`super::explain`): the ray of
@@ -274,9 +287,25 @@ impl Whitted<'_> {
         cone: RayCone,
         passed: impl Fn(&SurfaceHit, &Material) -> bool,
     ) -> Option<(SurfaceHit, Ray, RayCone)> {
+        let first = self.accelerator.closest(&self.primitives, ray, 0.0, f32::INFINITY);
+        self.nearest_surface_from(ray, cone, first, passed)
+    }
+
+    /// [`Self::nearest_surface_past`] for a ray whose nearest hit `first` is known (traced in a
+    /// packet, `super::render`).
+    fn nearest_surface_from(
+        &self,
+        ray: &Ray,
+        cone: RayCone,
+        first: Option<Hit>,
+        passed: impl Fn(&SurfaceHit, &Material) -> bool,
+    ) -> Option<(SurfaceHit, Ray, RayCone)> {
         let (mut ray, mut cone) = (*ray, cone);
-        for _ in 0..MAX_LAYERS {
-            let hit = self.accelerator.closest(&self.primitives, &ray, 0.0, f32::INFINITY)?;
+        for layer in 0..MAX_LAYERS {
+            let hit = match layer {
+                0 => first,
+                _ => self.accelerator.closest(&self.primitives, &ray, 0.0, f32::INFINITY),
+            }?;
             let surface = self.primitives[hit.primitive as usize].surface(&ray, hit.t);
             let material = &self.scene.materials[surface.material.0];
             let masked_out = match material.alpha_mode {

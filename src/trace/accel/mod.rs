@@ -93,6 +93,15 @@ pub trait Accelerator: Send + Sync {
     /// Whether anything is hit in `(t_min, t_max)`: stops at the first hit found (shadow rays).
     fn occluded(&self, prims: &[Primitive], ray: &Ray, t_min: f32, t_max: f32) -> bool;
     fn stats(&self) -> AccelStats;
+
+    /// The nearest hit of each of `rays` into `hits`: [`Self::closest`] for each. Coherent rays
+    /// (neighbouring pixels' primary rays, in blocks of 16) are traced together where the
+    /// accelerator can ([`wide::packets`]), with the same hits.
+    fn closest_packets(&self, prims: &[Primitive], rays: &[Ray], t_min: f32, t_max: f32, hits: &mut [Option<Hit>]) {
+        for (ray, hit) in rays.iter().zip(hits) {
+            *hit = self.closest(prims, ray, t_min, t_max);
+        }
+    }
 }
 
 pub use crate::settings::AccelKind;

@@ -51,6 +51,7 @@
 //! experiments).
 
 mod lanes;
+pub mod packets;
 
 use std::mem::MaybeUninit;
 
@@ -747,6 +748,10 @@ impl Accelerator for Wide {
 
     fn stats(&self) -> AccelStats {
         self.stats.clone()
+    }
+
+    fn closest_packets(&self, prims: &[Primitive], rays: &[Ray], t_min: f32, t_max: f32, hits: &mut [Option<Hit>]) {
+        self.closest_in_packets(prims, rays, t_min, t_max, hits);
     }
 }
 

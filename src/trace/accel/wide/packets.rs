@@ -1,0 +1,229 @@
+//! Coherent rays traced together: a packet of up to [`RAYS`] rays walks the wide BVH as one.
+//!
+//! Primary rays through neighbouring pixels, and shadow rays from them towards one light, visit
+//! nearly the same nodes in nearly the same order. Walked one by one, each ray pays alone for
+//! what they share: loading a node, choosing which children to enter, sorting and keeping them
+//! on a stack, and the branches a CPU mispredicts on the way. A packet walks once
+//! (Wald et al., "Interactive Rendering with Coherent Ray Tracing", 2001; Embree's packet
+//! kernels): at each node every ray still active is tested against the node's eight boxes, as
+//! one ray is ([`enter`]), and a child is entered by the rays that enter its box; the packet
+//! visits the children nearest first, by the nearest of those rays' entry distances, with one
+//! stack for all. In a leaf each of the child's rays tests the triangles as one ray does.
+//!
+//! **The same hits.** Every ray keeps its own far bound, and a ray leaves a pending child once
+//! its nearest hit is nearer than the packet's entry into that child, which is never farther
+//! than its own. So each ray tests at least every triangle the single-ray walk tests, each with
+//! the same arithmetic, and takes the nearest by the same rule ([`super::super::offer`]: the
+//! smaller distance, then the smaller index): the hits, and the image, are the single-ray walk's
+//! to the bit. A ray it could not walk the fast way (one that runs exactly along an axis, whose
+//! slab test needs [`enter`]'s careful variant) is walked alone.
+//!
+//! What a packet costs instead: a ray that left the others' path is carried along, masked, until
+//! the nodes it enters run out. Incoherent rays (reflections off curved surfaces, refraction)
+//! gain nothing, and are traced one by one.
+
+use super::*;
+
+/// Rays in one packet: a 4 × 4 block of pixels.
+pub const RAYS: usize = 16;
+
+/// One ray of the packet, prepared once.
+struct Member<'a> {
+    query: Query<'a>,
+    box_ray: BoxRay,
+    packet_ray: PacketRay,
+}
+
+/// The packet's stack of (child, the rays that enter it, their nearest entry distance).
+struct Pending<const N: usize> {
+    items: [MaybeUninit<(u32, u32, f32)>; N],
+    len: usize,
+}
+
+impl<const N: usize> Pending<N> {
+    #[inline(always)]
+    fn push(&mut self, item: (u32, u32, f32)) {
+        self.items[self.len].write(item);
+        self.len += 1;
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<(u32, u32, f32)> {
+        self.len = self.len.checked_sub(1)?;
+        // SAFETY: the entry was below `len`, so it is written.
+        Some(unsafe { self.items[self.len].assume_init() })
+    }
+}
+
+impl Wide {
+    /// The nearest hit of each of `rays` in `(t_min, t_max)`, into `hits` (as long as `rays`),
+    /// found [`RAYS`] at a time; the same hits as [`Accelerator::closest`] ray by ray.
+    pub(super) fn closest_in_packets(&self, prims: &[Primitive], rays: &[Ray], t_min: f32, t_max: f32, hits: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), hits.len(), "one hit for each ray");
+        for (rays, hits) in rays.chunks(RAYS).zip(hits.chunks_mut(RAYS)) {
+            self.packet(prims, rays, t_min, t_max, hits);
+        }
+    }
+
+    fn packet(&self, prims: &[Primitive], rays: &[Ray], t_min: f32, t_max: f32, hits: &mut [Option<Hit>]) {
+        let mut prepared: [Option<PreparedRay>; RAYS] = [None; RAYS];
+        for (i, ray) in rays.iter().enumerate() {
+            hits[i] = None;
+            prepared[i] = PreparedRay::new(ray);
+            // A ray along an axis needs the careful slab test: walked alone.
+            if prepared[i].is_some_and(|p| !p.inv_direction.is_finite()) {
+                hits[i] = self.closest(prims, ray, t_min, t_max);
+                prepared[i] = None;
+            }
+        }
+        if self.nodes.is_empty() {
+            return;
+        }
+        let members: [Option<Member>; RAYS] = std::array::from_fn(|i| {
+            let p = prepared[i].as_ref()?;
+            let query = Query { prims, ray: &rays[i], prepared: p, t_min, t_max };
+            Some(Member { query, box_ray: BoxRay::new(p), packet_ray: PacketRay::new(p) })
+        });
+        let active = (0..RAYS).filter(|&i| members[i].is_some()).fold(0u32, |m, i| m | 1 << i);
+        if active == 0 {
+            return;
+        }
+        let members = &members;
+        let small = self.stack_bound <= SMALL_STACK;
+        #[cfg(target_arch = "x86_64")]
+        if self.avx {
+            // SAFETY: `avx` is set only where the CPU reports AVX.
+            unsafe { self.packet_avx(members, active, small, hits) };
+            return;
+        }
+        // SAFETY: `Halves` uses what every target has (SSE2 on x86-64).
+        unsafe {
+            if small {
+                self.walk::<Halves, SMALL_STACK>(members, active, hits)
+            } else {
+                self.walk::<Halves, LARGE_STACK>(members, active, hits)
+            }
+        }
+    }
+
+    /// The packet's walk compiled with AVX enabled ([`Wide::run_avx`]'s reason).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx")]
+    fn packet_avx(&self, members: &[Option<Member>; RAYS], active: u32, small: bool, hits: &mut [Option<Hit>]) {
+        // SAFETY: this function runs only where the CPU has AVX (its caller checks).
+        unsafe {
+            if small {
+                self.walk::<Octet, SMALL_STACK>(members, active, hits)
+            } else {
+                self.walk::<Octet, LARGE_STACK>(members, active, hits)
+            }
+        }
+    }
+
+    /// The packet's nearest-first walk: the rays of `active` (those `members` holds), each with
+    /// its own far bound.
+    ///
+    /// # Safety
+    /// The CPU must have the instructions `L` uses.
+    #[inline(always)]
+    unsafe fn walk<L: Lanes, const STACK: usize>(&self, members: &[Option<Member>; RAYS], active: u32, hits: &mut [Option<Hit>]) {
+        let mut t_max = [f32::INFINITY; RAYS];
+        for (i, member) in members.iter().enumerate() {
+            if let Some(member) = member {
+                t_max[i] = member.query.t_max;
+            }
+        }
+        let mut stack = Pending::<STACK> { items: [const { MaybeUninit::uninit() }; STACK], len: 0 };
+        let (mut current, mut rays) = (0u32, active);
+        loop {
+            if current & LEAF == 0 {
+                // SAFETY: `current` is 0 or an inner child's entry of a node.
+                let node = unsafe { self.node(current) };
+                // SAFETY: the caller's promise about `L`.
+                let entered = unsafe { enter_all::<L>(node, members, rays, &t_max) };
+                if let Some((child, next)) = entered.nearest_pushing_others(node, &mut stack) {
+                    (current, rays) = (child, next);
+                    continue;
+                }
+            } else {
+                for i in bits(rays) {
+                    let Some(member) = &members[i] else { continue };
+                    // SAFETY: the caller's promise about `L`.
+                    let none = unsafe {
+                        self.leaf::<L, false>(current & !LEAF, &member.query, &member.packet_ray, &mut hits[i], &mut t_max[i])
+                    };
+                    debug_assert!(none.is_none(), "a nearest-hit walk returns from its leaves only at the end");
+                }
+            }
+            // Next: the nearest pending child, with the rays whose nearest hit is not nearer.
+            loop {
+                let Some((child, pending, entry)) = stack.pop() else { return };
+                let still = bits(pending).filter(|&i| entry < t_max[i]).fold(0, |m, i| m | 1 << i);
+                if still != 0 {
+                    (current, rays) = (child, still);
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// For each of a node's children, the rays that enter its box and the nearest of their entries.
+struct Entered {
+    rays: [u32; WIDTH],
+    entry: [f32; WIDTH],
+}
+
+/// Tests every ray of `rays` against the node's eight boxes.
+///
+/// # Safety
+/// The CPU must have the instructions `L` uses.
+#[inline(always)]
+unsafe fn enter_all<L: Lanes>(node: &Node, members: &[Option<Member>; RAYS], rays: u32, t_max: &[f32; RAYS]) -> Entered {
+    let mut entered = Entered { rays: [0; WIDTH], entry: [f32::INFINITY; WIDTH] };
+    for i in bits(rays) {
+        let Some(member) = &members[i] else { continue };
+        // SAFETY: the caller's promise about `L`.
+        let (mask, entries) = unsafe { enter::<L, false>(node, &member.box_ray, member.query.t_min, t_max[i]) };
+        for child in bits(mask) {
+            entered.rays[child] |= 1 << i;
+            entered.entry[child] = entered.entry[child].min(entries[child]);
+        }
+    }
+    entered
+}
+
+impl Entered {
+    /// Pushes every entered child but the nearest, farthest first, and returns the nearest with
+    /// its rays; `None` when no ray enters any.
+    #[inline(always)]
+    fn nearest_pushing_others<const N: usize>(&self, node: &Node, stack: &mut Pending<N>) -> Option<(u32, u32)> {
+        let mut order = [0usize; WIDTH];
+        let mut count = 0;
+        for child in (0..WIDTH).filter(|&c| self.rays[c] != 0) {
+            // Insertion, farthest first.
+            let mut j = count;
+            while j > 0 && self.entry[order[j - 1]] < self.entry[child] {
+                order[j] = order[j - 1];
+                j -= 1;
+            }
+            order[j] = child;
+            count += 1;
+        }
+        let (&nearest, others) = order[..count].split_last()?;
+        for &child in others {
+            stack.push((node.child[child], self.rays[child], self.entry[child]));
+        }
+        Some((node.child[nearest], self.rays[nearest]))
+    }
+}
+
+/// The set bits of `mask`, lowest first.
+#[inline(always)]
+fn bits(mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        let i = mask.trailing_zeros() as usize;
+        mask &= mask.wrapping_sub(1);
+        (i < 32).then_some(i)
+    })
+}
