@@ -44,6 +44,10 @@ struct Figure {
     /// The command, as a shell would run it (`mirador …`); images it writes go to a folder of the
     /// test's, and a later command names them as the document does.
     run: Option<String>,
+    /// Commands run first (each once per document), for images a later reading names: the
+    /// renders a `diff` compares.
+    #[serde(default)]
+    before: Vec<String>,
     /// What the figure is: `flip`, `out /REGEX/`, `pixel X,Y [IMAGE]`, `max [IMAGE]`,
     /// `count >LEVEL [IMAGE]`, or `calc EXPRESSION` (README.md lists them).
     read: String,
@@ -520,6 +524,9 @@ fn check(figure: &Figure, name: &str, flat: &Flat, markdown: &str, folder: &Path
         }
     };
     let expected = numbers(&written);
+    for command in &figure.before {
+        run(command, folder, ran)?;
+    }
     let result = match &figure.run {
         Some(command) => run(command, folder, ran).map(Some)?,
         None => None,
