@@ -276,6 +276,41 @@ fn compare_writes_a_sheet_and_prints_the_metrics() {
     assert_eq!(image::open(&traced).unwrap().into_rgba8().dimensions(), (230, 230));
 }
 
+/// `diff` prints the mean beyond rounding beside the plain mean: an image one level off
+/// everywhere differs by rounding alone (plain mean above 0, beyond rounding 0), three levels off
+/// it differs beyond rounding too; a mask gives both under the mask.
+#[test]
+fn diff_tells_rounding_from_a_difference() {
+    let dir = scratch("rounding");
+    let base = image::RgbaImage::from_fn(64, 48, |x, y| image::Rgba([(x * 3) as u8 + 40, (y * 4) as u8 + 30, 90, 255]));
+    let shifted = |levels: u8| image::RgbaImage::from_fn(64, 48, |x, y| {
+        let p = base.get_pixel(x, y).0;
+        image::Rgba([p[0] + levels, p[1], p[2], 255])
+    });
+    let save = |name: &str, image: &image::RgbaImage| {
+        let path = dir.join(name);
+        image.save(&path).unwrap();
+        path.display().to_string()
+    };
+    let (a, one, three) = (save("a.png", &base), save("one.png", &shifted(1)), save("three.png", &shifted(3)));
+    let means = |args: &[&str], under: &str| {
+        let output = mirador(args);
+        assert!(output.status.success(), "{}", stderr(&output));
+        let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
+        let read = |prefix: &str| -> f32 {
+            let line = stdout.lines().find_map(|l| l.strip_prefix(prefix)).unwrap_or_else(|| panic!("no {prefix} in {stdout}"));
+            line.split_whitespace().next().unwrap().parse().unwrap()
+        };
+        (read(&format!("FLIP mean{under}: ")), read(&format!("FLIP mean{under} beyond rounding: ")))
+    };
+    let (plain, beyond) = means(&["diff", &a, &one], "");
+    assert!(plain > 0.001 && beyond == 0.0, "one level off: plain {plain}, beyond rounding {beyond}");
+    let (plain, beyond) = means(&["diff", &a, &three], "");
+    assert!(beyond > 0.001 && beyond <= plain, "three levels off: plain {plain}, beyond rounding {beyond}");
+    let (plain, beyond) = means(&["diff", &a, &one, "--mask", &a], " under the mask");
+    assert!(plain > 0.001 && beyond == 0.0, "under the mask: plain {plain}, beyond rounding {beyond}");
+}
+
 /// `--set` reaches the scene file's own values (issue 35): the camera, a light, a material, an
 /// object, by index or name, each changing the image; a bad one fails naming the override and
 /// what the scene has, and writes nothing; a model file takes none.
