@@ -133,3 +133,38 @@ fn the_lights_past_the_fourth_traced_cast_their_shadows() {
     assert!(lights < 0.003, "the lights past the fourth traced vs the tracer: FLIP {lights}");
     assert!(shadows > 4.0 * lights, "without the row the two unshadowed lights show: {shadows} against {lights}");
 }
+
+/// A frame drawn like the last one (the same scene, camera, lights, settings and views) copies
+/// its traced terms rather than tracing them again: no ray, and the image a frame that traced them
+/// draws. A dimmer light, a moved camera or another setting traces them anew.
+#[test]
+fn a_frame_like_the_last_keeps_its_traced_terms() {
+    let gpu = common::gpu();
+    let mut scene = smaller(common::load("scenes/showcase.toml"), 160);
+    let settings = every_term_traced(&scene.settings);
+    let mut headless = mirador::raster::Headless::new(gpu, &scene);
+    let rays = |headless: &mirador::raster::Headless| headless.report.count("traced terms", "rays");
+    headless.render(gpu, &scene, &settings);
+    assert!(rays(&headless) > 0, "the first frame traces");
+    // The second frame may draw other views (a cube's faces are drawn once, then kept); by the
+    // third every view is one the last frame drew.
+    headless.render(gpu, &scene, &settings);
+    let kept = headless.render(gpu, &scene, &settings);
+    assert_eq!(rays(&headless), 0, "a frame like the last traces nothing");
+    assert!(headless.report.count("traced terms", "views kept") > 0);
+    // Traced again after another setting, then the first settings traced again: the same image.
+    let mut other = settings.clone();
+    other.exposure *= 0.5;
+    headless.render(gpu, &scene, &other);
+    assert!(rays(&headless) > 0, "another setting traces anew");
+    let traced = headless.render(gpu, &scene, &settings);
+    assert!(rays(&headless) > 0);
+    assert_eq!(kept, traced, "kept terms draw the image traced terms draw");
+    // The scene's own values: a light and the camera.
+    scene.lights[0].intensity *= 0.5;
+    headless.render(gpu, &scene, &settings);
+    assert!(rays(&headless) > 0, "a dimmer light traces anew");
+    scene.camera.eye += glam::Vec3::new(0.1, 0.0, 0.0);
+    headless.render(gpu, &scene, &settings);
+    assert!(rays(&headless) > 0, "a moved camera traces anew");
+}

@@ -37,11 +37,96 @@ pub fn wanted(settings: &RenderSettings) -> Option<Wanted> {
 
 /// Every view's traced terms, ready to be copied into its image: each view's buffer holds the
 /// layers traced, one after another, each the view's window.
+#[derive(Clone)]
 pub struct PreparedTraced {
     views: Vec<(ViewSlot, Upload)>,
 }
 
+/// The last frame's terms and what they were traced from, kept for the next frames: while the
+/// scene, its camera and lights and the settings are the same, a view drawn again from the same
+/// camera at the same size has the same terms, and the frame copies them again rather than
+/// tracing them again (as a raster frame keeps its shadow maps). A view that changed, or any
+/// change of the scene or the settings, is traced anew.
+#[derive(Default)]
+pub struct KeptTraced {
+    last: Option<(SceneInputs, Vec<(ViewInputs, Upload)>)>,
+    /// Counts the scenes loaded ([`Self::forget`]): a new scene is never the last one.
+    generation: u64,
+}
+
+/// What every view's traced terms depend on.
+#[derive(PartialEq)]
+struct SceneInputs {
+    generation: u64,
+    camera: Camera,
+    lights: Vec<crate::scene::Light>,
+    settings: RenderSettings,
+    wanted: Wanted,
+    stride: u32,
+    /// The shadowed lights whose slots the visibility layers follow.
+    slots: Vec<usize>,
+}
+
+/// What one view's terms depend on besides: its camera and the size it is drawn at.
+type ViewInputs = (FrameView, (u32, u32));
+
+impl KeptTraced {
+    /// Forgets the kept terms: the renderer loaded another scene.
+    pub fn forget(&mut self) {
+        self.last = None;
+        self.generation += 1;
+    }
+
+    /// The terms `wanted` for every view of `views`, each into a buffer of its image's layers:
+    /// the last frame's where nothing they depend on changed, else traced ([`trace`]); and kept.
+    /// `lights` are the frame's shadowed lights, whose slots the visibility layers follow.
+    pub fn prepare(
+        &mut self,
+        (device, scene, settings): (&wgpu::Device, &Scene, &RenderSettings),
+        frame: &mut FrameEncoder,
+        (wanted, stride): (Wanted, u32),
+        lights: &ShadowLayout,
+        views: &[ViewTargets<'_>],
+    ) -> PreparedTraced {
+        let slots: Vec<usize> =
+            lights.first_layer.iter().enumerate().filter(|(_, l)| l.is_some()).map(|(i, _)| i).collect();
+        let slots = slots[..slots.len().min(MAX_SHADOWED_LIGHTS)].to_vec();
+        let inputs = SceneInputs {
+            generation: self.generation,
+            camera: scene.camera.clone(),
+            lights: scene.lights.clone(),
+            settings: settings.clone(),
+            wanted,
+            stride,
+            slots,
+        };
+        let last = self.last.take().filter(|(kept, _)| *kept == inputs).map(|(_, views)| views).unwrap_or_default();
+        let (mut rays, mut kept) = (0, 0);
+        let mut now = Vec::new();
+        let tracer = std::cell::OnceCell::new();
+        for &(view, targets) in views {
+            let key = (view.clone(), targets.size);
+            let upload = match last.iter().find(|(k, _)| *k == key) {
+                Some((_, upload)) => {
+                    kept += 1;
+                    Some(upload.clone())
+                }
+                None => {
+                    let tracer = tracer.get_or_init(|| Tracer::new(scene, settings));
+                    trace(device, tracer, (view, targets), (wanted, stride), &inputs.slots, &mut rays)
+                }
+            };
+            now.extend(upload.map(|upload| (key, upload)));
+        }
+        frame.end("traced terms", &[("rays", Figure::Count(rays)), ("views kept", Figure::Count(kept))]);
+        let prepared = PreparedTraced { views: now.iter().map(|((view, _), upload)| (view.slot, upload.clone())).collect() };
+        self.last = Some((inputs, now));
+        prepared
+    }
+}
+
 /// One view's terms in a buffer: the window they cover and the image layer of each.
+#[derive(Clone)]
 struct Upload {
     buffer: wgpu::Buffer,
     window: [u32; 4],
@@ -51,38 +136,26 @@ struct Upload {
 /// Bytes of one pixel of one layer (`Rgba32Float`).
 const PIXEL_BYTES: u32 = 16;
 
-/// Traces the terms `wanted` for every view of `views`, each into a buffer of its image's
-/// layers. `lights` are the frame's shadowed lights, whose slots the visibility layers follow.
-pub fn prepare(
-    (device, scene, settings): (&wgpu::Device, &Scene, &RenderSettings),
-    frame: &mut FrameEncoder,
+/// Traces one view's terms into a buffer of its image's layers, adding its rays to `rays`; `None`
+/// for a view with an empty window (a mirror at the screen's edge may leave its camera one).
+fn trace(
+    device: &wgpu::Device,
+    tracer: &Tracer,
+    (view, targets): ViewTargets<'_>,
     (wanted, stride): (Wanted, u32),
-    lights: &ShadowLayout,
-    views: &[ViewTargets<'_>],
-) -> PreparedTraced {
-    let tracer = Tracer::new(scene, settings);
-    let slots: Vec<usize> =
-        lights.first_layer.iter().enumerate().filter(|(_, l)| l.is_some()).map(|(i, _)| i).collect();
-    let slots = &slots[..slots.len().min(MAX_SHADOWED_LIGHTS)];
-    let mut rays = 0;
-    let traced = views
-        .iter()
-        .filter_map(|&(view, targets)| {
-            let size = targets.size;
-            let window = view.scissor.unwrap_or([0, 0, size.0, size.1]);
-            // A mirror at the screen's edge may leave its camera an empty window.
-            if window[2] == 0 || window[3] == 0 {
-                return None;
-            }
-            let (ray, cone) = camera_rays(scene, view, size);
-            let view_rays = ViewRays { size, window, ray: &*ray, cone, skip: view.skip, lights: slots, stride };
-            let terms = tracer.terms(&view_rays, wanted);
-            rays += terms.rays.total();
-            Some((view.slot, upload(device, &terms)))
-        })
-        .collect();
-    frame.end("traced terms", &[("rays", Figure::Count(rays))]);
-    PreparedTraced { views: traced }
+    slots: &[usize],
+    rays: &mut u64,
+) -> Option<Upload> {
+    let size = targets.size;
+    let window = view.scissor.unwrap_or([0, 0, size.0, size.1]);
+    if window[2] == 0 || window[3] == 0 {
+        return None;
+    }
+    let (ray, cone) = camera_rays(tracer.scene, view, size);
+    let view_rays = ViewRays { size, window, ray: &*ray, cone, skip: view.skip, lights: slots, stride };
+    let terms = tracer.terms(&view_rays, wanted);
+    *rays += terms.rays.total();
+    Some(upload(device, &terms))
 }
 
 impl PreparedTraced {

@@ -34,7 +34,7 @@ use super::shadow::projected::ProjectedPass;
 use super::shadow::views::ShadowLayout;
 use super::shadow::{ShadowMaps, ShadowPass};
 use super::targets::{FrameTargets, ViewImage, drawn_size};
-use super::traced::{self, PreparedTraced};
+use super::traced::{self, KeptTraced, PreparedTraced};
 use super::transparency::{PreparedTransparency, TransparencyPass};
 use super::view::{ViewKind, ViewTargets};
 use super::view_group::{FrameInputs, ViewGroups};
@@ -103,6 +103,8 @@ pub struct Renderer {
     /// side, the block given its terms: the viewer's coarse frames, refined while the camera
     /// rests (1, the default: every pixel).
     pub traced_stride: u32,
+    /// The last frame's traced terms, kept while nothing they depend on changes.
+    traced: KeptTraced,
 }
 
 /// The phases every view draws, prepared for one frame.
@@ -174,6 +176,7 @@ impl Renderer {
             facts: FrameFacts::default(),
             profile: false,
             traced_stride: 1,
+            traced: KeptTraced::default(),
         }
     }
 
@@ -220,6 +223,7 @@ impl Renderer {
     pub fn load(&mut self, gpu: &Gpu, scene: &Scene) {
         let passes = (&mut self.mirrors, &mut self.environment, &mut self.volumes);
         self.scene_gpu = load(gpu, scene, (&self.layouts, &self.mipmaps), passes);
+        self.traced.forget();
     }
 
     /// The scene as uploaded.
@@ -283,7 +287,7 @@ impl Renderer {
             .collect();
         let traced = wanted.map(|terms| {
             let inputs = (&gpu.device, scene, settings);
-            traced::prepare(inputs, &mut frame, (terms, self.traced_stride), &plan.lights, &views)
+            self.traced.prepare(inputs, &mut frame, (terms, self.traced_stride), &plan.lights, &views)
         });
         let inspection = self.inspector.as_ref().map(|i| &i.buffer);
         let inputs = frame_inputs(&maps, environment, inspection);
