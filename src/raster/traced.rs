@@ -13,7 +13,8 @@
 //! camera sees only what lies beyond its mirror) and passing the object it looks out of. Each view
 //! is traced into a buffer before the frame is recorded, and copied into its image just before
 //! the view draws: the cube faces share one set of targets, so a copy made earlier would be
-//! overwritten by the next face's.
+//! overwritten by the next face's. A view drawn again as the last frame drew it, with nothing else
+//! changed, copies the buffer it was traced into then ([`KeptTraced`]).
 
 use glam::{Vec2, Vec3, Vec4};
 
