@@ -171,10 +171,16 @@ fn run<'a>(command: &str, folder: &Path, ran: &'a mut HashMap<String, Ran>) -> R
         let [printed] = printed.as_slice() else {
             return Err(format!("`{command}` is not one command"));
         };
-        let Some((program, words)) = printed.words.split_first().filter(|(p, _)| *p == "mirador") else {
+        // Variables set before the command, as a shell sets them: `WGPU_BACKEND=gl mirador …`.
+        let variable = |word: &String| word.split_once('=').is_some_and(|(name, _)| is_variable_name(name));
+        let set = printed.words.iter().take_while(|w| variable(w)).count();
+        let environment: Vec<(String, String)> = printed.words[..set]
+            .iter()
+            .filter_map(|w| w.split_once('=').map(|(n, v)| (n.to_string(), v.to_string())))
+            .collect();
+        let Some((_, words)) = printed.words[set..].split_first().filter(|(p, _)| *p == "mirador") else {
             return Err(format!("`{command}` is not a mirador command"));
         };
-        let _ = program;
         let mut image = None;
         let mut arguments: Vec<String> = words
             .iter()
@@ -197,6 +203,7 @@ fn run<'a>(command: &str, folder: &Path, ran: &'a mut HashMap<String, Ran>) -> R
             .args(&arguments)
             .current_dir(folder)
             .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+            .envs(environment)
             .output()
             .map_err(|e| format!("`{command}`: {e}"))?;
         let mut text = String::from_utf8_lossy(&out.stdout).into_owned();
@@ -207,6 +214,13 @@ fn run<'a>(command: &str, folder: &Path, ran: &'a mut HashMap<String, Ran>) -> R
         ran.insert(command.to_string(), Ran { printed: text, folder: folder.to_path_buf(), image, compared });
     }
     Ok(&ran[command])
+}
+
+/// Whether `name` is an environment variable's name as a shell reads one before a command.
+fn is_variable_name(name: &str) -> bool {
+    let mut chars = name.chars();
+    chars.next().is_some_and(|c| c.is_ascii_uppercase() || c == '_')
+        && chars.all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_')
 }
 
 /// The images whose FLIP a `compare` or `diff` prints, and its mask: for `compare` its traced
@@ -477,9 +491,8 @@ fn calculated(expression: &str) -> Result<Vec<f64>, String> {
 }
 
 /// The document's table: `tests/figures/NAME.toml` and any `NAME.PART.toml` beside it, or only
-/// the parts `MIRADOR_FIGURES_PART` names (`answers.5-8`), to check one part while writing it.
-fn table(name: &str, whole: bool) -> Table {
-    let only = std::env::var("MIRADOR_FIGURES_PART").ok().filter(|_| !whole);
+/// the parts whose file names start with `only` (`answers.4-6`).
+fn table(name: &str, only: Option<&str>) -> Table {
     let mut table = Table { figure: Vec::new(), given: Vec::new() };
     let mut paths: Vec<PathBuf> = std::fs::read_dir(repository().join("tests/figures"))
         .unwrap()
@@ -487,7 +500,7 @@ fn table(name: &str, whole: bool) -> Table {
         .filter(|path| {
             let stem = path.file_stem().unwrap().to_string_lossy().to_string();
             let ours = stem == name || stem.strip_prefix(name).is_some_and(|rest| rest.starts_with('.'));
-            ours && path.extension().is_some_and(|e| e == "toml") && only.as_ref().is_none_or(|only| stem.starts_with(only.as_str()))
+            ours && path.extension().is_some_and(|e| e == "toml") && only.is_none_or(|only| stem.starts_with(only))
         })
         .collect();
     paths.sort();
@@ -553,12 +566,20 @@ fn check(figure: &Figure, name: &str, flat: &Flat, markdown: &str, folder: &Path
     Ok(())
 }
 
-/// Checks every figure of document `name`, all of them, and says every disagreement at once.
-fn check_document(name: &str) {
+/// Checks every figure of document `name` in the parts of its table that `part` names (all where
+/// none; `MIRADOR_FIGURES_PART` narrows it further, to check one part while writing it), and says
+/// every disagreement at once.
+fn check_document(name: &str, part: Option<&str>) {
     let markdown = document(name);
     let flat = flatten(&markdown);
-    let table = table(name, false);
-    let folder = std::env::temp_dir().join(format!("mirador-figures-{}-{name}", std::process::id()));
+    let asked = std::env::var("MIRADOR_FIGURES_PART").ok();
+    if let (Some(asked), Some(part)) = (&asked, part)
+        && !asked.starts_with(part)
+    {
+        return;
+    }
+    let table = table(name, asked.as_deref().or(part));
+    let folder = std::env::temp_dir().join(format!("mirador-figures-{}-{}", std::process::id(), part.unwrap_or(name)));
     std::fs::create_dir_all(&folder).unwrap();
     let mut ran = HashMap::new();
     let mut errors: Vec<String> =
@@ -570,14 +591,19 @@ fn check_document(name: &str) {
 }
 
 macro_rules! documents {
-    ($($test:ident: $name:literal,)*) => {
+    ($($test:ident: $name:literal $(part $part:literal)?,)*) => {
         $(
             #[test]
             fn $test() {
-                check_document($name);
+                check_document($name, None $(.or(Some($part)))?);
             }
         )*
-        const DOCUMENTS: &[&str] = &[$($name),*];
+        /// Every document, once (the answers' parts are one document).
+        const DOCUMENTS: &[&str] = &[
+            "01-camera", "02-illumination", "03-mipmaps", "04-bump-mapping", "05-shadows", "06-transparency",
+            "07-planar-mirrors", "08-environment-maps", "09-ray-tracing", "10-anti-aliasing", "11-volumes",
+            "12-error-budget", "answers",
+        ];
     };
 }
 
@@ -594,7 +620,10 @@ documents! {
     chapter_10_anti_aliasing: "10-anti-aliasing",
     chapter_11_volumes: "11-volumes",
     chapter_12_error_budget: "12-error-budget",
-    the_answers: "answers",
+    the_answers_chapters_1_to_3: "answers" part "answers.1-3",
+    the_answers_chapters_4_to_6: "answers" part "answers.4-6",
+    the_answers_chapters_7_to_9: "answers" part "answers.7-9",
+    the_answers_chapters_10_to_12: "answers" part "answers.10-12",
 }
 
 /// The byte ranges of `markdown` a reader sees as prose: not fenced blocks, headings, HTML
@@ -676,7 +705,7 @@ fn every_figure_is_checked_or_said_why() {
     let mut failures = Vec::new();
     for name in DOCUMENTS {
         let markdown = document(name);
-        let table = table(name, true);
+        let table = table(name, None);
         let accounted = accounted(name, &markdown, &table);
         let open: Vec<String> = figures_seen(&markdown)
             .into_iter()
