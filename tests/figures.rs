@@ -383,8 +383,16 @@ fn reading(read: &str, ran: Option<&Ran>) -> Result<Vec<f64>, String> {
             let [colour, name @ ..] = &words[..] else { return Err(usage) };
             unlike(&image_of(ran, name.first().copied())?, colour).ok_or(usage)
         }
+        "file" => {
+            let usage = format!("`{read}`: write file PATH /REGEX/");
+            let (path, pattern) = rest.split_once(' ').ok_or(usage.clone())?;
+            let pattern = pattern.trim().strip_prefix('/').and_then(|r| r.strip_suffix('/')).ok_or(usage)?;
+            let folder = ran.map(|r| r.folder.as_path()).ok_or(format!("`{read}` needs a command"))?;
+            let text = std::fs::read_to_string(folder.join(path)).map_err(|e| format!("{path}: {e}"))?;
+            captured(&text, pattern)
+        }
         "calc" => calculated(rest),
-        _ => Err(format!("`{read}`: no such reading (flip, out, pixel, max, count, differ, run, nearest, box, calc)")),
+        _ => Err(format!("`{read}`: no such reading (flip, out, file, pixel, max, count, differ, run, nearest, box, calc)")),
     }
 }
 
