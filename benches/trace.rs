@@ -181,7 +181,9 @@ fn dump(tris: &[[Vec3; 3]], primary: &[Query]) {
     let bytes = |values: &mut dyn Iterator<Item = f32>| values.flat_map(f32::to_le_bytes).collect::<Vec<u8>>();
     let folder = std::path::Path::new(&folder);
     let written = std::fs::create_dir_all(folder)
-        .and_then(|_| std::fs::write(folder.join("triangles.f32"), bytes(&mut tris.iter().flatten().flat_map(|v| v.to_array()))))
+        .and_then(|_| {
+            std::fs::write(folder.join("triangles.f32"), bytes(&mut tris.iter().flatten().flat_map(|v| v.to_array())))
+        })
         .and_then(|_| {
             let rays = primary.iter().flat_map(|q| q.origin.to_array().into_iter().chain(q.direction.to_array()));
             std::fs::write(folder.join("primary.f32"), bytes(&mut { rays }))
@@ -308,7 +310,9 @@ fn packets_row(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Row {
     let (single_time, hits) = best_of(true, || rays.chunks(256).map(trace).sum());
     let (parallel_time, _) = best_of(false, || rays.par_chunks(256).map(trace).sum());
     let rate = |t: Duration| rays.len() as f64 / t.as_secs_f64();
-    let shadow = throughput(shadow, |q| accel.occluded(&prims, &Ray { origin: q.origin, direction: q.direction }, q.t_min, q.t_max));
+    let shadow = throughput(shadow, |q| {
+        accel.occluded(&prims, &Ray { origin: q.origin, direction: q.direction }, q.t_min, q.t_max)
+    });
     Row {
         name: "wide, packets",
         build: build_time,

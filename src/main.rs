@@ -701,7 +701,8 @@ fn report_figures(
         _ => {
             let [x, y] = figures.worst_region_at;
             let levels = mirador::budget::ROUNDING_LEVELS;
-            let beyond = format!("beyond rounding: {beyond_rounding:.5} (pixels within {levels} levels counted as equal)");
+            let beyond =
+                format!("beyond rounding: {beyond_rounding:.5} (pixels within {levels} levels counted as equal)");
             println!("FLIP mean: {:.5}", figures.mean);
             if figures.masked_mean.is_none() {
                 println!("FLIP mean {beyond}");

@@ -819,15 +819,20 @@ fn packets_find_the_single_ray_walks_hits() {
         rays.extend(axis_rays(&prims, &mut rng, 60).into_iter().map(|(r, _, _)| r));
         rays.push(ray(centre + Vec3::splat(10.0 * reach), Vec3::ONE));
         for t_max in [f32::INFINITY, 1.2 * reach] {
-            for (way, wide) in [("AVX where present", Wide::build(&prims)), ("two halves", Wide::build_without_avx(&prims))] {
+            for (way, wide) in
+                [("AVX where present", Wide::build(&prims)), ("two halves", Wide::build_without_avx(&prims))]
+            {
                 let mut hits = vec![None; rays.len()];
                 wide.closest_packets(&prims, &rays, 0.0, t_max, &mut hits);
                 for (r, got) in rays.iter().zip(&hits) {
                     let want = wide.closest(&prims, r, 0.0, t_max);
-                    let tie = |h: &Hit| prims[h.primitive as usize].intersect(r, 0.0, t_max).map(f32::to_bits) == Some(h.t.to_bits());
+                    let tie = |h: &Hit| {
+                        prims[h.primitive as usize].intersect(r, 0.0, t_max).map(f32::to_bits) == Some(h.t.to_bits())
+                    };
                     let same_distance = matches!((got, want), (Some(g), Some(w)) if g.t == w.t);
                     assert!(
-                        *got == want || same_distance && got.as_ref().is_some_and(tie) && want.as_ref().is_some_and(tie),
+                        *got == want
+                            || same_distance && got.as_ref().is_some_and(tie) && want.as_ref().is_some_and(tie),
                         "{name} ({way}, t_max {t_max}): {r:?} in a packet hits {got:?}, alone {want:?}"
                     );
                 }

@@ -283,10 +283,12 @@ fn compare_writes_a_sheet_and_prints_the_metrics() {
 fn diff_tells_rounding_from_a_difference() {
     let dir = scratch("rounding");
     let base = image::RgbaImage::from_fn(64, 48, |x, y| image::Rgba([(x * 3) as u8 + 40, (y * 4) as u8 + 30, 90, 255]));
-    let shifted = |levels: u8| image::RgbaImage::from_fn(64, 48, |x, y| {
-        let p = base.get_pixel(x, y).0;
-        image::Rgba([p[0] + levels, p[1], p[2], 255])
-    });
+    let shifted = |levels: u8| {
+        image::RgbaImage::from_fn(64, 48, |x, y| {
+            let p = base.get_pixel(x, y).0;
+            image::Rgba([p[0] + levels, p[1], p[2], 255])
+        })
+    };
     let save = |name: &str, image: &image::RgbaImage| {
         let path = dir.join(name);
         image.save(&path).unwrap();
@@ -298,7 +300,10 @@ fn diff_tells_rounding_from_a_difference() {
         assert!(output.status.success(), "{}", stderr(&output));
         let stdout = String::from_utf8_lossy(&output.stdout).into_owned();
         let read = |prefix: &str| -> f32 {
-            let line = stdout.lines().find_map(|l| l.strip_prefix(prefix)).unwrap_or_else(|| panic!("no {prefix} in {stdout}"));
+            let line = stdout
+                .lines()
+                .find_map(|l| l.strip_prefix(prefix))
+                .unwrap_or_else(|| panic!("no {prefix} in {stdout}"));
             line.split_whitespace().next().unwrap().parse().unwrap()
         };
         (read(&format!("FLIP mean{under}: ")), read(&format!("FLIP mean{under} beyond rounding: ")))

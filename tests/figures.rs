@@ -20,7 +20,6 @@ use std::process::Command;
 use regex::Regex;
 use serde::Deserialize;
 
-
 /// One document's table.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -158,9 +157,6 @@ struct Ran {
     printed: String,
     folder: PathBuf,
     image: Option<PathBuf>,
-    /// For `compare` and `diff`: the reference and the compared image, and the mask, whose FLIP
-    /// the command printed ([`rounding_share`]).
-    compared: Option<(PathBuf, PathBuf, Option<PathBuf>)>,
 }
 
 /// Runs `command` (a line beginning with `mirador`) in `folder`, with the repository's files
@@ -182,7 +178,7 @@ fn run<'a>(command: &str, folder: &Path, ran: &'a mut HashMap<String, Ran>) -> R
             return Err(format!("`{command}` is not a mirador command"));
         };
         let mut image = None;
-        let mut arguments: Vec<String> = words
+        let arguments: Vec<String> = words
             .iter()
             .enumerate()
             .map(|(i, word)| {
@@ -198,7 +194,6 @@ fn run<'a>(command: &str, folder: &Path, ran: &'a mut HashMap<String, Ran>) -> R
                 }
             })
             .collect();
-        let compared = compared_images(&mut arguments, folder, ran.len());
         let out = Command::new(env!("CARGO_BIN_EXE_mirador"))
             .args(&arguments)
             .current_dir(folder)
@@ -211,7 +206,7 @@ fn run<'a>(command: &str, folder: &Path, ran: &'a mut HashMap<String, Ran>) -> R
         if !out.status.success() {
             return Err(format!("`{command}` failed:\n{text}"));
         }
-        ran.insert(command.to_string(), Ran { printed: text, folder: folder.to_path_buf(), image, compared });
+        ran.insert(command.to_string(), Ran { printed: text, folder: folder.to_path_buf(), image });
     }
     Ok(&ran[command])
 }
@@ -221,36 +216,6 @@ fn is_variable_name(name: &str) -> bool {
     let mut chars = name.chars();
     chars.next().is_some_and(|c| c.is_ascii_uppercase() || c == '_')
         && chars.all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_')
-}
-
-/// The images whose FLIP a `compare` or `diff` prints, and its mask: for `compare` its traced
-/// and raster images, kept where the command names them (`--trace-out`, `--raster-out`), else
-/// in files of the test's added to its arguments; for `diff` its two images and `--mask`.
-fn compared_images(arguments: &mut Vec<String>, folder: &Path, k: usize) -> Option<(PathBuf, PathBuf, Option<PathBuf>)> {
-    let after = |flag: &str, arguments: &[String]| {
-        arguments.iter().position(|a| a == flag).and_then(|i| arguments.get(i + 1)).map(|p| folder.join(p))
-    };
-    match arguments.first().map(String::as_str) {
-        Some("compare") => {
-            for (flag, name) in [("--trace-out", "traced"), ("--raster-out", "raster")] {
-                if after(flag, arguments).is_none() {
-                    arguments.extend([flag.to_string(), format!(".figures-{k}-{name}.png")]);
-                }
-            }
-            Some((after("--trace-out", arguments)?, after("--raster-out", arguments)?, None))
-        }
-        Some("diff") => {
-            let images: Vec<PathBuf> = arguments[1..]
-                .iter()
-                .enumerate()
-                .filter(|(i, a)| !a.starts_with('-') && (*i == 0 || !arguments[*i].starts_with('-')))
-                .map(|(_, a)| folder.join(a))
-                .collect();
-            let [a, b, ..] = &images[..] else { return None };
-            Some((a.clone(), b.clone(), after("--mask", arguments)))
-        }
-        _ => None,
-    }
 }
 
 /// The command whose raster image tells whether this CPU's lavapipe rounds as the course's did:
@@ -271,10 +236,12 @@ fn rounds_as_the_course() -> bool {
         let mut ran = HashMap::new();
         run(&command, &folder, &mut ran).unwrap_or_else(|e| panic!("the probe: {e}"));
         let open = |path: &Path| image::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).to_rgba8();
-        let (ours, course) = (open(&folder.join("raster.png")), open(&repository().join("tests/figures/course-cpu.png")));
+        let (ours, course) =
+            (open(&folder.join("raster.png")), open(&repository().join("tests/figures/course-cpu.png")));
         let _ = std::fs::remove_dir_all(&folder);
         assert_eq!(ours.dimensions(), course.dimensions(), "tests/figures/course-cpu.png: not the probe's size");
-        let apart = ours.pixels().zip(course.pixels()).map(|(p, q)| (0..3).map(|c| p.0[c].abs_diff(q.0[c])).max().unwrap());
+        let apart =
+            ours.pixels().zip(course.pixels()).map(|(p, q)| (0..3).map(|c| p.0[c].abs_diff(q.0[c])).max().unwrap());
         let farthest = apart.max().unwrap_or(0);
         assert!(
             farthest <= 2,
@@ -282,31 +249,24 @@ fn rounds_as_the_course() -> bool {
              course is measured on with `mirador {PROBE} -o probe.png --raster-out tests/figures/course-cpu.png`"
         );
         if farthest > 0 {
-            eprintln!("this CPU rounds differently from the course's: FLIP figures are held to their rounding share too");
+            eprintln!(
+                "this CPU rounds differently from the course's: FLIP figures are held to their rounding share too"
+            );
         }
         farthest == 0
     });
     *SAME
 }
 
-/// How much of the FLIP a command printed comes from pixels within two levels of each other:
-/// the part another CPU, rounding its last bits differently, can move (`tests/README.md`, "Image
-/// comparisons"). A FLIP figure may differ from what this machine prints by that much more than
-/// its last digit: where the two images agree to rounding the figure is held loosely, where they
-/// differ by more it is held to its digit.
-fn rounding_share(compared: &(PathBuf, PathBuf, Option<PathBuf>)) -> Result<f64, String> {
-    let open = |path: &Path| image::open(path).map(|i| i.to_rgba8()).map_err(|e| format!("{}: {e}", path.display()));
-    let (reference, test) = (open(&compared.0)?, open(&compared.1)?);
-    let mask = match &compared.2 {
-        Some(path) => Some(open(path)?.pixels().map(|p| p.0[..3].iter().any(|&c| c > 0)).collect::<Vec<bool>>()),
-        None => None,
-    };
-    let mean = |levels: u8| -> Result<f64, String> {
-        let difference = mirador::compare::difference_beyond(&reference, &test, levels).map_err(|e| e.to_string())?;
-        let figures = mirador::compare::Figures::of(&difference.flip_errors, reference.width(), reference.height(), mask.as_deref());
-        Ok(figures.masked_mean.unwrap_or(figures.mean) as f64)
-    };
-    Ok((mean(0)? - mean(2)?).max(0.0))
+/// How much of the FLIP a `compare` or `diff` printed (`under the mask`, where it has one) comes
+/// from pixels within two levels of each other: its plain mean less its mean beyond rounding, both
+/// of which it prints. That part is what another CPU, rounding its last bits differently, can move
+/// (`tests/README.md`, "Image comparisons"): where the two images agree to rounding a figure is
+/// held loosely, where they differ by more it is held to its digit.
+fn rounding_share(printed: &str, under: &str) -> Result<f64, String> {
+    let plain = captured(printed, &format!("FLIP mean{under}: ([0-9.]+)"))?;
+    let beyond = captured(printed, &format!("FLIP mean{under} beyond rounding: ([0-9.]+)"))?;
+    Ok((plain[0] - beyond[0]).max(0.0))
 }
 
 /// The image a reading names, or the one its command wrote.
@@ -344,7 +304,8 @@ fn reading(read: &str, ran: Option<&Ran>) -> Result<Vec<f64>, String> {
         }
         "count" => {
             let (level, name) = rest.split_once(' ').map_or((rest, None), |(l, n)| (l, Some(n)));
-            let level: u8 = level.strip_prefix('>').and_then(|l| l.parse().ok()).ok_or(format!("`{read}`: write count >LEVEL"))?;
+            let level: u8 =
+                level.strip_prefix('>').and_then(|l| l.parse().ok()).ok_or(format!("`{read}`: write count >LEVEL"))?;
             let image = image_of(ran, name)?;
             Ok(vec![image.pixels().filter(|p| p.0[..3].iter().any(|&c| c > level)).count() as f64])
         }
@@ -352,9 +313,11 @@ fn reading(read: &str, ran: Option<&Ran>) -> Result<Vec<f64>, String> {
             let words: Vec<&str> = rest.split_whitespace().collect();
             let [levels, a, b] = words[..] else { return Err(format!("`{read}`: write differ LO..HI A B")) };
             let (lo, hi) = levels.split_once("..").ok_or(format!("`{read}`: write differ LO..HI A B"))?;
-            let (lo, hi): (u8, u8) = (lo.parse().map_err(|_| read.to_string())?, hi.parse().map_err(|_| read.to_string())?);
+            let (lo, hi): (u8, u8) =
+                (lo.parse().map_err(|_| read.to_string())?, hi.parse().map_err(|_| read.to_string())?);
             let (a, b) = (image_of(ran, Some(a))?, image_of(ran, Some(b))?);
-            let apart = |p: &image::Rgba<u8>, q: &image::Rgba<u8>| (0..3).map(|c| p.0[c].abs_diff(q.0[c])).max().unwrap();
+            let apart =
+                |p: &image::Rgba<u8>, q: &image::Rgba<u8>| (0..3).map(|c| p.0[c].abs_diff(q.0[c])).max().unwrap();
             Ok(vec![a.pixels().zip(b.pixels()).filter(|(p, q)| (lo..=hi).contains(&apart(p, q))).count() as f64])
         }
         "run" => {
@@ -392,7 +355,9 @@ fn reading(read: &str, ran: Option<&Ran>) -> Result<Vec<f64>, String> {
             captured(&text, pattern)
         }
         "calc" => calculated(rest),
-        _ => Err(format!("`{read}`: no such reading (flip, out, file, pixel, max, count, differ, run, nearest, box, calc)")),
+        _ => Err(format!(
+            "`{read}`: no such reading (flip, out, file, pixel, max, count, differ, run, nearest, box, calc)"
+        )),
     }
 }
 
@@ -527,7 +492,14 @@ fn document(name: &str) -> String {
 }
 
 /// Checks one figure; the error says where it is, what the program gives and how to see it.
-fn check(figure: &Figure, name: &str, flat: &Flat, markdown: &str, folder: &Path, ran: &mut HashMap<String, Ran>) -> Result<(), String> {
+fn check(
+    figure: &Figure,
+    name: &str,
+    flat: &Flat,
+    markdown: &str,
+    folder: &Path,
+    ran: &mut HashMap<String, Ran>,
+) -> Result<(), String> {
     let doc = format!("docs/course/{name}.md");
     let place = locate(flat, &figure.text, &doc)?;
     let quoted = &markdown[place.clone()];
@@ -553,9 +525,10 @@ fn check(figure: &Figure, name: &str, flat: &Flat, markdown: &str, folder: &Path
         None => None,
     };
     let measured = reading(&figure.read, result)?;
-    let reads_flip = figure.read == "flip" || figure.read.contains("under the mask");
-    let share = match result.and_then(|r| r.compared.as_ref()) {
-        Some(compared) if reads_flip && !rounds_as_the_course() => rounding_share(compared)?,
+    let under = if figure.read.contains("under the mask") { " under the mask" } else { "" };
+    let reads_flip = figure.read == "flip" || !under.is_empty();
+    let share = match result {
+        Some(ran) if reads_flip && !rounds_as_the_course() => rounding_share(&ran.printed, under)?,
         _ => 0.0,
     };
     let how = figure.run.as_deref().map_or(figure.read.clone(), |c| format!("`{c}` ({})", figure.read));
@@ -590,10 +563,15 @@ fn check_document(name: &str, part: Option<&str>) {
     let folder = std::env::temp_dir().join(format!("mirador-figures-{}-{}", std::process::id(), part.unwrap_or(name)));
     std::fs::create_dir_all(&folder).unwrap();
     let mut ran = HashMap::new();
-    let mut errors: Vec<String> =
-        table.figure.iter().filter_map(|figure| check(figure, name, &flat, &markdown, &folder, &mut ran).err()).collect();
+    let mut errors: Vec<String> = table
+        .figure
+        .iter()
+        .filter_map(|figure| check(figure, name, &flat, &markdown, &folder, &mut ran).err())
+        .collect();
     let _ = std::fs::remove_dir_all(&folder);
-    errors.extend(table.given.iter().filter_map(|given| locate(&flat, &given.text, &format!("docs/course/{name}.md")).err()));
+    errors.extend(
+        table.given.iter().filter_map(|given| locate(&flat, &given.text, &format!("docs/course/{name}.md")).err()),
+    );
     eprintln!("{name}: {} figures checked by {} commands", table.figure.len() - errors.len(), ran.len());
     assert!(errors.is_empty(), "{} of {} figures disagree:\n{}", errors.len(), table.figure.len(), errors.join("\n\n"));
 }

@@ -120,7 +120,8 @@ impl KeptTraced {
             now.extend(upload.map(|upload| (key, upload)));
         }
         frame.end("traced terms", &[("rays", Figure::Count(rays)), ("views kept", Figure::Count(kept))]);
-        let prepared = PreparedTraced { views: now.iter().map(|((view, _), upload)| (view.slot, upload.clone())).collect() };
+        let prepared =
+            PreparedTraced { views: now.iter().map(|((view, _), upload)| (view.slot, upload.clone())).collect() };
         self.last = Some((inputs, now));
         prepared
     }

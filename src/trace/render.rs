@@ -11,9 +11,9 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::Tracer;
-use crate::base::Ray;
 use super::sampling::{jittered_offsets, regular_offsets, subdivide, uses_corner_grid};
 use super::whitted::RayCounts;
+use crate::base::Ray;
 use crate::settings::AntiAliasing;
 
 /// Side of the square tiles the image is cut into: small enough to balance threads, large enough

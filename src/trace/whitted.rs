@@ -154,13 +154,7 @@ impl Whitted<'_> {
     /// packet of neighbouring pixels' rays, `super::render`). Where the scene has volumes the
     /// hit is found again, among the volumes' isosurfaces.
     pub fn radiance_from_hit(&self, ray: &Ray, cone: RayCone, first: Option<Hit>, counts: &mut RayCounts) -> Vec3 {
-        if !self.volumes.is_empty() {
-            return self.radiance(ray, cone, 0, counts);
-        }
-        match self.nearest_surface_from(ray, cone, first, |_, _| false) {
-            Some((surface, moved, cone)) => self.shade(&moved, cone, &surface, 0, counts, &mut Unobserved),
-            None => self.scene.environment_radiance(ray.direction),
-        }
+        self.radiance_after(ray, cone, || first, (0, RayKind::Primary), counts, &mut Unobserved)
     }
 
     /// [`Self::radiance`], reporting what it does to `observer` (`super::explain`): the ray of
@@ -169,6 +163,21 @@ impl Whitted<'_> {
         &self,
         ray: &Ray,
         cone: RayCone,
+        depth_kind: (u32, RayKind),
+        counts: &mut RayCounts,
+        observer: &mut O,
+    ) -> Vec3 {
+        let first = || self.accelerator.closest(&self.primitives, ray, 0.0, f32::INFINITY);
+        self.radiance_after(ray, cone, first, depth_kind, counts, observer)
+    }
+
+    /// [`Self::radiance_observed`] with the ray's nearest hit given by `first` (asked only where
+    /// the scene has no volumes, whose isosurfaces the hit must be found among).
+    fn radiance_after<O: Observer>(
+        &self,
+        ray: &Ray,
+        cone: RayCone,
+        first: impl FnOnce() -> Option<Hit>,
         (depth, kind): (u32, RayKind),
         counts: &mut RayCounts,
         observer: &mut O,
@@ -177,7 +186,7 @@ impl Whitted<'_> {
         let radiance = if !self.volumes.is_empty() {
             self.radiance_through_volumes(ray, cone, depth, counts, observer)
         } else {
-            match self.nearest_surface(ray, cone) {
+            match self.nearest_surface_from(ray, cone, first(), |_, _| false) {
                 Some((surface, moved, cone)) => {
                     observer.hit(&surface, (moved.origin - ray.origin).dot(ray.direction) + surface.t);
                     self.shade(&moved, cone, &surface, depth, counts, observer)

@@ -477,7 +477,7 @@ impl Wide {
         let box_ray = BoxRay::new(query.prepared);
         let packet_ray = PacketRay::new(query.prepared);
         let mut best = None;
-        let mut stack = Stack::<STACK>::new();
+        let mut stack = Stack::<(u32, f32), STACK>::new();
         let mut current = 0u32;
         loop {
             if current & LEAF == 0 {
@@ -600,15 +600,16 @@ impl Wide {
     }
 }
 
-/// The traversal's stack of `(child, entry distance)`, left uninitialized: zeroing its
-/// [`SMALL_STACK`] entries for every ray cost 7 % of a primary ray's time.
-struct Stack<const N: usize> {
-    items: [MaybeUninit<(u32, f32)>; N],
+/// The traversal's stack of `(child, entry distance)` (a packet's: of `(child, its rays, their
+/// nearest entry)`), left uninitialized: zeroing its [`SMALL_STACK`] entries for every ray cost
+/// 7 % of a primary ray's time.
+struct Stack<T, const N: usize> {
+    items: [MaybeUninit<T>; N],
     /// `items[..len]` are written.
     len: usize,
 }
 
-impl<const N: usize> Stack<N> {
+impl<T: Copy, const N: usize> Stack<T, N> {
     #[inline(always)]
     fn new() -> Self {
         Stack { items: [const { MaybeUninit::uninit() }; N], len: 0 }
@@ -621,11 +622,20 @@ impl<const N: usize> Stack<N> {
 
     /// Panics past `N` entries, which [`stack_bound`] rules out.
     #[inline(always)]
-    fn push(&mut self, item: (u32, f32)) {
+    fn push(&mut self, item: T) {
         self.items[self.len].write(item);
         self.len += 1;
     }
 
+    #[inline(always)]
+    fn pop(&mut self) -> Option<T> {
+        self.len = self.len.checked_sub(1)?;
+        // SAFETY: the entry was below `len`, so it is written.
+        Some(unsafe { self.items[self.len].assume_init() })
+    }
+}
+
+impl<const N: usize> Stack<(u32, f32), N> {
     /// Pushes `item` into the run pushed since `base`, keeping the run farthest first (unless
     /// `ANY`, when order does not matter).
     #[inline(always)]
@@ -640,13 +650,6 @@ impl<const N: usize> Stack<N> {
             }
             self.items[j].write(item);
         }
-    }
-
-    #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, f32)> {
-        self.len = self.len.checked_sub(1)?;
-        // SAFETY: the entry was below `len`, so it is written.
-        Some(unsafe { self.items[self.len].assume_init() })
     }
 }
 

@@ -34,31 +34,17 @@ struct Member<'a> {
     packet_ray: PacketRay,
 }
 
-/// The packet's stack of (child, the rays that enter it, their nearest entry distance).
-struct Pending<const N: usize> {
-    items: [MaybeUninit<(u32, u32, f32)>; N],
-    len: usize,
-}
-
-impl<const N: usize> Pending<N> {
-    #[inline(always)]
-    fn push(&mut self, item: (u32, u32, f32)) {
-        self.items[self.len].write(item);
-        self.len += 1;
-    }
-
-    #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, u32, f32)> {
-        self.len = self.len.checked_sub(1)?;
-        // SAFETY: the entry was below `len`, so it is written.
-        Some(unsafe { self.items[self.len].assume_init() })
-    }
-}
-
 impl Wide {
     /// The nearest hit of each of `rays` in `(t_min, t_max)`, into `hits` (as long as `rays`),
     /// found [`RAYS`] at a time; the same hits as [`Accelerator::closest`] ray by ray.
-    pub(super) fn closest_in_packets(&self, prims: &[Primitive], rays: &[Ray], t_min: f32, t_max: f32, hits: &mut [Option<Hit>]) {
+    pub(super) fn closest_in_packets(
+        &self,
+        prims: &[Primitive],
+        rays: &[Ray],
+        t_min: f32,
+        t_max: f32,
+        hits: &mut [Option<Hit>],
+    ) {
         assert_eq!(rays.len(), hits.len(), "one hit for each ray");
         for (rays, hits) in rays.chunks(RAYS).zip(hits.chunks_mut(RAYS)) {
             self.packet(prims, rays, t_min, t_max, hits);
@@ -126,14 +112,19 @@ impl Wide {
     /// # Safety
     /// The CPU must have the instructions `L` uses.
     #[inline(always)]
-    unsafe fn walk<L: Lanes, const STACK: usize>(&self, members: &[Option<Member>; RAYS], active: u32, hits: &mut [Option<Hit>]) {
+    unsafe fn walk<L: Lanes, const STACK: usize>(
+        &self,
+        members: &[Option<Member>; RAYS],
+        active: u32,
+        hits: &mut [Option<Hit>],
+    ) {
         let mut t_max = [f32::INFINITY; RAYS];
         for (i, member) in members.iter().enumerate() {
             if let Some(member) = member {
                 t_max[i] = member.query.t_max;
             }
         }
-        let mut stack = Pending::<STACK> { items: [const { MaybeUninit::uninit() }; STACK], len: 0 };
+        let mut stack = Stack::<(u32, u32, f32), STACK>::new();
         let (mut current, mut rays) = (0u32, active);
         loop {
             if current & LEAF == 0 {
@@ -150,7 +141,13 @@ impl Wide {
                     let Some(member) = &members[i] else { continue };
                     // SAFETY: the caller's promise about `L`.
                     let none = unsafe {
-                        self.leaf::<L, false>(current & !LEAF, &member.query, &member.packet_ray, &mut hits[i], &mut t_max[i])
+                        self.leaf::<L, false>(
+                            current & !LEAF,
+                            &member.query,
+                            &member.packet_ray,
+                            &mut hits[i],
+                            &mut t_max[i],
+                        )
                     };
                     debug_assert!(none.is_none(), "a nearest-hit walk returns from its leaves only at the end");
                 }
@@ -179,7 +176,12 @@ struct Entered {
 /// # Safety
 /// The CPU must have the instructions `L` uses.
 #[inline(always)]
-unsafe fn enter_all<L: Lanes>(node: &Node, members: &[Option<Member>; RAYS], rays: u32, t_max: &[f32; RAYS]) -> Entered {
+unsafe fn enter_all<L: Lanes>(
+    node: &Node,
+    members: &[Option<Member>; RAYS],
+    rays: u32,
+    t_max: &[f32; RAYS],
+) -> Entered {
     let mut entered = Entered { rays: [0; WIDTH], entry: [f32::INFINITY; WIDTH] };
     for i in bits(rays) {
         let Some(member) = &members[i] else { continue };
@@ -197,7 +199,11 @@ impl Entered {
     /// Pushes every entered child but the nearest, farthest first, and returns the nearest with
     /// its rays; `None` when no ray enters any.
     #[inline(always)]
-    fn nearest_pushing_others<const N: usize>(&self, node: &Node, stack: &mut Pending<N>) -> Option<(u32, u32)> {
+    fn nearest_pushing_others<const N: usize>(
+        &self,
+        node: &Node,
+        stack: &mut Stack<(u32, u32, f32), N>,
+    ) -> Option<(u32, u32)> {
         let mut order = [0usize; WIDTH];
         let mut count = 0;
         for child in (0..WIDTH).filter(|&c| self.rays[c] != 0) {
