@@ -281,10 +281,10 @@ fn transparency_costs(gpu: &Gpu) {
         sphere.shape = Shape::Sphere { center: Vec3::new(-2.5 + i as f32, 0.35, 1.6), radius: 0.3 };
         scene.objects.push(sphere);
     }
-    let mut base = scene.settings.clone();
     // A fixed tessellation: the moving camera below must change the order, not the meshes.
+    scene.settings.sphere_segments = 32;
+    let mut base = scene.settings.clone();
     base.raster.adaptive_tessellation = false;
-    base.sphere_segments = 32;
     let mut opaque = base.clone();
     opaque.transparency.enabled = false;
     let mut bench = Bench::new(gpu, &scene);

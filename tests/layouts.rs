@@ -460,21 +460,21 @@ fn the_view_group_table_is_the_wgsl_binding_by_binding() {
     let scene = shaders::compose_surface(shaders::SCENE);
     // The check can fail: a view image renamed, retyped, or left out of the table.
     let renamed = scene
-        .replace("var projected_mask:", "var shadow_mask:")
-        .replace("textureLoad(projected_mask", "textureLoad(shadow_mask");
+        .replace("var drawn_images:", "var shadow_mask:")
+        .replace("textureLoad(drawn_images", "textureLoad(shadow_mask");
     let found = view_group_differences(&renamed);
     assert!(found.iter().any(|d| d.contains("WGSL names it shadow_mask")), "{found:?}");
-    let retyped = parse("@group(2) @binding(4) var projected_mask: texture_2d_array<f32>;");
+    let retyped = parse("@group(2) @binding(4) var drawn_images: texture_2d<f32>;");
     let (_, var) = retyped.global_variables.iter().next().unwrap();
-    let row = mirador::raster::view_group::VIEW_GROUP.iter().find(|row| row.binding == 4).unwrap();
-    assert!(binding_mismatch(&retyped, var, &row.ty).is_some(), "a 2D array where the table has a 2D image");
-    assert!(binding_mismatch(&retyped, var, &mirador::raster::view_group::VIEW_GROUP[3].ty).is_none());
+    let row = |binding: u32| mirador::raster::view_group::VIEW_GROUP.iter().find(|row| row.binding == binding).unwrap();
+    assert!(binding_mismatch(&retyped, var, &row(4).ty).is_some(), "a 2D image where the table has a 2D array");
+    assert!(binding_mismatch(&retyped, var, &row(9).ty).is_none(), "the sphere map's row is a 2D image");
     let extra = format!("{scene}\n@group(2) @binding(20) var stray: texture_2d<f32>;");
     assert!(view_group_differences(&extra).iter().any(|d| d.contains("stray")));
-    // Every view image has its row.
-    for image in mirador::raster::targets::ViewImage::ALL {
-        let resource = mirador::raster::view_group::Resource::View(image);
-        assert!(mirador::raster::view_group::VIEW_GROUP.iter().any(|row| row.resource == resource), "{image:?}");
+    // Every view array has its row, and so every view image its binding.
+    for array in mirador::raster::targets::ViewArray::ALL {
+        let resource = mirador::raster::view_group::Resource::View(array);
+        assert!(mirador::raster::view_group::VIEW_GROUP.iter().any(|row| row.resource == resource), "{array:?}");
     }
 }
 

@@ -111,7 +111,7 @@ fn visibility(light: Light, p: vec3f, facing: vec3f, pixel: vec2f) -> vec3f {
         return vec3f(1.0);
     }
     if SHADOW_METHOD == SHADOWS_PROJECTED {
-        let mask = textureLoad(projected_mask, vec2i(pixel), 0);
+        let mask = textureLoad(drawn_images, vec2i(pixel), PROJECTED_MASK_LAYER, 0);
         if INSPECT {
             probe.lights[probe_light].lit = 1.0 - mask[light.shadow_slot];
         }
@@ -495,12 +495,12 @@ fn with_mirror_term(lit: vec3f, in: VertexOut, n: vec3f, v: vec3f, here: bool) -
 
 // The object + 1 whose surface the view's traced terms were traced on at this pixel; 0: none.
 fn traced_object(pixel: vec2f) -> u32 {
-    return u32(textureLoad(traced, vec2i(pixel), TRACED_SURFACE_LAYER, 0).a);
+    return u32(textureLoad(copied_images, vec2i(pixel), TRACED_FIRST_LAYER + TRACED_SURFACE_LAYER, 0).a);
 }
 
 // One of the view's traced terms at this pixel.
 fn traced_term(pixel: vec2f, layer: i32) -> vec3f {
-    return textureLoad(traced, vec2i(pixel), layer, 0).rgb;
+    return textureLoad(copied_images, vec2i(pixel), TRACED_FIRST_LAYER + layer, 0).rgb;
 }
 
 // L(d), the radiance arriving at p from direction d, looked up in the environment map: for the

@@ -23,11 +23,14 @@
 @group(2) @binding(8) var env_cubes: CubeArray;
 @group(2) @binding(9) var env_sphere: texture_2d<f32>;
 @group(2) @binding(10) var env_latlong: texture_2d<f32>;
-// The view's own images (ViewImage in src/raster/targets.rs).
-// Object-precision shadows (src/raster/shadow/projected.rs): per shadowed light, a channel that
-// is 1 where the polygons cover this view's pixel.
-@group(2) @binding(4) var projected_mask: texture_2d<f32>;
-// The hybrid's traced terms (src/raster/traced.rs), at the first opaque surface of this view's
-// pixel: layer TRACED_SURFACE_LAYER its colour C and object + 1, then each traced term's layers
-// from TRACED_NAME_LAYER (the approximations table, src/settings/hybrid.rs).
-@group(2) @binding(13) var traced: texture_2d_array<f32>;
+// The view's own images (ViewImage in src/raster/targets.rs): layers of two arrays, so the next
+// image is layers of one of them, never a binding; each image's first layer is a constant.
+// Drawn and blended by the view's raster passes: from PROJECTED_MASK_LAYER, object-precision
+// shadows (src/raster/shadow/projected.rs), per shadowed light a channel that is 1 where the
+// polygons cover this view's pixel.
+@group(2) @binding(4) var drawn_images: texture_2d_array<f32>;
+// Copied in from the CPU: from TRACED_FIRST_LAYER, the hybrid's traced terms
+// (src/raster/traced.rs) at the first opaque surface of this view's pixel: layer
+// TRACED_SURFACE_LAYER its colour C and object + 1, then each traced term's layers from
+// TRACED_NAME_LAYER (the approximations table, src/settings/hybrid.rs).
+@group(2) @binding(13) var copied_images: texture_2d_array<f32>;

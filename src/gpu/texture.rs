@@ -34,16 +34,15 @@ impl GpuTexture {
         Self::image(device, label, size, format, usage)
     }
 
-    /// A 2D array of `layers` images that receives copies (`COPY_DST`) for shaders to read, viewed
-    /// as an array whatever its number of layers.
-    pub fn layered_copy_target(
+    /// A 2D array of `layers` images with `usage`, viewed as an array whatever its number of
+    /// layers (on GL, only where it has more than one: one layer is a plain 2D texture there).
+    pub fn layered_array(
         device: &wgpu::Device,
         label: &str,
-        size: (u32, u32),
-        layers: u32,
+        (size, layers): ((u32, u32), u32),
         format: wgpu::TextureFormat,
+        usage: wgpu::TextureUsages,
     ) -> GpuTexture {
-        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST;
         let texture = Self::layered(device, label, (size, layers), format, usage);
         let view = texture.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),

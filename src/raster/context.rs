@@ -148,21 +148,43 @@ pub struct FrameEncoder<'g> {
     profile: bool,
     mark: Instant,
     pub report: FrameReport,
+    /// The debug groups open now, outermost first ([`Self::group`]).
+    groups: Vec<String>,
 }
 
 impl<'g> FrameEncoder<'g> {
     pub fn new(gpu: &'g Gpu, profile: bool) -> FrameEncoder<'g> {
-        FrameEncoder { gpu, encoder: Self::encoder(gpu), profile, mark: Instant::now(), report: FrameReport::default() }
+        let (mark, report) = (Instant::now(), FrameReport::default());
+        FrameEncoder { gpu, encoder: Self::encoder(gpu), profile, mark, report, groups: Vec::new() }
     }
 
     fn encoder(gpu: &Gpu) -> wgpu::CommandEncoder {
         gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame::encoder") })
     }
 
+    /// Records what `record` records inside a debug group named `name`, so a frame capture
+    /// (RenderDoc, Xcode, PIX) shows the frame as its views and each view as its phases. A
+    /// profiled frame's [`Self::end`] submits the encoder mid-group: the groups open then are
+    /// closed on the encoder it submits and opened again on the next.
+    pub fn group<R>(&mut self, name: &str, record: impl FnOnce(&mut Self) -> R) -> R {
+        self.encoder.push_debug_group(name);
+        self.groups.push(name.to_owned());
+        let recorded = record(self);
+        self.groups.pop();
+        self.encoder.pop_debug_group();
+        recorded
+    }
+
     /// Ends what pass `name` recorded since the last call, with the figures it reports.
     pub fn end(&mut self, name: &'static str, figures: &[(&'static str, Figure)]) {
         let time = self.profile.then(|| {
-            let encoder = std::mem::replace(&mut self.encoder, Self::encoder(self.gpu));
+            let mut encoder = std::mem::replace(&mut self.encoder, Self::encoder(self.gpu));
+            for _ in &self.groups {
+                encoder.pop_debug_group();
+            }
+            for group in &self.groups {
+                self.encoder.push_debug_group(group);
+            }
             self.gpu.queue.submit([encoder.finish()]);
             self.gpu.wait();
             let time = self.mark.elapsed();

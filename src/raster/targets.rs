@@ -4,6 +4,7 @@
 //! phases of one view never read what another is writing.
 
 use crate::gpu::texture::GpuTexture;
+use crate::shaders::constants;
 
 /// Linear radiance, before the output transform.
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
@@ -31,7 +32,58 @@ impl FrameTargets {
     }
 }
 
-/// An image a view's phases make for its own shading, kept in the view's targets.
+/// The arrays a view's images are layers of, one view-group binding each. An image is its layers
+/// of one of them, so the next image a technique adds costs layers, never a binding: the view
+/// group's fullest entry point is at the downlevel limit of 16 sampled textures
+/// (docs/architecture.md). Two arrays, not one, because how an image is made fixes its format:
+/// a pass that draws and blends needs a blendable format, and a copy from the tracer needs full
+/// floats, which would cost a drawn mask four times its bytes and cannot be blended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ViewArray {
+    /// Drawn into and blended by the view's raster passes (`drawn_images` in the WGSL).
+    Drawn,
+    /// Copied into from the CPU (`copied_images`); made at the targets' size only when a frame
+    /// asks ([`ViewImages::ensure`]), one pixel until then, so views that never read it cost
+    /// nothing.
+    Copied,
+}
+
+impl ViewArray {
+    /// Every view array, in the order the targets keep them.
+    pub const ALL: [ViewArray; 2] = [ViewArray::Drawn, ViewArray::Copied];
+
+    pub fn format(self) -> wgpu::TextureFormat {
+        match self {
+            ViewArray::Drawn => wgpu::TextureFormat::Rgba8Unorm,
+            ViewArray::Copied => wgpu::TextureFormat::Rgba32Float,
+        }
+    }
+
+    pub fn label(self) -> &'static str {
+        match self {
+            ViewArray::Drawn => "view_group::drawn_images",
+            ViewArray::Copied => "view_group::copied_images",
+        }
+    }
+
+    /// Its layers: past the last of its images, and at least two, since GL makes a texture of
+    /// one layer a plain 2D texture, which no array view reads.
+    pub fn layers(self) -> u32 {
+        let images = ViewImage::ALL.into_iter().filter(|i| i.array() == self);
+        images.map(|i| i.first_layer() + i.layers()).max().unwrap_or(0).max(2)
+    }
+
+    fn on_demand(self) -> bool {
+        matches!(self, ViewArray::Copied)
+    }
+
+    fn index(self) -> usize {
+        self as usize
+    }
+}
+
+/// An image a view's phases make for its own shading: layers of one of the view's arrays, from
+/// its first layer, which `crate::shaders::constants` numbers once for the Rust and the WGSL.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ViewImage {
     /// Object-precision shadows: one channel per shadowed light, 1 where the light is hidden
@@ -40,8 +92,7 @@ pub enum ViewImage {
     /// The hybrid's traced terms at each pixel's first opaque surface (`super::traced`, copied in
     /// before the view draws): the surface layer holds `C` and the surface's object + 1, each
     /// traced term its own layers ([`crate::settings::Traced::layer`]): `L(r)`, what a
-    /// transparent surface lets through, each shadowed light's
-    /// `V_i`. Made at the targets' size only when a frame traces a term.
+    /// transparent surface lets through, each shadowed light's `V_i`.
     Traced,
 }
 
@@ -50,72 +101,94 @@ pub enum ViewImage {
 pub use crate::settings::hybrid::TRACED_LAYERS;
 
 impl ViewImage {
-    /// Every view image, in the order the targets keep them.
+    /// Every view image.
     pub const ALL: [ViewImage; 2] = [ViewImage::ProjectedMask, ViewImage::Traced];
 
-    pub fn format(self) -> wgpu::TextureFormat {
+    /// The array it is layers of.
+    pub fn array(self) -> ViewArray {
         match self {
-            ViewImage::ProjectedMask => wgpu::TextureFormat::Rgba8Unorm,
-            ViewImage::Traced => wgpu::TextureFormat::Rgba32Float,
+            ViewImage::ProjectedMask => ViewArray::Drawn,
+            ViewImage::Traced => ViewArray::Copied,
         }
     }
 
-    pub fn label(self) -> &'static str {
+    /// Its first layer of its array.
+    pub fn first_layer(self) -> u32 {
         match self {
-            ViewImage::ProjectedMask => "view_group::projected_mask",
-            ViewImage::Traced => "view_group::traced",
+            ViewImage::ProjectedMask => constants::PROJECTED_MASK_LAYER,
+            ViewImage::Traced => constants::TRACED_FIRST_LAYER,
         }
     }
 
-    /// Its layers: one, or a 2D array.
-    pub fn layers(self) -> Option<u32> {
+    /// How many layers it has.
+    pub fn layers(self) -> u32 {
         match self {
-            ViewImage::ProjectedMask => None,
-            ViewImage::Traced => Some(TRACED_LAYERS),
+            ViewImage::ProjectedMask => 1,
+            ViewImage::Traced => TRACED_LAYERS,
         }
-    }
-
-    /// Made at the targets' size only when a frame asks ([`ViewImages::ensure`]); one pixel
-    /// until then, so views that never read it cost nothing.
-    fn on_demand(self) -> bool {
-        matches!(self, ViewImage::Traced)
-    }
-
-    fn index(self) -> usize {
-        self as usize
     }
 }
 
-/// Every view image of one view's targets, at the targets' size.
+/// Every view array of one view's targets, at the targets' size.
 pub struct ViewImages {
-    images: Vec<GpuTexture>,
+    arrays: Vec<GpuTexture>,
+    /// A 2D view of each layer of [`ViewArray::Drawn`], which its passes draw into.
+    drawn_layers: Vec<wgpu::TextureView>,
 }
 
 impl ViewImages {
     pub fn new(device: &wgpu::Device, size: (u32, u32)) -> ViewImages {
-        let made = |i: &ViewImage| make(device, *i, if i.on_demand() { (1, 1) } else { size });
-        ViewImages { images: ViewImage::ALL.iter().map(made).collect() }
+        let made = |a: &ViewArray| make(device, *a, if a.on_demand() { (1, 1) } else { size });
+        let arrays: Vec<GpuTexture> = ViewArray::ALL.iter().map(made).collect();
+        let drawn = &arrays[ViewArray::Drawn.index()].texture;
+        let drawn_layers = (0..ViewArray::Drawn.layers())
+            .map(|layer| {
+                drawn.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some("view_group::drawn_layer"),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        ViewImages { arrays, drawn_layers }
     }
 
+    /// The array `array`, viewed whole.
+    pub fn array(&self, array: ViewArray) -> &GpuTexture {
+        &self.arrays[array.index()]
+    }
+
+    /// The array that holds `image`.
     pub fn get(&self, image: ViewImage) -> &GpuTexture {
-        &self.images[image.index()]
+        self.array(image.array())
     }
 
-    /// Makes `image` at `size` if it has another size (an image made on demand; once made, it
-    /// stays until the targets are remade).
+    /// The layer a pass draws `image` into (an image of [`ViewArray::Drawn`]).
+    pub fn drawn(&self, image: ViewImage) -> &wgpu::TextureView {
+        assert_eq!(image.array(), ViewArray::Drawn, "{image:?} is copied in, not drawn");
+        &self.drawn_layers[image.first_layer() as usize]
+    }
+
+    /// Makes the array of `image` at `size` if it has another size (an array made on demand;
+    /// once made, it stays until the targets are remade).
     pub fn ensure(&mut self, device: &wgpu::Device, image: ViewImage, size: (u32, u32)) {
-        let made = self.images[image.index()].texture.size();
+        let array = image.array();
+        assert!(array.on_demand(), "{array:?} is made at the targets' size");
+        let made = self.arrays[array.index()].texture.size();
         if (made.width, made.height) != size {
-            self.images[image.index()] = make(device, image, size);
+            self.arrays[array.index()] = make(device, array, size);
         }
     }
 }
 
-fn make(device: &wgpu::Device, image: ViewImage, size: (u32, u32)) -> GpuTexture {
-    match image.layers() {
-        None => GpuTexture::target(device, image.label(), size, image.format()),
-        Some(layers) => GpuTexture::layered_copy_target(device, image.label(), size, layers, image.format()),
-    }
+fn make(device: &wgpu::Device, array: ViewArray, size: (u32, u32)) -> GpuTexture {
+    let usage = match array {
+        ViewArray::Drawn => wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        ViewArray::Copied => wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::TEXTURE_BINDING,
+    };
+    GpuTexture::layered_array(device, array.label(), (size, array.layers()), array.format(), usage)
 }
 
 /// The size a frame is drawn at: the output's times the render scale, at least one pixel.
@@ -162,5 +235,30 @@ impl<T> PerTarget<T> {
     /// Drops what is kept for targets no view of `drawn` draws into.
     pub fn keep_drawn<'t>(&mut self, drawn: impl IntoIterator<Item = &'t FrameTargets> + Clone) {
         self.entries.retain(|(depth, _)| drawn.clone().into_iter().any(|t| t.depth.view == *depth));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each image's layers lie in its array, apart from every other image's: a first layer
+    /// written wrong in `crate::shaders::constants` would have two images share a layer.
+    #[test]
+    fn the_view_images_share_no_layer() {
+        for array in ViewArray::ALL {
+            let mut taken = vec![None; array.layers() as usize];
+            for image in ViewImage::ALL.into_iter().filter(|i| i.array() == array) {
+                assert!(image.layers() > 0, "{image:?}");
+                for layer in image.first_layer()..image.first_layer() + image.layers() {
+                    let slot = &mut taken[layer as usize];
+                    assert_eq!(*slot, None, "{image:?} and {slot:?} both hold layer {layer} of {array:?}");
+                    *slot = Some(image);
+                }
+            }
+        }
+        // The traced terms' layers are the approximations table's, from the surface's.
+        assert_eq!(ViewImage::Traced.layers(), crate::settings::hybrid::TRACED_LAYERS);
+        assert!(ViewArray::Drawn.layers() >= 2, "GL reads no array view of a one-layer texture");
     }
 }

@@ -180,7 +180,7 @@ impl PreparedTraced {
                 wgpu::TexelCopyTextureInfo {
                     texture: image,
                     mip_level: 0,
-                    origin: wgpu::Origin3d { x, y, z: layer },
+                    origin: wgpu::Origin3d { x, y, z: ViewImage::Traced.first_layer() + layer },
                     aspect: wgpu::TextureAspect::All,
                 },
                 wgpu::Extent3d { width, height, depth_or_array_layers: 1 },

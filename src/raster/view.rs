@@ -99,6 +99,17 @@ pub enum ViewKind {
     CubeFace { cube: usize, face: usize },
 }
 
+impl ViewKind {
+    /// Its name in a frame capture's debug groups.
+    pub fn name(self) -> String {
+        match self {
+            ViewKind::Main => "main view".to_owned(),
+            ViewKind::Mirror(n) => format!("mirrored view {n}"),
+            ViewKind::CubeFace { cube, face } => format!("cube {cube}, face {face}"),
+        }
+    }
+}
+
 /// One camera of the frame, as every per-view phase (opaque, volumes, transparent) draws it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrameView {

@@ -4,16 +4,20 @@
 //! - the frame's inputs, the same in every view: the shadow maps and how to read them, the
 //!   environment maps;
 //! - the **view images**: images that earlier phases of *that* view made for its shading to
-//!   read ([`ViewImage`]: the projected-shadow mask, the hybrid's traced terms). Each view draws its own into its
-//!   own targets, so a technique that makes one shows in every view: the main camera, each
-//!   mirrored camera and each cube face (STYLE rule 17; Bevy's mesh view bind group is the model).
+//!   read ([`ViewImage`]: the projected-shadow mask, the hybrid's traced terms), layers of the
+//!   view's two arrays ([`ViewArray`]: the drawn images and the copied ones). Each view draws its
+//!   own into its own targets, so a technique that makes one shows in every view: the main
+//!   camera, each mirrored camera and each cube face (STYLE rule 17; Bevy's mesh view bind group
+//!   is the model).
 //!
 //! [`VIEW_GROUP`] is the one table of the group: its layout and every view's bind group are
 //! made from it, and `tests/layouts.rs` checks it binding by binding against the WGSL. A new view
-//! image is a variant of [`ViewImage`] and a row of the table (with its `var` in the WGSL); the
-//! targets then carry it and every view's group binds the view's own.
+//! image is a variant of [`ViewImage`] and its first layer in `crate::shaders::constants`: layers
+//! of an array the group binds already, never a binding of its own (the fullest entry point is
+//! at the downlevel limit of 16 sampled textures); the targets then carry it and every view's
+//! group binds the view's own.
 
-use super::targets::{ViewImage, ViewImages};
+use super::targets::{ViewArray, ViewImages};
 use super::view::{FrameView, ViewSlot, ViewTargets};
 
 /// Where a binding of the view group comes from.
@@ -29,8 +33,8 @@ pub enum Resource {
     DynamicCubes,
     SphereMap,
     LatlongMap,
-    /// The view's own image.
-    View(ViewImage),
+    /// One of the view's own arrays of images.
+    View(ViewArray),
     /// An inspecting renderer's record of one pixel (`shaders/common/inspect.wgsl`).
     Inspection,
     /// The shadow maps read as floats, for the inspection's texel values.
@@ -95,9 +99,9 @@ pub const VIEW_GROUP: &[ViewBinding] = {
         },
         ViewBinding {
             binding: 4,
-            name: "projected_mask",
-            ty: texture(UNFILTERABLE, Dim::D2),
-            resource: Resource::View(ViewImage::ProjectedMask),
+            name: "drawn_images",
+            ty: texture(UNFILTERABLE, Dim::D2Array),
+            resource: Resource::View(ViewArray::Drawn),
         },
         ViewBinding { binding: 5, name: "environment", ty: UNIFORM, resource: Resource::EnvironmentUniform },
         ViewBinding {
@@ -127,9 +131,9 @@ pub const VIEW_GROUP: &[ViewBinding] = {
         },
         ViewBinding {
             binding: 13,
-            name: "traced",
+            name: "copied_images",
             ty: texture(UNFILTERABLE, Dim::D2Array),
-            resource: Resource::View(ViewImage::Traced),
+            resource: Resource::View(ViewArray::Copied),
         },
         ViewBinding {
             binding: 11,
@@ -221,7 +225,7 @@ impl<'a> FrameInputs<'a> {
             Resource::DynamicCubes => TextureView(self.dynamic_cubes),
             Resource::SphereMap => TextureView(self.sphere_map),
             Resource::LatlongMap => TextureView(self.latlong_map),
-            Resource::View(image) => TextureView(&images.get(image).view),
+            Resource::View(array) => TextureView(&images.array(array).view),
             Resource::Inspection => self.inspection?.as_entire_binding(),
         })
     }
@@ -261,7 +265,7 @@ impl ViewGroups {
         self.views.clear();
         for (view, targets) in views {
             let images: Vec<wgpu::TextureView> =
-                ViewImage::ALL.iter().map(|&i| targets.images.get(i).view.clone()).collect();
+                ViewArray::ALL.iter().map(|&a| targets.images.array(a).view.clone()).collect();
             let index = match self.kept.iter().position(|(kept, _)| *kept == images) {
                 Some(index) => index,
                 None => {

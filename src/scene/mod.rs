@@ -184,18 +184,24 @@ impl Scene {
         }
     }
 
+    /// Slices around the rasterizer's spheres, tori and rounded boxes (the setting
+    /// `sphere_segments`, at most this many where tessellation adapts to the screen). Read here
+    /// only, from the scene's own settings: the frame's geometry, its mirrors, projected shadows
+    /// and cubes, displacement and the tracer's rounded boxes all make a shape from one count.
+    pub fn sphere_segments(&self) -> u32 {
+        self.settings.sphere_segments
+    }
+
     /// The triangles the rasterizer draws for `object`, in its local coordinates.
     pub fn tessellate(&self, object: &Object) -> std::borrow::Cow<'_, Mesh> {
         use std::borrow::Cow;
         match object.shape {
-            Shape::Sphere { center, radius } => Cow::Owned(Mesh::sphere(center, radius, self.settings.sphere_segments)),
+            Shape::Sphere { center, radius } => Cow::Owned(Mesh::sphere(center, radius, self.sphere_segments())),
             Shape::Cuboid { min, max } => Cow::Owned(Mesh::cuboid(min, max)),
             Shape::Plane { size, uv_scale } => Cow::Owned(Mesh::plane(size, uv_scale)),
             Shape::Mesh(index) => Cow::Borrowed(&self.meshes[index]),
-            Shape::Torus { major, minor } => Cow::Owned(Mesh::torus(major, minor, self.settings.sphere_segments)),
-            Shape::RoundedBox { half, radius } => {
-                Cow::Owned(Mesh::rounded_box(half, radius, self.settings.sphere_segments))
-            }
+            Shape::Torus { major, minor } => Cow::Owned(Mesh::torus(major, minor, self.sphere_segments())),
+            Shape::RoundedBox { half, radius } => Cow::Owned(Mesh::rounded_box(half, radius, self.sphere_segments())),
         }
     }
 

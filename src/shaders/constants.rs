@@ -140,6 +140,14 @@ wgsl_constants! {
     TONE_MAP_REINHARD: u32 as U32 = 1;
     TONE_MAP_ACES: u32 as U32 = 2;
     TONE_MAP_PBR_NEUTRAL: u32 as U32 = 3;
+    /// The view's images (`crate::raster::targets::ViewImage`) are layers of its two arrays, one
+    /// view-group binding each: `drawn_images`, which its raster passes draw and blend, and
+    /// `copied_images`, which the CPU copies in. Each image's first layer: the projected-shadow
+    /// mask's, of the drawn images;
+    PROJECTED_MASK_LAYER: u32 as I32 = 0;
+    /// the hybrid's traced terms', of the copied images (`TRACED_SURFACE_LAYER` and each row's
+    /// `TRACED_NAME_LAYER` count from it).
+    TRACED_FIRST_LAYER: u32 as I32 = 0;
 }
 
 /// The WGSL `const`s of [`ALL`] and of the approximations table: `TRACED_NAME`, the row's bit in

@@ -910,7 +910,7 @@ pub fn scene_primitives(scene: &Scene) -> Vec<Primitive> {
             Shape::Plane { size, uv_scale } => AnalyticShape::Plane { size, uv_scale },
             Shape::Torus { major, minor } => AnalyticShape::Torus { major, minor },
             Shape::RoundedBox { half, radius } => {
-                AnalyticShape::RoundedBox { half, radius, steps: (scene.settings.sphere_segments / 4).max(2) }
+                AnalyticShape::RoundedBox { half, radius, steps: (scene.sphere_segments() / 4).max(2) }
             }
         };
         match Analytic::new(analytic, object.world_from_local, index, object.material) {

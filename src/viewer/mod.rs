@@ -25,33 +25,33 @@
 //! settings are remembered and the viewer exits), destroyed from outside (the `Destroyed` event:
 //! the same, with a line saying so), or the display lost (Xlib prints its one line and exits).
 
-pub mod budget;
-pub mod camera_control;
-pub mod config;
-pub mod error_budget;
-pub mod frame;
-pub mod hud;
-pub mod inspect;
-pub mod kept;
-pub mod lab;
-pub mod lab_difference;
-pub mod lab_frame;
-pub mod panel;
-pub mod picking;
-pub mod raster_view;
-pub mod scene_panel;
-pub mod scene_settings;
-pub mod scene_state;
-pub mod screen;
+mod budget;
+mod camera_control;
+pub(crate) mod config;
+mod error_budget;
+pub(crate) mod frame;
+mod hud;
+mod inspect;
+mod kept;
+pub(crate) mod lab;
+mod lab_difference;
+mod lab_frame;
+mod panel;
+mod picking;
+mod raster_view;
+mod scene_panel;
+mod scene_settings;
+pub(crate) mod scene_state;
+pub(crate) mod screen;
 pub mod script;
-pub mod seen;
-pub mod steps;
-pub mod tools;
-pub mod traced;
+mod seen;
+mod steps;
+mod tools;
+pub(crate) mod traced;
 pub mod ui;
-pub mod upscale;
-pub mod view_mode;
-pub mod volume_probe;
+mod upscale;
+mod view_mode;
+mod volume_probe;
 
 use std::path::PathBuf;
 use web_time::Instant;

@@ -35,6 +35,7 @@ impl Viewer {
     /// wait's end; for `wait traced`, at once when it ends or fails at the next frame or the
     /// difference view still needs its raster image read back, else at its timeout (the tracer
     /// wakes the window sooner); `None` once the script is done.
+    #[cfg(target_arch = "wasm32")]
     pub fn script_next(&self, now: Instant) -> Option<Instant> {
         let script = &self.script;
         if self.script_done() {
@@ -56,6 +57,7 @@ impl Viewer {
 
     /// Queues more steps, run one a frame after those already queued (the browser's page sends
     /// them, `src/web/`).
+    #[cfg(target_arch = "wasm32")]
     pub fn push_steps(&mut self, steps: impl IntoIterator<Item = Step>) {
         self.script.steps.extend(steps);
     }

@@ -317,7 +317,8 @@ impl Renderer {
             }
         }
         if !plan.cube_views.is_empty() {
-            environment.finish_faces(gpu, &self.mipmaps, &mut frame, plan.cube_views.len());
+            let faces = plan.cube_views.len();
+            frame.group("cubes' mip chains", |frame| environment.finish_faces(gpu, &self.mipmaps, frame, faces));
         }
         for (k, view) in plan.mirror_views.iter().enumerate().rev() {
             let images = mirrors.images(&plan.mirror_nodes, Some(k));
@@ -325,7 +326,7 @@ impl Renderer {
         }
         let images = mirrors.images(&plan.mirror_nodes, None);
         record_view(&ctx, &mut frame, &phases, (&plan.main, targets), &images);
-        self.record_overlays(&ctx, &mut frame, &plan, (targets, &maps));
+        frame.group("overlays", |frame| self.record_overlays(&ctx, frame, &plan, (targets, &maps)));
         // The first mirrored camera's own image, in place of the frame.
         let shown = match plan.mirror_views.first() {
             Some(_) if settings.mirrors.view == MirrorView::Image => &mirrors.targets(0).hdr.view,
@@ -372,7 +373,7 @@ impl Renderer {
     ) -> FramePlan {
         let scene_gpu = &mut self.scene_gpu;
         scene_gpu.prepare_materials(&gpu.device, &self.layouts, &settings.textures);
-        let (segments, adaptive) = (settings.sphere_segments, settings.raster.adaptive_tessellation);
+        let (segments, adaptive) = (scene.sphere_segments(), settings.raster.adaptive_tessellation);
         scene_gpu.geometry.prepare(&gpu.device, scene, &scene.camera, segments, adaptive);
         let bounds = scene_gpu.geometry.bounds;
         let faces = self.environment.prepare(gpu, (&self.mipmaps, frame), scene, settings, bounds);
@@ -448,27 +449,32 @@ fn record_view(
     (view, targets): ViewTargets<'_>,
     mirrors: &MirrorImages,
 ) {
-    let transparent_later = phases.transparency.is_some();
-    if let Some(traced) = &phases.traced {
-        traced.record(frame, view, targets);
-    }
-    if view.prepass {
-        phases.scene.record_prepass(ctx, frame, view, targets, transparent_later);
-    }
-    if view.projected {
-        phases.projected.record(ctx, frame, view, targets);
-    }
-    phases.scene.record_opaque(ctx, frame, view, targets, (transparent_later, mirrors));
-    phases.volumes.record_isosurfaces(ctx, frame, view, targets);
-    if let Some(refraction) = &phases.refraction {
-        refraction.record(ctx, frame, view, targets);
-    }
-    let mut composite =
-        |frame: &mut FrameEncoder, span: RaySpan| phases.volumes.composite(ctx, frame, view, targets, span);
-    match &phases.transparency {
-        Some(transparency) => transparency.record(ctx, frame, (view, targets), &mut composite),
-        None => composite(frame, RaySpan { volumes: VolumeSet::All, near: None, far: None }),
-    }
+    frame.group(&view.kind.name(), |frame| {
+        let transparent_later = phases.transparency.is_some();
+        if let Some(traced) = &phases.traced {
+            frame.group("traced terms", |frame| traced.record(frame, view, targets));
+        }
+        if view.prepass {
+            frame.group("depth prepass", |frame| {
+                phases.scene.record_prepass(ctx, frame, view, targets, transparent_later)
+            });
+        }
+        if view.projected {
+            frame.group("projected shadows", |frame| phases.projected.record(ctx, frame, view, targets));
+        }
+        let opaque = (transparent_later, mirrors);
+        frame.group("opaque", |frame| phases.scene.record_opaque(ctx, frame, view, targets, opaque));
+        frame.group("isosurfaces", |frame| phases.volumes.record_isosurfaces(ctx, frame, view, targets));
+        if let Some(refraction) = &phases.refraction {
+            frame.group("refraction", |frame| refraction.record(ctx, frame, view, targets));
+        }
+        let mut composite =
+            |frame: &mut FrameEncoder, span: RaySpan| phases.volumes.composite(ctx, frame, view, targets, span);
+        frame.group("transparency and volumes", |frame| match &phases.transparency {
+            Some(transparency) => transparency.record(ctx, frame, (view, targets), &mut composite),
+            None => composite(frame, RaySpan { volumes: VolumeSet::All, near: None, far: None }),
+        });
+    });
 }
 
 /// Every kind of inspection record the passes write, each declared by its pass.

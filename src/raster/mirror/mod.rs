@@ -301,7 +301,7 @@ enum NotPlanar {
 /// mesh), from its world-space triangles.
 fn planar(scene: &Scene, index: usize, indices: Option<std::ops::Range<u32>>) -> Result<PlaneFit, NotPlanar> {
     let object = &scene.objects[index];
-    let (key, world_from_mesh) = instance_of(object, scene.settings.sphere_segments);
+    let (key, world_from_mesh) = instance_of(object, scene.sphere_segments());
     let mesh = build_mesh(scene, key);
     // A mirroring transform reverses the winding in the world; undo it so the winding still
     // names the front.

@@ -233,7 +233,7 @@ impl ProjectedPass {
                 entry_point: Some("fs_shadow_projected"),
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState {
-                    format: ViewImage::ProjectedMask.format(),
+                    format: ViewImage::ProjectedMask.array().format(),
                     blend: Some(wgpu::BlendState { color: max, alpha: max }),
                     write_mask: wgpu::ColorWrites::ALL,
                 })],
@@ -269,7 +269,7 @@ impl ProjectedPass {
         let mut pass = frame.encoder.begin_render_pass(&layout::pass(
             "shadow_projected::pass",
             &[Some(layout::color_attachment(
-                &targets.images.get(ViewImage::ProjectedMask).view,
+                targets.images.drawn(ViewImage::ProjectedMask),
                 wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
             ))],
             Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Load)),
