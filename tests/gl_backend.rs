@@ -286,3 +286,26 @@ fn webgl2_profile_shadow_filters_and_cubes_match_vulkan() {
     assert!(error <= BALL_TOLERANCE, "the WebGL2 profile's ball differs by mean FLIP {error:.5}");
     assert_no_errors(&ErrorLog::take());
 }
+
+/// A frame's debug groups (each view's, each phase's: `FrameEncoder::group`) balance on every
+/// encoder, a profiled frame's too, which submits its encoder after every phase and so must
+/// close the groups open then and open them again on the next: wgpu refuses an encoder whose
+/// groups do not balance. GL records the groups; Vulkan on a CPU records none
+/// (`Gpu::debug_groups`). Mirrored views, cube faces, refraction and transparency each add
+/// groups.
+#[test]
+fn a_profiled_frames_debug_groups_balance_on_gl() {
+    let gl = &devices().gl;
+    assert!(gl.debug_groups(), "GL records the frame's debug groups");
+    for name in ["showcase.toml", "mirrors.toml", "refraction.toml"] {
+        let mut scene = Scene::load(&mirador::scene::builtin_path(name)).expect("a built-in scene");
+        (scene.camera.width, scene.camera.height) = (160, 90);
+        let mut headless = mirador::raster::Headless::new(gl, &scene);
+        headless.renderer.profile = true;
+        let drawn = gl.checked(|| headless.render(gl, &scene, &scene.settings));
+        assert!(drawn.is_ok(), "{name}: {:?}", drawn.err());
+        assert_no_errors(&ErrorLog::take());
+        let passes = headless.report.passes.iter().filter(|p| p.time.is_some()).count();
+        assert!(passes >= 4, "{name}: a profiled frame times each pass, {passes} timed");
+    }
+}

@@ -210,6 +210,14 @@ impl Gpu {
         Profile::of(&self.device)
     }
 
+    /// Whether a frame records its debug groups (a capture tool's tree of views and phases). Not
+    /// on Vulkan on a CPU (Mesa's lavapipe): the lavapipe of Debian 12 (Mesa 22.3) crashes in
+    /// `vkCmdBeginDebugUtilsLabelEXT` on a frame's groups, and no capture tool is aimed at it.
+    pub fn debug_groups(&self) -> bool {
+        let info = self.adapter.get_info();
+        !(info.backend == wgpu::Backend::Vulkan && info.device_type == wgpu::DeviceType::Cpu)
+    }
+
     /// "name (backend)", for logs and `--stats`.
     pub fn describe(&self) -> String {
         let info = self.adapter.get_info();

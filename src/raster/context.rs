@@ -148,14 +148,16 @@ pub struct FrameEncoder<'g> {
     profile: bool,
     mark: Instant,
     pub report: FrameReport,
-    /// The debug groups open now, outermost first ([`Self::group`]).
-    groups: Vec<String>,
+    /// The debug groups open now, outermost first ([`Self::group`]); `None` where the device
+    /// records none ([`Gpu::debug_groups`]).
+    groups: Option<Vec<String>>,
 }
 
 impl<'g> FrameEncoder<'g> {
     pub fn new(gpu: &'g Gpu, profile: bool) -> FrameEncoder<'g> {
         let (mark, report) = (Instant::now(), FrameReport::default());
-        FrameEncoder { gpu, encoder: Self::encoder(gpu), profile, mark, report, groups: Vec::new() }
+        let groups = gpu.debug_groups().then(Vec::new);
+        FrameEncoder { gpu, encoder: Self::encoder(gpu), profile, mark, report, groups }
     }
 
     fn encoder(gpu: &Gpu) -> wgpu::CommandEncoder {
@@ -167,11 +169,12 @@ impl<'g> FrameEncoder<'g> {
     /// profiled frame's [`Self::end`] submits the encoder mid-group: the groups open then are
     /// closed on the encoder it submits and opened again on the next.
     pub fn group<R>(&mut self, name: &str, record: impl FnOnce(&mut Self) -> R) -> R {
+        let Some(groups) = &mut self.groups else { return record(self) };
+        groups.push(name.to_owned());
         self.encoder.push_debug_group(name);
-        self.groups.push(name.to_owned());
         let recorded = record(self);
-        self.groups.pop();
         self.encoder.pop_debug_group();
+        self.groups.as_mut().map(Vec::pop);
         recorded
     }
 
@@ -179,10 +182,8 @@ impl<'g> FrameEncoder<'g> {
     pub fn end(&mut self, name: &'static str, figures: &[(&'static str, Figure)]) {
         let time = self.profile.then(|| {
             let mut encoder = std::mem::replace(&mut self.encoder, Self::encoder(self.gpu));
-            for _ in &self.groups {
+            for group in self.groups.iter().flatten() {
                 encoder.pop_debug_group();
-            }
-            for group in &self.groups {
                 self.encoder.push_debug_group(group);
             }
             self.gpu.queue.submit([encoder.finish()]);
