@@ -17,7 +17,10 @@
 //! `benches/embree.py`, which runs Embree 4 on the same work.
 //!
 //! The row `wide, packets` traces the same primary rays in packets of 16 (4 × 4 pixels,
-//! `mirador::trace::accel::wide::packets`), as the tracer does for centre-sampled images.
+//! `mirador::trace::accel::wide::packets`), as the tracer does for centre-sampled images. A
+//! table after the rows sets packets against single rays on the wide BVH for the three kinds of
+//! ray: primary, shadow (each to its light's distance) and reflected, from the same hits in the
+//! blocks' order (`-- packets` prints it alone with Mirador's rows).
 //!
 //! The peers use their own idioms: obvhs its two-sided Möller–Trumbore `Triangle::intersect`
 //! with the triangles reordered into leaf order (as its examples recommend) and its
@@ -321,6 +324,85 @@ fn packets_row(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Row {
     }
 }
 
+/// Packets against single rays on the wide BVH, for the three kinds of ray the tracer casts: the
+/// primary rays in 4 × 4 blocks; from each hit, in the same order, a shadow ray to the light
+/// (to its own distance) and the mirror reflection about the triangle's normal. Each kind is
+/// traced one by one and in packets of 16, with the same answers (checked); one thread and all.
+fn packet_table(tris: &[[Vec3; 3]], primary: &[Query], light: Vec3) {
+    let prims: Vec<Primitive> = tris.iter().copied().map(Primitive::flat_triangle).collect();
+    let accel = Wide::build(&prims);
+    let ray = |q: &Query| Ray { origin: q.origin, direction: q.direction };
+    let blocks = in_blocks(primary);
+    let mut hits = vec![None; blocks.len()];
+    accel.closest_packets(&prims, &blocks.iter().map(ray).collect::<Vec<_>>(), 0.0, f32::INFINITY, &mut hits);
+    let (mut shadow, mut reflected) = (Vec::new(), Vec::new());
+    for (q, hit) in blocks.iter().zip(&hits) {
+        let Some(hit) = hit else { continue };
+        let p = ray(q).at(hit.t);
+        let [a, b, c] = tris[hit.primitive as usize];
+        let n = (b - a).cross(c - a).normalize();
+        let to_light = light - p;
+        shadow.push(Query {
+            origin: p,
+            direction: to_light.normalize(),
+            t_min: SHADOW_T_MIN,
+            t_max: to_light.length(),
+        });
+        let d = q.direction;
+        reflected.push(Query {
+            origin: p,
+            direction: d - 2.0 * d.dot(n) * n,
+            t_min: SHADOW_T_MIN,
+            t_max: f32::INFINITY,
+        });
+    }
+    println!();
+    println!("packets against single rays (the wide BVH; the rays in 4 × 4 blocks of pixels, in that order):");
+    println!(
+        "{:<10} {:>9} {:>12} {:>12} {:>7} {:>12} {:>12} {:>7}",
+        "", "rays", "single 1T", "packets 1T", "ratio", "single all", "packets all", "ratio"
+    );
+    let closest = |queries: &[Query]| -> usize {
+        let rays: Vec<Ray> = queries.iter().map(ray).collect();
+        let mut hits = vec![None; rays.len()];
+        accel.closest_packets(&prims, &rays, queries[0].t_min, f32::INFINITY, &mut hits);
+        hits.iter().filter(|h| h.is_some()).count()
+    };
+    let occluded = |queries: &[Query]| -> usize {
+        let rays: Vec<Ray> = queries.iter().map(ray).collect();
+        let t_max: Vec<f32> = queries.iter().map(|q| q.t_max).collect();
+        let mut occluded = vec![false; rays.len()];
+        accel.occluded_packets(&prims, &rays, (SHADOW_T_MIN, &t_max), &mut occluded);
+        occluded.iter().filter(|&&o| o).count()
+    };
+    let kinds: [(&str, &[Query], &(dyn Fn(&[Query]) -> usize + Sync)); 3] =
+        [("primary", &blocks, &closest), ("shadow", &shadow, &occluded), ("reflected", &reflected, &closest)];
+    for (name, queries, packets) in kinds {
+        let one = |q: &Query| match name {
+            "shadow" => accel.occluded(&prims, &ray(q), q.t_min, q.t_max),
+            _ => accel.closest(&prims, &ray(q), q.t_min, q.t_max).is_some(),
+        };
+        let single = throughput(queries, one);
+        let _ = queries.par_chunks(256).take(80).map(packets).sum::<usize>();
+        let (packet_time, packet_hits) = best_of(true, || queries.chunks(256).map(packets).sum());
+        let (parallel_time, _) = best_of(false, || queries.par_chunks(256).map(packets).sum());
+        assert_eq!(packet_hits, single.hits, "{name}: packets and single rays find the same hits");
+        let rate = |t: Duration| queries.len() as f64 / t.as_secs_f64() / 1e6;
+        let (packet, parallel) = (rate(packet_time), rate(parallel_time));
+        println!(
+            "{:<10} {:>9} {:>7.2} Mr/s {:>7.2} Mr/s {:>6.2}× {:>7.2} Mr/s {:>7.2} Mr/s {:>6.2}×",
+            name,
+            queries.len(),
+            single.single / 1e6,
+            packet,
+            packet / (single.single / 1e6),
+            single.parallel / 1e6,
+            parallel,
+            parallel / (single.parallel / 1e6)
+        );
+    }
+}
+
 fn obvhs_rows(tris: &[[Vec3; 3]], primary: &[Query], shadow: &[Query]) -> Vec<Row> {
     use obvhs::ray::{Ray as ORay, RayHit};
     let triangles: Vec<obvhs::triangle::Triangle> =
@@ -394,10 +476,10 @@ fn main() {
     let primary = primary_rays();
     dump(&tris, &primary);
     // Shadow rays from Mirador's primary hits toward a point light.
+    let light = Vec3::new(3.0, 4.0, 2.0);
     let shadow: Vec<Query> = {
         let prims: Vec<Primitive> = tris.iter().copied().map(Primitive::flat_triangle).collect();
         let accel = Bvh::build(&prims);
-        let light = Vec3::new(3.0, 4.0, 2.0);
         primary
             .par_iter()
             .filter_map(|q| {
@@ -480,6 +562,9 @@ fn main() {
             ours.primary.parallel / peer.primary.parallel,
             ours.shadow.parallel / peer.shadow.parallel
         );
+    }
+    if wanted("packets") {
+        packet_table(&tris, &primary, light);
     }
     println!();
     println!("total {:.1} s", total.elapsed().as_secs_f64());

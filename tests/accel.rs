@@ -842,3 +842,50 @@ fn packets_find_the_single_ray_walks_hits() {
     }
     assert!(packets_tested > 300);
 }
+
+/// Shadow rays in packets (`Accelerator::occluded_packets`), each to its own far bound, against
+/// the same rays one by one: the same answer for every ray, on AVX and two halves of four alike.
+/// The bounds range from nothing (no ray can be occluded) to beyond the scene; the rays are the
+/// packets test's, coherent and not.
+#[test]
+fn shadow_packets_answer_as_single_rays() {
+    let mut rng = Pcg::new(17);
+    let sphere = mesh_primitives(welded_sphere(96, 48), Mat4::IDENTITY);
+    let showcase = scene_primitives(&Scene::load(&mirador::scene::builtin_path("showcase.toml")).unwrap());
+    let mut awkward = triangle_soup(&mut rng, 300);
+    awkward.extend(scene_primitives(&analytic_scene()));
+    let (mut occluded_seen, mut clear_seen) = (0, 0);
+    for (name, prims) in [("sphere mesh", sphere), ("showcase", showcase), ("soup and analytic", awkward)] {
+        let focus = bounds_of(&prims);
+        let focus =
+            if focus.extent().max_element() > 50.0 { Aabb::new(Vec3::splat(-5.0), Vec3::splat(5.0)) } else { focus };
+        let centre = (focus.min + focus.max) / 2.0;
+        let reach = focus.extent().max_element();
+        let mut rays = fan(centre + Vec3::new(0.3, 0.4, 1.6) * reach, centre, reach, 37);
+        rays.extend(random_queries(&mut rng, &focus, 500).into_iter().map(|(r, _, _)| r));
+        rays.extend(axis_rays(&prims, &mut rng, 60).into_iter().map(|(r, _, _)| r));
+        rays.push(ray(centre + Vec3::splat(10.0 * reach), Vec3::ONE));
+        let t_max: Vec<f32> = (0..rays.len())
+            .map(|i| match i % 4 {
+                0 => f32::INFINITY,
+                1 => 0.0,
+                _ => rng.range(0.0, 2.0 * reach),
+            })
+            .collect();
+        for (way, wide) in [("AVX where present", Wide::build(&prims)), ("two halves", Wide::build_without_avx(&prims))]
+        {
+            let mut occluded = vec![false; rays.len()];
+            wide.occluded_packets(&prims, &rays, (1e-4, &t_max), &mut occluded);
+            for ((r, &t_max), &got) in rays.iter().zip(&t_max).zip(&occluded) {
+                let want = wide.occluded(&prims, r, 1e-4, t_max);
+                assert_eq!(got, want, "{name} ({way}): {r:?} to {t_max} in a packet occluded {got}, alone {want}");
+                if got {
+                    occluded_seen += 1;
+                } else {
+                    clear_seen += 1;
+                }
+            }
+        }
+    }
+    assert!(occluded_seen > 300 && clear_seen > 300, "{occluded_seen} occluded, {clear_seen} not");
+}

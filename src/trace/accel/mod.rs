@@ -102,6 +102,22 @@ pub trait Accelerator: Send + Sync {
             *hit = self.closest(prims, ray, t_min, t_max);
         }
     }
+
+    /// Whether anything is hit along each of `rays` in `(t_min, t_max[i])`, into `occluded`:
+    /// [`Self::occluded`] for each. Coherent shadow rays (neighbouring pixels' towards one
+    /// light, in blocks of 16) are traced together where the accelerator can
+    /// ([`wide::packets`]), with the same answers.
+    fn occluded_packets(
+        &self,
+        prims: &[Primitive],
+        rays: &[Ray],
+        (t_min, t_max): (f32, &[f32]),
+        occluded: &mut [bool],
+    ) {
+        for ((ray, &t_max), answer) in rays.iter().zip(t_max).zip(occluded) {
+            *answer = self.occluded(prims, ray, t_min, t_max);
+        }
+    }
 }
 
 pub use crate::settings::AccelKind;

@@ -756,6 +756,10 @@ impl Accelerator for Wide {
     fn closest_packets(&self, prims: &[Primitive], rays: &[Ray], t_min: f32, t_max: f32, hits: &mut [Option<Hit>]) {
         self.closest_in_packets(prims, rays, t_min, t_max, hits);
     }
+
+    fn occluded_packets(&self, prims: &[Primitive], rays: &[Ray], bounds: (f32, &[f32]), occluded: &mut [bool]) {
+        self.occluded_in_packets(prims, rays, bounds, occluded);
+    }
 }
 
 #[cfg(test)]

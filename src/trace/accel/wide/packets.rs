@@ -18,6 +18,10 @@
 //! to the bit. A ray it could not walk the fast way (one that runs exactly along an axis, whose
 //! slab test needs [`enter`]'s careful variant) is walked alone.
 //!
+//! **Shadow rays** ([`Wide::occluded_in_packets`]) walk the same way, each to its own far bound
+//! (its light's distance), and a ray leaves the packet at its first hit: whether anything is hit
+//! is the single ray's answer, since a ray enters every box the single-ray walk enters until then.
+//!
 //! What a packet costs instead: a ray that left the others' path is carried along, masked, until
 //! the nodes it enters run out. Incoherent rays (reflections off curved surfaces, refraction)
 //! gain nothing, and are traced one by one.
@@ -46,19 +50,49 @@ impl Wide {
         hits: &mut [Option<Hit>],
     ) {
         assert_eq!(rays.len(), hits.len(), "one hit for each ray");
+        let t_max = [t_max; RAYS];
         for (rays, hits) in rays.chunks(RAYS).zip(hits.chunks_mut(RAYS)) {
-            self.packet(prims, rays, t_min, t_max, hits);
+            self.packet::<false>(prims, rays, (t_min, &t_max), hits);
         }
     }
 
-    fn packet(&self, prims: &[Primitive], rays: &[Ray], t_min: f32, t_max: f32, hits: &mut [Option<Hit>]) {
+    /// Whether anything is hit along each of `rays` in `(t_min, t_max[i])`, into `occluded`,
+    /// [`RAYS`] at a time (shadow rays, each to its own light distance); the same answers as
+    /// [`Accelerator::occluded`] ray by ray. A ray leaves the packet at its first hit.
+    pub(super) fn occluded_in_packets(
+        &self,
+        prims: &[Primitive],
+        rays: &[Ray],
+        (t_min, t_max): (f32, &[f32]),
+        occluded: &mut [bool],
+    ) {
+        assert!(rays.len() == t_max.len() && rays.len() == occluded.len(), "one bound and one answer for each ray");
+        let mut hits = [None; RAYS];
+        for ((rays, t_max), occluded) in rays.chunks(RAYS).zip(t_max.chunks(RAYS)).zip(occluded.chunks_mut(RAYS)) {
+            let hits = &mut hits[..rays.len()];
+            self.packet::<true>(prims, rays, (t_min, t_max), hits);
+            for (answer, hit) in occluded.iter_mut().zip(hits.iter()) {
+                *answer = hit.is_some();
+            }
+        }
+    }
+
+    /// One packet: with `ANY`, each ray's first hit found (whether it is occluded); without, its
+    /// nearest.
+    fn packet<const ANY: bool>(
+        &self,
+        prims: &[Primitive],
+        rays: &[Ray],
+        (t_min, t_max): (f32, &[f32]),
+        hits: &mut [Option<Hit>],
+    ) {
         let mut prepared: [Option<PreparedRay>; RAYS] = [None; RAYS];
         for (i, ray) in rays.iter().enumerate() {
             hits[i] = None;
             prepared[i] = PreparedRay::new(ray);
             // A ray along an axis needs the careful slab test: walked alone.
             if prepared[i].is_some_and(|p| !p.inv_direction.is_finite()) {
-                hits[i] = self.closest(prims, ray, t_min, t_max);
+                hits[i] = self.query::<ANY>(prims, ray, t_min, t_max[i]);
                 prepared[i] = None;
             }
         }
@@ -67,7 +101,7 @@ impl Wide {
         }
         let members: [Option<Member>; RAYS] = std::array::from_fn(|i| {
             let p = prepared[i].as_ref()?;
-            let query = Query { prims, ray: &rays[i], prepared: p, t_min, t_max };
+            let query = Query { prims, ray: &rays[i], prepared: p, t_min, t_max: t_max[i] };
             Some(Member { query, box_ray: BoxRay::new(p), packet_ray: PacketRay::new(p) })
         });
         let active = (0..RAYS).filter(|&i| members[i].is_some()).fold(0u32, |m, i| m | 1 << i);
@@ -79,15 +113,15 @@ impl Wide {
         #[cfg(target_arch = "x86_64")]
         if self.avx {
             // SAFETY: `avx` is set only where the CPU reports AVX.
-            unsafe { self.packet_avx(members, active, small, hits) };
+            unsafe { self.packet_avx::<ANY>(members, active, small, hits) };
             return;
         }
         // SAFETY: `Halves` uses what every target has (SSE2 on x86-64).
         unsafe {
             if small {
-                self.walk::<Halves, SMALL_STACK>(members, active, hits)
+                self.walk::<Halves, ANY, SMALL_STACK>(members, active, hits)
             } else {
-                self.walk::<Halves, LARGE_STACK>(members, active, hits)
+                self.walk::<Halves, ANY, LARGE_STACK>(members, active, hits)
             }
         }
     }
@@ -95,24 +129,31 @@ impl Wide {
     /// The packet's walk compiled with AVX enabled ([`Wide::run_avx`]'s reason).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    fn packet_avx(&self, members: &[Option<Member>; RAYS], active: u32, small: bool, hits: &mut [Option<Hit>]) {
+    fn packet_avx<const ANY: bool>(
+        &self,
+        members: &[Option<Member>; RAYS],
+        active: u32,
+        small: bool,
+        hits: &mut [Option<Hit>],
+    ) {
         // SAFETY: this function runs only where the CPU has AVX (its caller checks).
         unsafe {
             if small {
-                self.walk::<Octet, SMALL_STACK>(members, active, hits)
+                self.walk::<Octet, ANY, SMALL_STACK>(members, active, hits)
             } else {
-                self.walk::<Octet, LARGE_STACK>(members, active, hits)
+                self.walk::<Octet, ANY, LARGE_STACK>(members, active, hits)
             }
         }
     }
 
     /// The packet's nearest-first walk: the rays of `active` (those `members` holds), each with
-    /// its own far bound.
+    /// its own far bound. With `ANY`, a ray's first hit ends its walk: its far bound becomes
+    /// −∞, so it enters no more boxes and leaves every pending child.
     ///
     /// # Safety
     /// The CPU must have the instructions `L` uses.
     #[inline(always)]
-    unsafe fn walk<L: Lanes, const STACK: usize>(
+    unsafe fn walk<L: Lanes, const ANY: bool, const STACK: usize>(
         &self,
         members: &[Option<Member>; RAYS],
         active: u32,
@@ -126,6 +167,7 @@ impl Wide {
         }
         let mut stack = Stack::<(u32, u32, f32), STACK>::new();
         let (mut current, mut rays) = (0u32, active);
+        let mut done = 0u32;
         loop {
             if current & LEAF == 0 {
                 // SAFETY: `current` is 0 or an inner child's entry of a node.
@@ -140,8 +182,8 @@ impl Wide {
                 for i in bits(rays) {
                     let Some(member) = &members[i] else { continue };
                     // SAFETY: the caller's promise about `L`.
-                    let none = unsafe {
-                        self.leaf::<L, false>(
+                    let first = unsafe {
+                        self.leaf::<L, ANY>(
                             current & !LEAF,
                             &member.query,
                             &member.packet_ray,
@@ -149,7 +191,15 @@ impl Wide {
                             &mut t_max[i],
                         )
                     };
-                    debug_assert!(none.is_none(), "a nearest-hit walk returns from its leaves only at the end");
+                    debug_assert!(ANY || first.is_none(), "a nearest-hit walk returns from its leaves only at the end");
+                    if ANY && first.is_some() {
+                        hits[i] = first;
+                        t_max[i] = f32::NEG_INFINITY;
+                        done |= 1 << i;
+                    }
+                }
+                if ANY && done == active {
+                    return;
                 }
             }
             // Next: the nearest pending child, with the rays whose nearest hit is not nearer.
