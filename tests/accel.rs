@@ -796,28 +796,44 @@ fn fan(eye: Vec3, target: Vec3, size: f32, side: usize) -> Vec<Ray> {
     rays
 }
 
+/// The scenes and rays the packet tests trace: a sphere mesh, the showcase, and a triangle soup
+/// with analytic shapes; for each, a fan of coherent rays, random rays, rays along the axes
+/// (walked alone inside a packet) and a ray that misses, so that the last packet is short. Each
+/// with its reach, the size of what the rays aim at.
+fn packet_cases(rng: &mut Pcg) -> Vec<(&'static str, Vec<Primitive>, Vec<Ray>, f32)> {
+    let sphere = mesh_primitives(welded_sphere(96, 48), Mat4::IDENTITY);
+    let showcase = scene_primitives(&Scene::load(&mirador::scene::builtin_path("showcase.toml")).unwrap());
+    let mut awkward = triangle_soup(rng, 300);
+    awkward.extend(scene_primitives(&analytic_scene()));
+    let scenes = [("sphere mesh", sphere), ("showcase", showcase), ("soup and analytic", awkward)];
+    scenes
+        .into_iter()
+        .map(|(name, prims)| {
+            let focus = bounds_of(&prims);
+            let focus = if focus.extent().max_element() > 50.0 {
+                Aabb::new(Vec3::splat(-5.0), Vec3::splat(5.0))
+            } else {
+                focus
+            };
+            let centre = (focus.min + focus.max) / 2.0;
+            let reach = focus.extent().max_element();
+            let mut rays = fan(centre + Vec3::new(0.3, 0.4, 1.6) * reach, centre, reach, 37);
+            rays.extend(random_queries(rng, &focus, 500).into_iter().map(|(r, _, _)| r));
+            rays.extend(axis_rays(&prims, rng, 60).into_iter().map(|(r, _, _)| r));
+            rays.push(ray(centre + Vec3::splat(10.0 * reach), Vec3::ONE));
+            (name, prims, rays, reach)
+        })
+        .collect()
+}
+
 /// Packets of coherent rays (`Accelerator::closest_packets`) against the same rays one by one:
 /// the same hits, ties at shared vertices and edges aside as between the two BVHs (equally near,
-/// both real); and on AVX and two halves of four alike. Incoherent rays, rays along the axes
-/// (walked alone inside a packet) and rays that miss are mixed in, and the last packet is short.
+/// both real); and on AVX and two halves of four alike, on [`packet_cases`].
 #[test]
 fn packets_find_the_single_ray_walks_hits() {
     let mut rng = Pcg::new(16);
-    let sphere = mesh_primitives(welded_sphere(96, 48), Mat4::IDENTITY);
-    let showcase = scene_primitives(&Scene::load(&mirador::scene::builtin_path("showcase.toml")).unwrap());
-    let mut awkward = triangle_soup(&mut rng, 300);
-    awkward.extend(scene_primitives(&analytic_scene()));
     let mut packets_tested = 0;
-    for (name, prims) in [("sphere mesh", sphere), ("showcase", showcase), ("soup and analytic", awkward)] {
-        let focus = bounds_of(&prims);
-        let focus =
-            if focus.extent().max_element() > 50.0 { Aabb::new(Vec3::splat(-5.0), Vec3::splat(5.0)) } else { focus };
-        let centre = (focus.min + focus.max) / 2.0;
-        let reach = focus.extent().max_element();
-        let mut rays = fan(centre + Vec3::new(0.3, 0.4, 1.6) * reach, centre, reach, 37);
-        rays.extend(random_queries(&mut rng, &focus, 500).into_iter().map(|(r, _, _)| r));
-        rays.extend(axis_rays(&prims, &mut rng, 60).into_iter().map(|(r, _, _)| r));
-        rays.push(ray(centre + Vec3::splat(10.0 * reach), Vec3::ONE));
+    for (name, prims, rays, reach) in packet_cases(&mut rng) {
         for t_max in [f32::INFINITY, 1.2 * reach] {
             for (way, wide) in
                 [("AVX where present", Wide::build(&prims)), ("two halves", Wide::build_without_avx(&prims))]
@@ -850,21 +866,8 @@ fn packets_find_the_single_ray_walks_hits() {
 #[test]
 fn shadow_packets_answer_as_single_rays() {
     let mut rng = Pcg::new(17);
-    let sphere = mesh_primitives(welded_sphere(96, 48), Mat4::IDENTITY);
-    let showcase = scene_primitives(&Scene::load(&mirador::scene::builtin_path("showcase.toml")).unwrap());
-    let mut awkward = triangle_soup(&mut rng, 300);
-    awkward.extend(scene_primitives(&analytic_scene()));
     let (mut occluded_seen, mut clear_seen) = (0, 0);
-    for (name, prims) in [("sphere mesh", sphere), ("showcase", showcase), ("soup and analytic", awkward)] {
-        let focus = bounds_of(&prims);
-        let focus =
-            if focus.extent().max_element() > 50.0 { Aabb::new(Vec3::splat(-5.0), Vec3::splat(5.0)) } else { focus };
-        let centre = (focus.min + focus.max) / 2.0;
-        let reach = focus.extent().max_element();
-        let mut rays = fan(centre + Vec3::new(0.3, 0.4, 1.6) * reach, centre, reach, 37);
-        rays.extend(random_queries(&mut rng, &focus, 500).into_iter().map(|(r, _, _)| r));
-        rays.extend(axis_rays(&prims, &mut rng, 60).into_iter().map(|(r, _, _)| r));
-        rays.push(ray(centre + Vec3::splat(10.0 * reach), Vec3::ONE));
+    for (name, prims, rays, reach) in packet_cases(&mut rng) {
         let t_max: Vec<f32> = (0..rays.len())
             .map(|i| match i % 4 {
                 0 => f32::INFINITY,

@@ -4,8 +4,8 @@
 # with WebGL2 (on SwiftShader too); headed under Xvfb (headless Chromium cannot make a WebGPU
 # canvas's swap chain, and the device is lost). Each time the page takes its screenshots through
 # its own interface (web/test.js), and they are checked against the native renderers
-# (`cargo test --test web_page -- --ignored`, tests/web_page.rs). Installs Chromium and Xvfb when
-# missing.
+# (`cargo test --test web_page the_page_draws -- --ignored`, tests/web_page.rs; the course-links
+# test beside it is web/site-test.sh's). Installs Chromium and Xvfb when missing.
 # Takes about 10 minutes cold (web/README.md); CI runs the web build's compile check instead
 # (tests/web.rs).
 set -euo pipefail
@@ -46,6 +46,6 @@ for api in webgpu webgl2; do
     fi
     echo "$api: $(grep -ao "adapter: [^\"]*profile" "$work/browser.log" | tail -1)"
     grep -ao "first frame [0-9]* ms after the page started loading\|traced [0-9]*×[0-9]* in [0-9.]* s ([^)\"]*)" "$work/browser.log" || true
-    MIRADOR_WEB_CAPTURE="$capture" cargo test --locked --test web_page -- --ignored --nocapture
+    MIRADOR_WEB_CAPTURE="$capture" cargo test --locked --test web_page the_page_draws -- --ignored --nocapture
     echo "the page's screenshots ($api): $capture"
 done
