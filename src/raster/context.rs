@@ -174,7 +174,9 @@ impl<'g> FrameEncoder<'g> {
         self.encoder.push_debug_group(name);
         let recorded = record(self);
         self.encoder.pop_debug_group();
-        self.groups.as_mut().map(Vec::pop);
+        if let Some(groups) = &mut self.groups {
+            groups.pop();
+        }
         recorded
     }
 

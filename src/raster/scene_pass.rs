@@ -299,7 +299,6 @@ impl PreparedScene<'_> {
             &[],
             Some(layout::depth_attachment(&targets.depth.view, wgpu::LoadOp::Clear(1.0))),
         ));
-        pass.push_debug_group("depth prepass");
         scissor(&mut pass, view);
         pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view.slot)]);
         pass.set_bind_group(2, ctx.view_group(view), &[]);
@@ -312,7 +311,6 @@ impl PreparedScene<'_> {
             pass.set_bind_group(1, &scene.materials()[batch.material], &[]);
             scene.geometry.draw(&mut pass, batch);
         }
-        pass.pop_debug_group();
     }
 
     /// Shades every surface seen from `view` (after its prepass when it has one); transparent
@@ -338,7 +336,6 @@ impl PreparedScene<'_> {
             ))],
             Some(layout::depth_attachment(&targets.depth.view, depth_load)),
         ));
-        pass.push_debug_group("opaque");
         scissor(&mut pass, view);
         pass.set_bind_group(0, scene.frame_group(), &[scene.views.offset(view.slot)]);
         pass.set_bind_group(2, ctx.view_group(view), &[]);
@@ -379,7 +376,6 @@ impl PreparedScene<'_> {
             pass.set_bind_group(1, &self.pass.empty_group, &[]);
             pass.draw(0..3, 0..1);
         }
-        pass.pop_debug_group();
     }
 }
 

@@ -66,11 +66,15 @@ impl ViewArray {
         }
     }
 
-    /// Its layers: past the last of its images, and at least two, since GL makes a texture of
-    /// one layer a plain 2D texture, which no array view reads.
+    /// Its layers: past the last of its images, and a count GL reads as an array. wgpu's GL
+    /// backend decides a texture's kind from its size when it is made: one layer is a plain 2D
+    /// texture, and a square one with a multiple of six layers a cube (the copied array's one
+    /// pixel is square, and so are the cube faces' targets); no array view reads either. So at
+    /// least two, and never a multiple of six.
     pub fn layers(self) -> u32 {
         let images = ViewImage::ALL.into_iter().filter(|i| i.array() == self);
-        images.map(|i| i.first_layer() + i.layers()).max().unwrap_or(0).max(2)
+        let layers = images.map(|i| i.first_layer() + i.layers()).max().unwrap_or(0).max(2);
+        if layers.is_multiple_of(6) { layers + 1 } else { layers }
     }
 
     fn on_demand(self) -> bool {
@@ -161,7 +165,7 @@ impl ViewImages {
     }
 
     /// The array that holds `image`.
-    pub fn get(&self, image: ViewImage) -> &GpuTexture {
+    pub fn array_of(&self, image: ViewImage) -> &GpuTexture {
         self.array(image.array())
     }
 
@@ -257,8 +261,9 @@ mod tests {
                 }
             }
         }
-        // The traced terms' layers are the approximations table's, from the surface's.
-        assert_eq!(ViewImage::Traced.layers(), crate::settings::hybrid::TRACED_LAYERS);
-        assert!(ViewArray::Drawn.layers() >= 2, "GL reads no array view of a one-layer texture");
+        for array in ViewArray::ALL {
+            let layers = array.layers();
+            assert!(layers >= 2 && !layers.is_multiple_of(6), "GL reads {array:?}'s {layers} layers as no array");
+        }
     }
 }

@@ -164,7 +164,7 @@ impl PreparedTraced {
     /// Copies `view`'s terms into its traced image, which the view's shading then reads.
     pub fn record(&self, frame: &mut FrameEncoder, view: &FrameView, targets: &FrameTargets) {
         let Some((_, upload)) = self.views.iter().find(|(slot, _)| *slot == view.slot) else { return };
-        let image = &targets.images.get(ViewImage::Traced).texture;
+        let image = &targets.images.array_of(ViewImage::Traced).texture;
         let [x, y, width, height] = upload.window;
         let layer_bytes = u64::from(padded_row(width) * height);
         for (k, &layer) in upload.layers.iter().enumerate() {

@@ -140,13 +140,12 @@ wgsl_constants! {
     TONE_MAP_REINHARD: u32 as U32 = 1;
     TONE_MAP_ACES: u32 as U32 = 2;
     TONE_MAP_PBR_NEUTRAL: u32 as U32 = 3;
-    /// The view's images (`crate::raster::targets::ViewImage`) are layers of its two arrays, one
-    /// view-group binding each: `drawn_images`, which its raster passes draw and blend, and
-    /// `copied_images`, which the CPU copies in. Each image's first layer: the projected-shadow
-    /// mask's, of the drawn images;
+    /// The projected-shadow mask's first layer of the view's `drawn_images`, the array its raster
+    /// passes draw and blend (each view image is layers of one of the view's two arrays,
+    /// `crate::raster::targets::ViewImage`).
     PROJECTED_MASK_LAYER: u32 as I32 = 0;
-    /// the hybrid's traced terms', of the copied images (`TRACED_SURFACE_LAYER` and each row's
-    /// `TRACED_NAME_LAYER` count from it).
+    /// The hybrid's traced terms' first layer of the view's `copied_images`, the array the CPU
+    /// copies into (`TRACED_SURFACE_LAYER` and each row's `TRACED_NAME_LAYER` count from it).
     TRACED_FIRST_LAYER: u32 as I32 = 0;
 }
 

@@ -338,15 +338,13 @@ impl ShadowPass {
                 !keep
             })
             .collect();
-        if !stale.is_empty() {
-            frame.encoder.push_debug_group("shadow maps");
+        frame.group("shadow maps", |frame| {
             for &layer in &stale {
                 let slot = ViewSlot(first_slot + layer as u32);
                 scene.views.write(&gpu.queue, slot, &View::projection_only(layout.views[layer].clip_from_world));
                 self.record_layer(&mut frame.encoder, scene, layer, slot);
             }
-            frame.encoder.pop_debug_group();
-        }
+        });
         frame.end("shadow maps", &[("layers drawn", Figure::Count(stale.len() as u64))]);
     }
 

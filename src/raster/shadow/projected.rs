@@ -276,12 +276,10 @@ impl ProjectedPass {
         ));
         let polygons = self.polygons.as_ref().filter(|p| p.vertices.is_some());
         if let Some(Polygons { vertices: Some(vertices), count, .. }) = polygons {
-            pass.push_debug_group("projected shadows");
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, scene_gpu.frame_group(), &[scene_gpu.views.offset(view.slot)]);
             pass.set_vertex_buffer(0, vertices.slice(..));
             pass.draw(0..*count, 0..1);
-            pass.pop_debug_group();
         }
         drop(pass);
         let polygons = self.polygons.as_ref().map_or(0, |p| u64::from(p.count / 3));

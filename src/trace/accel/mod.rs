@@ -104,9 +104,10 @@ pub trait Accelerator: Send + Sync {
     }
 
     /// Whether anything is hit along each of `rays` in `(t_min, t_max[i])`, into `occluded`:
-    /// [`Self::occluded`] for each. Coherent shadow rays (neighbouring pixels' towards one
-    /// light, in blocks of 16) are traced together where the accelerator can
-    /// ([`wide::packets`]), with the same answers.
+    /// [`Self::occluded`] for each, or 16 at a time where the accelerator can
+    /// ([`wide::packets`]), with the same answers. The tracer casts its shadow rays one by one:
+    /// packets of them measured slower (docs/performance.md); `benches/trace.rs` keeps the
+    /// comparison.
     fn occluded_packets(
         &self,
         prims: &[Primitive],
