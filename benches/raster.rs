@@ -23,6 +23,8 @@
 //!    at 1280×720, with and without early termination, and the grid's memory on each side.
 //! 8. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
 //!    about a million triangles: upload, frame, triangles, beside `trace` of the same scene.
+//! 9. The hybrid (`-- hybrid`): the showcase with its four per-pixel terms traced, still and
+//!    with the camera turning, as ratios to the plain frame still and turning.
 //!
 //! Times are wall-clock from submit to the queue being idle (the median of several frames after
 //! warm-up), so they include the driver's work on the CPU: on lavapipe that is all of it.
@@ -646,13 +648,52 @@ fn volume_costs(gpu: &Gpu) {
     println!("{:>44} {:.0} s (the grid, the count and the rounds)", "this section took", start.elapsed().as_secs_f64());
 }
 
+/// The hybrid with its four per-pixel terms traced (shadows, reflections, transmission,
+/// textures) against the plain frame, the showcase at 1280×720: the view still (the terms kept
+/// while nothing changes, `raster::traced::KeptTraced`) and moving (the camera turned a quarter
+/// of a degree about the target every frame, so every view is traced again, as the plain frame
+/// draws its views again). Each a median of [`FRAMES`] after two warm-up frames.
+fn hybrid_costs(gpu: &Gpu) {
+    let scene = Scene::showcase().expect("the built-in showcase loads");
+    let plain = scene.settings.clone();
+    let mut hybrid = plain.clone();
+    for term in ["shadows", "reflections", "transmission", "textures"] {
+        hybrid.set(&format!("hybrid.{term}=true")).expect("a hybrid switch");
+    }
+    let moving = |settings: &RenderSettings| {
+        let mut scene = scene.clone();
+        let mut bench = Bench::new(gpu, &scene);
+        let times = (0..FRAMES + 2)
+            .map(|_| {
+                let (c, e) = (scene.camera.center, scene.camera.eye - scene.camera.center);
+                scene.camera.eye =
+                    c + glam::Quat::from_axis_angle(scene.camera.up.normalize(), 0.25f32.to_radians()) * e;
+                bench.frame(&scene, settings).0
+            })
+            .skip(2)
+            .collect();
+        median(times)
+    };
+    println!("\nthe hybrid, showcase 1280×720, median of {FRAMES} frames, ratios to the plain frame");
+    let (still, still_plain) = (frame_time(gpu, &scene, &hybrid), frame_time(gpu, &scene, &plain));
+    let (turning, turning_plain) = (moving(&hybrid), moving(&plain));
+    for (name, frame, base) in [("still", still, still_plain), ("moving", turning, turning_plain)] {
+        println!(
+            "{name:>8}: plain {:>7.1} ms, all four traced {:>7.1} ms, {:>5.2}×",
+            ms(base),
+            ms(frame),
+            frame.as_secs_f64() / base.as_secs_f64()
+        );
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let quick = args.iter().any(|a| a == "--quick");
     // Section names on the command line run those sections alone:
     // `cargo bench --bench raster -- transparency`.
-    const SECTIONS: [&str; 8] =
-        ["showcase", "shadows", "transparency", "mirrors", "environment", "refraction", "volume", "growing"];
+    const SECTIONS: [&str; 9] =
+        ["showcase", "shadows", "transparency", "mirrors", "environment", "refraction", "volume", "growing", "hybrid"];
     let chosen: Vec<&str> = SECTIONS.into_iter().filter(|s| args.iter().any(|a| a == s)).collect();
     let run = |section: &str| chosen.is_empty() || chosen.contains(&section);
     let gpu = Gpu::headless().expect("the benchmark needs a graphics adapter");
@@ -680,5 +721,8 @@ fn main() {
     }
     if run("growing") {
         growing_scenes(&gpu, quick);
+    }
+    if run("hybrid") {
+        hybrid_costs(&gpu);
     }
 }
