@@ -34,23 +34,6 @@ impl GpuTexture {
         Self::image(device, label, size, format, usage)
     }
 
-    /// A 2D array of `layers` images with `usage`, viewed as an array whatever its number of
-    /// layers (on GL, only where it has more than one: one layer is a plain 2D texture there).
-    pub fn layered_array(
-        device: &wgpu::Device,
-        label: &str,
-        (size, layers): ((u32, u32), u32),
-        format: wgpu::TextureFormat,
-        usage: wgpu::TextureUsages,
-    ) -> GpuTexture {
-        let texture = Self::layered(device, label, (size, layers), format, usage);
-        let view = texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
-        GpuTexture { texture, view }
-    }
-
     /// One 2D image of one level, with `usage`.
     fn image(
         device: &wgpu::Device,

@@ -3,7 +3,7 @@
 //! show them (`super::mirror`, `super::environment`). Every view draws into its own, so the
 //! phases of one view never read what another is writing.
 
-use crate::gpu::texture::GpuTexture;
+use crate::gpu::texture::{GpuTexture, Layers};
 use crate::shaders::constants;
 
 /// Linear radiance, before the output transform.
@@ -66,15 +66,13 @@ impl ViewArray {
         }
     }
 
-    /// Its layers: past the last of its images, and a count GL reads as an array. wgpu's GL
-    /// backend decides a texture's kind from its size when it is made: one layer is a plain 2D
-    /// texture, and a square one with a multiple of six layers a cube (the copied array's one
-    /// pixel is square, and so are the cube faces' targets); no array view reads either. So at
-    /// least two, and never a multiple of six.
+    /// Its layers: up to the last of its images. The texture is made with as many more as GL
+    /// needs to keep it an array ([`Layers::count`]: one layer would be a plain 2D texture, and
+    /// a square one of six a cube; the copied array's one pixel is square, and so are the cube
+    /// faces' targets).
     pub fn layers(self) -> u32 {
         let images = ViewImage::ALL.into_iter().filter(|i| i.array() == self);
-        let layers = images.map(|i| i.first_layer() + i.layers()).max().unwrap_or(0).max(2);
-        if layers.is_multiple_of(6) { layers + 1 } else { layers }
+        images.map(|i| i.first_layer() + i.layers()).max().unwrap_or(0)
     }
 
     fn on_demand(self) -> bool {
@@ -192,7 +190,19 @@ fn make(device: &wgpu::Device, array: ViewArray, size: (u32, u32)) -> GpuTexture
         ViewArray::Drawn => wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
         ViewArray::Copied => wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::TEXTURE_BINDING,
     };
-    GpuTexture::layered_array(device, array.label(), (size, array.layers()), array.format(), usage)
+    Layers::Array(array.layers()).texture(
+        device,
+        &wgpu::TextureDescriptor {
+            label: Some(array.label()),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: array.format(),
+            usage,
+            view_formats: &[],
+        },
+    )
 }
 
 /// The size a frame is drawn at: the output's times the render scale, at least one pixel.
@@ -261,8 +271,10 @@ mod tests {
                 }
             }
         }
+        // Made square (the copied array's one pixel, a cube face's targets), each is made with a
+        // count GL keeps an array.
         for array in ViewArray::ALL {
-            let layers = array.layers();
+            let layers = Layers::Array(array.layers()).count((1, 1), crate::shaders::Profile::Standard);
             assert!(layers >= 2 && !layers.is_multiple_of(6), "GL reads {array:?}'s {layers} layers as no array");
         }
     }

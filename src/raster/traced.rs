@@ -38,7 +38,6 @@ pub fn wanted(settings: &RenderSettings) -> Option<Wanted> {
 
 /// Every view's traced terms, ready to be copied into its image: each view's buffer holds the
 /// layers traced, one after another, each the view's window.
-#[derive(Clone)]
 pub struct PreparedTraced {
     views: Vec<(ViewSlot, Upload)>,
 }
