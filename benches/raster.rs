@@ -25,6 +25,11 @@
 //!    about a million triangles: upload, frame, triangles, beside `trace` of the same scene.
 //! 9. The hybrid (`-- hybrid`): the showcase with its four per-pixel terms traced, still and
 //!    with the camera turning, as ratios to the plain frame still and turning.
+//! 10. Displacement (`-- displacement`): the cobbled ball at 1280×720, bump-mapped, displaced with
+//!    the tracer's uniform mesh, and tessellated on the GPU for the view at several edge lengths,
+//!    still and turning (made again every frame), as ratios to the bump-mapped frame; the
+//!    triangles and the buffers' memory of each; the tracer on the displaced ball against the
+//!    bump-mapped one.
 //!
 //! Times are wall-clock from submit to the queue being idle (the median of several frames after
 //! warm-up), so they include the driver's work on the CPU: on lavapipe that is all of it.
@@ -687,13 +692,85 @@ fn hybrid_costs(gpu: &Gpu) {
     }
 }
 
+/// Displacement's cost, the cobbled ball at 1280×720 (see the header).
+fn displacement_costs(gpu: &Gpu) {
+    use mirador::settings::{BumpMethod, Tessellation};
+    let path = mirador::scene::builtin_path("course/displacement-sphere.toml");
+    let mut bumped = Scene::load(&path).expect("the displaced ball's scene loads");
+    (bumped.camera.width, bumped.camera.height) = (1280, 720);
+    let mut displaced = bumped.clone();
+    displaced.settings.bump.method = BumpMethod::Displacement;
+    mirador::texture::displacement::displace(&mut displaced);
+    let turning = |scene: &Scene, settings: &RenderSettings| {
+        let mut scene = scene.clone();
+        let mut bench = Bench::new(gpu, &scene);
+        let times = (0..FRAMES + 2)
+            .map(|_| {
+                let (c, e) = (scene.camera.center, scene.camera.eye - scene.camera.center);
+                scene.camera.eye = c + glam::Quat::from_axis_angle(Vec3::Y, 0.5f32.to_radians()) * e;
+                bench.frame(&scene, settings).0
+            })
+            .skip(2)
+            .collect();
+        median(times)
+    };
+    println!("\ndisplacement, the cobbled ball 1280×720, median of {FRAMES} frames, ratios to bump mapping's");
+    let base = (frame_time(gpu, &bumped, &bumped.settings), turning(&bumped, &bumped.settings));
+    let row = |name: &str, frames: (Duration, Duration), made: &str| {
+        let ratio = |a: Duration, b: Duration| a.as_secs_f64() / b.as_secs_f64();
+        println!(
+            "{name:>22}: still {:>6.1} ms {:>5.2}×, turning {:>6.1} ms {:>5.2}×  {made}",
+            ms(frames.0),
+            ratio(frames.0, base.0),
+            ms(frames.1),
+            ratio(frames.1, base.1)
+        );
+    };
+    row("bump mapping", base, "");
+    let mut uniform = displaced.settings.clone();
+    uniform.bump.tessellation = Tessellation::Uniform;
+    let mesh = displaced.meshes.last().expect("the displaced mesh");
+    let bytes = mesh.positions.len() * 48 + mesh.indices.len() * 4;
+    let made = format!("{} triangles, {:.1} MB", mesh.indices.len() / 3, bytes as f64 / 1e6);
+    row("uniform (the tracer's)", (frame_time(gpu, &displaced, &uniform), turning(&displaced, &uniform)), &made);
+    for pixels in [16.0, 8.0, 4.0, 2.0, 1.0] {
+        let mut adaptive = displaced.settings.clone();
+        adaptive.bump.edge_pixels = pixels;
+        let mut bench = Bench::new(gpu, &displaced);
+        let still = bench.median_frame(&displaced, &adaptive);
+        let report = bench.renderer.tessellation_report().expect("tessellated on the GPU").clone();
+        let bytes = report.vertices * 48 + report.triangles * 12;
+        let made =
+            format!("{} triangles, finest split {}, {:.1} MB", report.triangles, report.finest, bytes as f64 / 1e6);
+        row(&format!("adaptive, {pixels} px"), (still, turning(&displaced, &adaptive)), &made);
+    }
+    let (traced_bumped, traced_displaced) = (trace_time(&bumped), trace_time(&displaced));
+    println!(
+        "{:>22}: bump-mapped {:.0} ms, displaced {:.0} ms, {:.2}×",
+        "the tracer",
+        ms(traced_bumped),
+        ms(traced_displaced),
+        traced_displaced.as_secs_f64() / traced_bumped.as_secs_f64()
+    );
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let quick = args.iter().any(|a| a == "--quick");
     // Section names on the command line run those sections alone:
     // `cargo bench --bench raster -- transparency`.
-    const SECTIONS: [&str; 9] =
-        ["showcase", "shadows", "transparency", "mirrors", "environment", "refraction", "volume", "growing", "hybrid"];
+    const SECTIONS: [&str; 10] = [
+        "showcase",
+        "shadows",
+        "transparency",
+        "mirrors",
+        "environment",
+        "refraction",
+        "volume",
+        "growing",
+        "hybrid",
+        "displacement",
+    ];
     let chosen: Vec<&str> = SECTIONS.into_iter().filter(|s| args.iter().any(|a| a == s)).collect();
     let run = |section: &str| chosen.is_empty() || chosen.contains(&section);
     let gpu = Gpu::headless().expect("the benchmark needs a graphics adapter");
@@ -724,5 +801,8 @@ fn main() {
     }
     if run("hybrid") {
         hybrid_costs(&gpu);
+    }
+    if run("displacement") {
+        displacement_costs(&gpu);
     }
 }

@@ -899,6 +899,9 @@ fn rasterize(
             let profiled = frame(&mut renderer);
             let meshes = renderer.scene_gpu().geometry.mesh_count();
             print_frame_stats(&first, &second, &profiled, meshes, renderer.shader_variants());
+            if let Some(report) = renderer.tessellation_report() {
+                println!("{}", report.summary());
+            }
         }
         clock.time("readback", || {
             let pixels = readback::read_rgba8(&gpu.device, &gpu.queue, &output.texture)?;

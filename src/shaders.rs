@@ -86,6 +86,8 @@ pub const OVERLAYS: &str = include_str!("../shaders/overlays.wgsl");
 pub const ENVIRONMENT: &str = include_str!("../shaders/environment.wgsl");
 /// The viewer's: its 3D view's image stretched over the view while the camera moves.
 pub const UPSCALE: &str = include_str!("../shaders/upscale.wgsl");
+/// Displacement tessellated adaptively, in compute shaders (src/raster/tessellation).
+pub const TESSELLATION: &str = include_str!("../shaders/tessellation.wgsl");
 
 /// Every pass's whole source, by name, for tests that validate them all.
 pub fn passes() -> Vec<(&'static str, String)> {
@@ -181,6 +183,7 @@ impl Wgsl {
             ("overlays", OVERLAYS),
             ("environment", ENVIRONMENT),
             ("upscale", UPSCALE),
+            ("tessellation", TESSELLATION),
         ];
         let surface = surface.into_iter().map(|(name, pass)| (name, self.compose_surface(pass)));
         surface.chain(others.into_iter().map(|(name, pass)| (name, self.compose(pass)))).collect()

@@ -7,12 +7,19 @@
 //!   self-shadows;
 //! - the displaced sphere is closed (no sky through it), whatever the seam and the poles;
 //! - bad input (a huge scale, a bound on triangles) ends in a surface or a said level, never a
-//!   panic or unbounded memory.
+//!   panic or unbounded memory;
+//! - adaptive tessellation on the GPU (`bump.tessellation = "adaptive"`, the default) makes the
+//!   triangles its CPU twin makes, closed where neighbours have different levels and across a
+//!   seam whose two sides have different heights, finer near the camera, within its bound.
 
 mod common;
 
+use glam::Vec3;
 use mirador::Scene;
-use mirador::settings::BumpMethod;
+use mirador::raster::geometry::SceneGeometry;
+use mirador::raster::tessellation::pass::TessellationPass;
+use mirador::raster::tessellation::{self, Patches};
+use mirador::settings::{BumpMethod, Tessellation};
 use mirador::texture::displacement::{self, MAX_TRIANGLES};
 
 /// `path`'s scene with `method`, displaced when asked.
@@ -30,18 +37,25 @@ fn raster_against_traced(raster: &Scene, traced: &Scene) -> f32 {
 }
 
 /// The displaced sphere and plane: raster against the tracer on one displaced surface, and bump
-/// mapping against the same traced surface.
+/// mapping against the same traced surface. The rasterizer draws the tracer's triangles
+/// (`uniform`) or its own, made on the GPU for the view (`adaptive`): either agrees with it.
 #[test]
 fn both_renderers_draw_one_displaced_surface_and_bump_mapping_misses_it() {
     for path in ["scenes/course/displacement-sphere.toml", "scenes/course/displacement-plane.toml"] {
         let displaced = with_method(path, BumpMethod::Displacement);
         let bumped = with_method(path, BumpMethod::Normal);
-        let agree = raster_against_traced(&displaced, &displaced);
         let bump = raster_against_traced(&bumped, &displaced);
-        eprintln!("{path}: displaced raster vs displaced tracer {agree:.4}; bump raster vs displaced tracer {bump:.4}");
-        // Measured on lavapipe: see tests/README.md.
-        assert!(agree < 0.02, "{path}: the two renderers on one displaced surface: FLIP {agree}");
-        assert!(bump > 2.0 * agree, "{path}: bump mapping {bump} is not worse than displacement {agree}");
+        for tessellation in [Tessellation::Uniform, Tessellation::Adaptive] {
+            let mut raster = displaced.clone();
+            raster.settings.bump.tessellation = tessellation;
+            let agree = raster_against_traced(&raster, &displaced);
+            eprintln!(
+                "{path}: {tessellation:?} displaced raster vs tracer {agree:.4}; bump raster vs displaced tracer {bump:.4}"
+            );
+            // Measured on lavapipe: see tests/README.md.
+            assert!(agree < 0.02, "{path}, {tessellation:?}: the two renderers on one displaced surface: FLIP {agree}");
+            assert!(bump > 2.0 * agree, "{path}: bump mapping {bump} is not worse than displacement {agree}");
+        }
     }
 }
 
@@ -97,7 +111,8 @@ fn bump_mapping_keeps_a_circular_silhouette_and_displacement_breaks_it() {
 }
 
 /// No sky through a closed displaced sphere: every pixel well inside its outline is the ball,
-/// across the seam (u = 0 = 1) and at the poles, where vertices at one point are moved together.
+/// across the seam (u = 0 = 1) and at the poles, where vertices at one point are moved together;
+/// in the tracer's triangles and in the GPU's adaptive ones alike.
 #[test]
 fn a_displaced_sphere_is_closed() {
     let mut scene = with_method("scenes/course/displacement-sphere.toml", BumpMethod::Displacement);
@@ -108,18 +123,151 @@ fn a_displaced_sphere_is_closed() {
     for object in &mut scene.objects {
         object.world_from_local = turn * object.world_from_local;
     }
-    let image = common::raster(&scene, &scene.settings);
-    let (w, h) = (image.width() as f32, image.height() as f32);
-    // The ball's outline on screen: radius 0.8 at distance ~2.92 with fovy 40°.
-    let radius_pixels = 0.8 / (2.92 * (20f32.to_radians()).tan()) * h / 2.0;
-    let mut holes = 0;
-    for (x, y, p) in image.enumerate_pixels() {
-        let d = ((x as f32 + 0.5 - w / 2.0).powi(2) + (y as f32 + 0.5 - h / 2.0 + 0.0).powi(2)).sqrt();
-        if d < 0.85 * radius_pixels && p.0[0] > 200 && p.0[1] < 60 && p.0[2] > 200 {
-            holes += 1;
+    for tessellation in [Tessellation::Uniform, Tessellation::Adaptive] {
+        scene.settings.bump.tessellation = tessellation;
+        let image = common::raster(&scene, &scene.settings);
+        let (w, h) = (image.width() as f32, image.height() as f32);
+        // The ball's outline on screen: radius 0.8 at distance ~2.92 with fovy 40°.
+        let radius_pixels = 0.8 / (2.92 * (20f32.to_radians()).tan()) * h / 2.0;
+        let mut holes = 0;
+        for (x, y, p) in image.enumerate_pixels() {
+            let d = ((x as f32 + 0.5 - w / 2.0).powi(2) + (y as f32 + 0.5 - h / 2.0 + 0.0).powi(2)).sqrt();
+            if d < 0.85 * radius_pixels && p.0[0] > 200 && p.0[1] < 60 && p.0[2] > 200 {
+                holes += 1;
+            }
+        }
+        assert_eq!(holes, 0, "{tessellation:?}: {holes} background pixels inside the displaced ball");
+    }
+}
+
+/// The edges of a triangle list not met by exactly two triangles, by their ends' bits (triangles
+/// folded to a line or a point left out: snapping makes some, and they cover nothing).
+fn open_edges(positions: &[Vec3], indices: &[u32]) -> usize {
+    let key = |i: u32| (positions[i as usize] + Vec3::ZERO).to_array().map(f32::to_bits);
+    let mut edges: std::collections::HashMap<([u32; 3], [u32; 3]), i32> = Default::default();
+    for t in indices.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|i| positions[i as usize]);
+        if (b - a).cross(c - a).length_squared() == 0.0 {
+            continue;
+        }
+        for (p, q) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+            let (p, q) = (key(p), key(q));
+            *edges.entry(if p < q { (p, q) } else { (q, p) }).or_default() += 1;
         }
     }
-    assert_eq!(holes, 0, "{holes} background pixels inside the displaced ball");
+    edges.values().filter(|&&count| count != 2).count()
+}
+
+/// The displaced ball seen from near by (its triangles' levels differ: long edges in front, short
+/// ones at the outline), its height map made a ramp `f = u` that does not tile, so the seam's two
+/// sides have different heights.
+fn ball_near_with_a_seam() -> Scene {
+    let mut scene = common::load("scenes/course/displacement-sphere.toml");
+    for texture in &mut scene.textures {
+        let width = texture.width.max(2) as usize;
+        for (i, texel) in texture.rgba8.chunks_exact_mut(4).enumerate() {
+            texel[..3].fill(((i % width) * 255 / (width - 1)) as u8);
+        }
+    }
+    scene.settings.bump.method = BumpMethod::Displacement;
+    scene.settings.bump.edge_pixels = 6.0;
+    displacement::displace(&mut scene);
+    scene.camera.eye = Vec3::new(0.6, 0.5, 1.9);
+    scene
+}
+
+/// The pass that tessellated `scene`'s displaced objects on the GPU, and the geometry it gave
+/// them to.
+fn tessellated_on_the_gpu(scene: &Scene) -> (TessellationPass, SceneGeometry) {
+    let gpu = common::gpu();
+    let mut pass = TessellationPass::new(&gpu.device);
+    pass.load(gpu, scene);
+    let mut geometry = SceneGeometry::new(scene, &[], &[]);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    pass.prepare(gpu, &mut encoder, scene, &scene.settings, &mut geometry).expect("a report");
+    gpu.queue.submit([encoder.finish()]);
+    (pass, geometry)
+}
+
+/// The GPU's adaptive triangles: closed, where neighbours have different levels and across a seam
+/// whose two sides' heights differ (each edge point made once, from the edge alone, on either
+/// side), and the very triangles the CPU twin makes (`Patches::tessellate`).
+#[test]
+fn adaptive_tessellation_is_closed_between_levels_and_is_the_cpus() {
+    let scene = ball_near_with_a_seam();
+    let (pass, geometry) = tessellated_on_the_gpu(&scene);
+    assert!(geometry.has_displaced());
+    let made = pass.read_back(common::gpu());
+    let twins = pass.cpu_meshes(&scene);
+    assert_eq!((made.len(), twins.len()), (1, 1));
+    let ((vertices, indices), (_, twin)) = (&made[0], &twins[0]);
+    eprintln!("{}", pass.report.as_ref().expect("a report").summary());
+    // The levels differ from triangle to triangle, and some edges are coarser than their
+    // triangles: the case snapping is for.
+    let patches = Patches::new(&scene, 0).expect("patches");
+    let bump = &scene.settings.bump;
+    let levels = patches.levels(&scene.camera, bump.edge_pixels, bump.displacement_texels);
+    let splits: Vec<u32> = levels.patches.iter().map(|l| l[3]).collect();
+    let (least, most) = (splits.iter().min().unwrap(), splits.iter().max().unwrap());
+    let snapped = levels.patches.iter().filter(|l| l[..3].iter().any(|&e| e < l[3])).count();
+    eprintln!("splits {least} to {most}; {snapped} of {} triangles have a coarser edge", splits.len());
+    assert!(least < most && snapped > 100, "the levels do not vary: {least} to {most}, {snapped} snapped");
+    assert_eq!((vertices.len() as u64, indices.len() as u64 / 3), (levels.vertices, levels.triangles));
+    assert!(indices.iter().all(|&i| (i as usize) < vertices.len()));
+    let positions: Vec<Vec3> = vertices.iter().map(|v| Vec3::from_array(v.position)).collect();
+    assert_eq!(open_edges(&twin.positions, &twin.indices), 0, "the CPU twin's triangles are closed");
+    assert_eq!(open_edges(&positions, indices), 0, "the GPU's triangles are closed");
+    // The same triangles as the CPU twin's: positions to f32 rounding, normals to a fraction of
+    // a degree.
+    assert_eq!(twin.indices, *indices);
+    let (mut far, mut turned) = (0f32, 1f32);
+    for (v, (p, n)) in vertices.iter().zip(twin.positions.iter().zip(&twin.normals)) {
+        far = far.max(Vec3::from_array(v.position).distance(*p));
+        turned = turned.min(Vec3::from_array(v.normal).dot(*n));
+    }
+    eprintln!("GPU against CPU: positions within {far:e}, normals within {:.3}°", turned.min(1.0).acos().to_degrees());
+    assert!(far < 1e-4 && turned > 0.9999, "GPU against CPU: {far}, {turned}");
+}
+
+/// Adaptive tessellation follows the screen: nearer, or with shorter edges asked, more
+/// triangles; never finer than the height field's own rule.
+#[test]
+fn adaptive_tessellation_is_finer_near_the_camera() {
+    let scene = ball_near_with_a_seam();
+    let patches = Patches::new(&scene, 0).expect("patches");
+    let texels = scene.settings.bump.displacement_texels;
+    let triangles = |eye: Vec3, pixels: f32| {
+        let mut camera = scene.camera.clone();
+        camera.eye = eye;
+        patches.levels(&camera, pixels, texels).triangles
+    };
+    let (near, far) = (triangles(Vec3::new(0.0, 0.3, 1.6), 6.0), triangles(Vec3::new(0.0, 3.0, 16.0), 6.0));
+    let (coarse, fine) = (triangles(Vec3::new(0.0, 0.3, 2.9), 12.0), triangles(Vec3::new(0.0, 0.3, 2.9), 3.0));
+    eprintln!("near {near}, far {far}; 12 px {coarse}, 3 px {fine}");
+    assert!(near > 4 * far && fine > 4 * coarse, "near {near}, far {far}; 12 px {coarse}, 3 px {fine}");
+    // The field's rule bounds it: no more than the uniform mesh has, however short the edges.
+    let uniform = scene.meshes.last().expect("the uniform mesh").indices.len() as u64 / 3;
+    assert!(triangles(Vec3::new(0.0, 0.3, 1.2), 0.5) <= uniform);
+}
+
+/// The bound: edges asked half a pixel long on a finely tessellated ball would make tens of
+/// millions of triangles; the levels are made coarser until at most two million remain, and the
+/// report says the edge length used.
+#[test]
+fn adaptive_tessellation_keeps_to_its_bound_and_says_so() {
+    let mut scene = common::load("scenes/course/displacement-sphere.toml");
+    scene.settings.bump.method = BumpMethod::Displacement;
+    scene.settings.bump.displacement_texels = 0.25;
+    scene.settings.bump.edge_pixels = 0.5;
+    scene.settings.sphere_segments = 192;
+    scene.camera.width = 1920;
+    scene.camera.height = 1440;
+    displacement::displace(&mut scene);
+    let (pass, _) = tessellated_on_the_gpu(&scene);
+    let report = pass.report.clone().expect("a report");
+    eprintln!("{}", report.summary());
+    assert!(report.triangles <= tessellation::MAX_TRIANGLES && report.triangles > tessellation::MAX_TRIANGLES / 3);
+    assert!(report.edge_pixels > 1.0 && report.summary().contains("forced longer edges"), "{}", report.summary());
 }
 
 /// What `bump.method = "normal"` does to a scene: nothing; and the summary says what was made.

@@ -258,12 +258,29 @@ fn the_worst_region_is_the_mean_of_the_worst_window() {
 }
 
 /// Displacement mapping: the cobbled ball with its relief made as triangles (its outline and
-/// self-shadows the relief's).
+/// self-shadows the relief's), the triangles the tracer traces (`bump.tessellation = "uniform"`).
 #[test]
 fn displaced_ball() {
     let mut scene = common::load("scenes/course/displacement-sphere.toml");
     (scene.camera.width, scene.camera.height) = (480, 270);
     scene.settings.bump.method = mirador::settings::BumpMethod::Displacement;
+    scene.settings.bump.tessellation = mirador::settings::Tessellation::Uniform;
     mirador::texture::displacement::displace(&mut scene);
     common::assert_golden("displaced-ball", &common::raster(&scene, &scene.settings), TOLERANCE);
+}
+
+/// The same ball tessellated on the GPU for the view (`bump.tessellation = "adaptive"`, the
+/// default); and with edges of up to 16 pixels under the tessellation view: finer where the ball
+/// faces the camera, coarser towards its outline, where its triangles are seen edge on.
+#[test]
+fn displaced_ball_adaptive() {
+    let mut scene = common::load("scenes/course/displacement-sphere.toml");
+    (scene.camera.width, scene.camera.height) = (480, 270);
+    scene.settings.bump.method = mirador::settings::BumpMethod::Displacement;
+    mirador::texture::displacement::displace(&mut scene);
+    let mut settings = scene.settings.clone();
+    common::assert_golden("displaced-ball-adaptive", &common::raster(&scene, &settings), TOLERANCE);
+    settings.bump.view = mirador::settings::BumpView::Tessellation;
+    settings.bump.edge_pixels = 16.0;
+    common::assert_golden("displaced-ball-adaptive-edges", &common::raster(&scene, &settings), TOLERANCE);
 }

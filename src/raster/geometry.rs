@@ -41,6 +41,9 @@ pub enum MeshKey {
     RoundedBox([u32; 4], u32),
     /// `Scene::meshes[i]`.
     File(usize),
+    /// The displaced surface of object `i`, tessellated on the GPU for this frame's view, in
+    /// world coordinates (`crate::raster::tessellation`).
+    Displaced(usize),
 }
 
 /// The mesh an object is an instance of, at `segments`, and the transform from that mesh to the
@@ -85,6 +88,8 @@ pub fn build_mesh(scene: &Scene, key: MeshKey) -> std::borrow::Cow<'_, Mesh> {
             Cow::Owned(Mesh::rounded_box(Vec3::new(f(b[0]), f(b[1]), f(b[2])), f(b[3]), segments))
         }
         MeshKey::File(index) => Cow::Borrowed(&scene.meshes[index]),
+        // Made by the GPU; its uniform mesh where asked for here.
+        MeshKey::Displaced(object) => scene.tessellate(&scene.objects[object]),
     }
 }
 
@@ -227,6 +232,10 @@ pub struct SceneGeometry {
     pub bounds: Option<(Vec3, Vec3)>,
     /// The draw list was built at least once.
     prepared: bool,
+    /// The objects drawn from the GPU's adaptive tessellation (`MeshKey::Displaced`), and how
+    /// many times it changed, against how many times the draw list has seen.
+    displaced: Vec<usize>,
+    displaced_changes: (u64, u64),
 }
 
 /// The name of one draw list: its instance buffer, made anew for every list (wgpu's handles
@@ -259,7 +268,28 @@ impl SceneGeometry {
             transparent: Vec::new(),
             bounds: scene.bounds(),
             prepared: false,
+            displaced: Vec::new(),
+            displaced_changes: (0, 0),
         }
+    }
+
+    /// Draws each listed object from its mesh made by the GPU (world coordinates) instead of its
+    /// own; an empty list, every object from its own. The next [`Self::prepare`] makes a new draw
+    /// list, so what was kept of the last (shadow maps) is made again.
+    pub fn set_displaced(&mut self, meshes: Vec<(usize, GpuMesh)>) {
+        if meshes.is_empty() && self.displaced.is_empty() {
+            return;
+        }
+        self.displaced = meshes.iter().map(|(object, _)| *object).collect();
+        for (object, mesh) in meshes {
+            self.meshes.insert(MeshKey::Displaced(object), mesh);
+        }
+        self.displaced_changes.0 += 1;
+    }
+
+    /// Whether some object is drawn from the GPU's tessellation.
+    pub fn has_displaced(&self) -> bool {
+        !self.displaced.is_empty()
     }
 
     /// Chooses each curved shape's tessellation for `camera` (or `max_segments` everywhere when
@@ -274,9 +304,10 @@ impl SceneGeometry {
         adaptive: bool,
     ) -> bool {
         let segments = self.segments_for(scene, camera, max_segments, adaptive);
-        if segments == self.segments && self.prepared {
+        if segments == self.segments && self.prepared && self.displaced_changes.0 == self.displaced_changes.1 {
             return false;
         }
+        self.displaced_changes.1 = self.displaced_changes.0;
         let entries = self.entries(scene, &segments);
         for (_, _, _, key, ..) in &entries {
             if !self.meshes.contains_key(key) {
@@ -330,7 +361,10 @@ impl SceneGeometry {
             .zip(segments)
             .enumerate()
             .map(|(index, ((object, info), &n))| {
-                let (key, world_from_mesh) = instance_of(object, n);
+                let (key, world_from_mesh) = match self.displaced.contains(&index) {
+                    true => (MeshKey::Displaced(index), Mat4::IDENTITY),
+                    false => instance_of(object, n),
+                };
                 let alone = (info.mirror || info.env_layer.is_some()).then_some(index);
                 (
                     info.transparent,
@@ -486,5 +520,6 @@ fn mesh_order(key: &MeshKey) -> (u8, [u32; 6], u32) {
         MeshKey::Torus(b, n) => (3, [b[0], b[1], 0, 0, 0, 0], n),
         MeshKey::RoundedBox(b, n) => (4, [b[0], b[1], b[2], b[3], 0, 0], n),
         MeshKey::File(i) => (5, [0; 6], i as u32),
+        MeshKey::Displaced(i) => (6, [0; 6], i as u32),
     }
 }

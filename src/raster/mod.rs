@@ -25,6 +25,7 @@ pub mod scene_gpu;
 pub mod scene_pass;
 pub mod shadow;
 pub mod targets;
+pub mod tessellation;
 pub mod traced;
 pub mod transparency;
 pub mod uniforms;

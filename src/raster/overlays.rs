@@ -38,13 +38,21 @@ pub const TESSELLATION_COLOUR: Vec3 = Vec3::new(0.1, 1.0, 0.3);
 const MAX_EDGES: usize = 3_000_000;
 
 /// Every edge of every mesh object's triangles (a displaced surface is one), once, as world-space
-/// segments: the tessellation view (`bump.view = "tessellation"`). Analytic shapes are left out:
-/// the rasterizer tessellates them by their size on screen, frame by frame.
-pub fn mesh_edges(scene: &crate::Scene) -> Vec<Vec3> {
+/// segments: the tessellation view (`bump.view = "tessellation"`). `adaptive` holds the objects
+/// whose triangles the GPU made this frame (their CPU twin, in world coordinates), drawn instead
+/// of their own mesh. Analytic shapes are left out: the rasterizer tessellates them by their size
+/// on screen, frame by frame.
+pub fn mesh_edges(scene: &crate::Scene, adaptive: &[(usize, crate::scene::Mesh)]) -> Vec<Vec3> {
     let mut lines = Vec::new();
-    for object in &scene.objects {
-        let crate::scene::Shape::Mesh(index) = object.shape else { continue };
-        let Some(mesh) = scene.meshes.get(index) else { continue };
+    for (index, object) in scene.objects.iter().enumerate() {
+        let (mesh, world_from_mesh) = match adaptive.iter().find(|(o, _)| *o == index) {
+            Some((_, mesh)) => (mesh, glam::Mat4::IDENTITY),
+            None => {
+                let crate::scene::Shape::Mesh(mesh) = object.shape else { continue };
+                let Some(mesh) = scene.meshes.get(mesh) else { continue };
+                (mesh, object.world_from_local)
+            }
+        };
         let mut edges: Vec<(u32, u32)> = mesh
             .indices
             .chunks_exact(3)
@@ -65,7 +73,7 @@ pub fn mesh_edges(scene: &crate::Scene) -> Vec<Vec3> {
         let world = |i: u32| {
             let p = *mesh.positions.get(i as usize)?;
             let n = mesh.normals.get(i as usize).copied().unwrap_or(Vec3::ZERO);
-            Some(object.world_from_local.transform_point3(p + lift * n))
+            Some(world_from_mesh.transform_point3(p + lift * n))
         };
         for (a, b) in edges {
             if let (Some(a), Some(b)) = (world(a), world(b)) {

@@ -124,8 +124,28 @@ pub struct Scene {
     pub objects: Vec<Object>,
     /// Voxel grids, drawn by ray casting (`crate::volume`).
     pub volumes: Vec<crate::volume::Volume>,
+    /// The objects displacement made into triangles (`bump.method = "displacement"`), each with
+    /// the surface it was made from: what the rasterizer tessellates again, adaptively, on the
+    /// GPU (`crate::raster::tessellation`). Empty unless [`crate::texture::displacement::displace`]
+    /// displaced something.
+    pub displaced: Vec<DisplacedSurface>,
     /// The scene file's defaults for the toggles; the CLI and the viewer start from these.
     pub settings: RenderSettings,
+}
+
+/// An object displacement made into triangles (`crate::texture::displacement::displace`), and
+/// what it was made from: the surface the rasterizer tessellates again on the GPU, adaptively
+/// (`crate::raster::tessellation`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DisplacedSurface {
+    /// Index into `Scene::objects`: the object, now a mesh of the uniformly displaced surface.
+    pub object: usize,
+    /// The material with the height field (the object's own is now a copy without it).
+    pub material: usize,
+    /// The undisplaced mesh, in the object's coordinates.
+    pub base: Mesh,
+    /// The displacement `k` in world units: the material's `bump_scale` times `bump.scale`.
+    pub k: f32,
 }
 
 /// Why a scene could not be loaded. Every variant names the file it is about.

@@ -21,6 +21,16 @@ section! {
         /// million in a scene: past that the level is lowered, and said).
         #[values(closed(0.25, 64.0).unit("texels").slider(0.25, 16.0))]
         displacement_texels: f32 = 2.0,
+        /// How the rasterizer tessellates displacement: on the GPU every frame, each edge split
+        /// until its pieces are under `edge_pixels` on screen (and under `displacement_texels` of
+        /// the field), or the uniform mesh the tracer draws. WebGL2 has no compute shaders and
+        /// always draws the uniform mesh.
+        tessellation: Tessellation = Tessellation::Adaptive,
+        /// Adaptive tessellation's longest edge on screen, in pixels: smaller follows the
+        /// silhouette more closely with more triangles (at most two million: past that the
+        /// edges are made longer, and said).
+        #[values(closed(0.5, 64.0).unit("px").slider(0.5, 32.0))]
+        edge_pixels: f32 = 4.0,
         /// Where the rasterizer's tangents `t_u = ∂p/∂u`, `t_v = ∂p/∂v` come from (the tracer
         /// uses the third source, the analytic surface).
         tangents: TangentSource = TangentSource::Derivatives,
@@ -53,6 +63,18 @@ choices! {
         Parallax,
         /// Displacement mapping: the surface moved by `k·f(u, v)` along its normal, as geometry.
         Displacement,
+    }
+}
+
+choices! {
+    /// How the rasterizer makes displacement's triangles.
+    pub enum Tessellation {
+        /// In a compute shader, every frame the view changes: each edge of the object's mesh split
+        /// by its length on screen, neighbours of different levels joined without cracks.
+        Adaptive,
+        /// The mesh displacement made once for both renderers: every triangle split alike, by
+        /// the height field's texels.
+        Uniform,
     }
 }
 

@@ -28,7 +28,7 @@ mod trace;
 mod transparency;
 mod volume;
 
-pub use bump::{BumpMethod, BumpSettings, BumpView, TangentSource};
+pub use bump::{BumpMethod, BumpSettings, BumpView, TangentSource, Tessellation};
 pub use environment::{EnvironmentMap, EnvironmentSettings, EnvironmentView, Parallax, SphereView};
 pub use hybrid::{APPROXIMATIONS, Approximation, HybridSettings, SceneFacts, Traced, TracedSet};
 pub use mirrors::{MAX_MIRROR_DEPTH, MirrorSettings, MirrorView};

@@ -29,7 +29,7 @@ use std::collections::HashMap;
 use glam::{Mat4, Vec2, Vec3};
 
 use super::height::{HeightField, TextureHeight, with_material_field};
-use crate::scene::{Material, Mesh, Scene, Shape};
+use crate::scene::{DisplacedSurface, Material, Mesh, Scene, Shape};
 use crate::settings::{BumpMethod, RenderSettings};
 
 /// The most triangles the displaced meshes of one scene may have together: about 100 MB of
@@ -145,6 +145,7 @@ pub fn displace(scene: &mut Scene) -> Displaced {
             scene.materials.len() - 1
         });
         scene.meshes.push(moved);
+        scene.displaced.push(DisplacedSurface { object: index, material: old_material, base: mesh.clone(), k });
         let object = &mut scene.objects[index];
         object.shape = Shape::Mesh(scene.meshes.len() - 1);
         object.material = crate::base::MaterialId(new_material);
@@ -159,7 +160,7 @@ fn has_height(material: &Material) -> bool {
 
 /// `f` of `material`'s height field: its procedural one, or its height map read as the tracer
 /// reads it (level 0, bilinear, repeat).
-fn with_field<T>(scene: &Scene, material: &Material, f: impl FnOnce(&dyn HeightField) -> T) -> Option<T> {
+pub(crate) fn with_field<T>(scene: &Scene, material: &Material, f: impl FnOnce(&dyn HeightField) -> T) -> Option<T> {
     let map = material.height_map.and_then(|id| scene.textures.get(id.0)).map(TextureHeight::new);
     with_material_field(material, map.as_ref(), f)
 }
@@ -228,7 +229,7 @@ pub fn displaced_mesh(mesh: &Mesh, field: &dyn HeightField, k: f32, world_from_l
 /// The vertices at one point, as groups of indices: within a millionth of the mesh's size of
 /// each other (a sphere's seam is computed at `φ = 0` and `φ = 2π`, whose sines differ by 10⁻⁷),
 /// found through a grid of cells of that size and their neighbours.
-fn welded(positions: &[Vec3]) -> Vec<Vec<usize>> {
+pub(crate) fn welded(positions: &[Vec3]) -> Vec<Vec<usize>> {
     let (low, high) = positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| (l.min(*p), h.max(*p)));
     let extent = (high - low).max_element();
     let epsilon = if extent.is_finite() && extent > 0.0 { extent * 1e-6 } else { f32::MIN_POSITIVE };
@@ -419,7 +420,7 @@ fn push(out: &mut Mesh, position: Vec3, normal: Vec3, uv: Vec2) -> u32 {
 }
 
 /// Each vertex's normal from the faces around it, for a mesh that has none.
-fn face_normals(mesh: &Mesh) -> Vec<Vec3> {
+pub(crate) fn face_normals(mesh: &Mesh) -> Vec<Vec3> {
     let mut sums = vec![Vec3::ZERO; mesh.positions.len()];
     for t in mesh.indices.chunks_exact(3) {
         let [a, b, c] = [t[0], t[1], t[2]].map(|i| i as usize);

@@ -34,6 +34,7 @@ use super::shadow::projected::ProjectedPass;
 use super::shadow::views::ShadowLayout;
 use super::shadow::{ShadowMaps, ShadowPass};
 use super::targets::{FrameTargets, ViewImage, drawn_size};
+use super::tessellation::pass::TessellationPass;
 use super::traced::{self, KeptTraced, PreparedTraced};
 use super::transparency::{PreparedTransparency, TransparencyPass};
 use super::view::{ViewKind, ViewTargets};
@@ -44,7 +45,7 @@ use crate::gpu::mipmap::MipmapGenerator;
 use crate::output::OutputTransform;
 use crate::scene::Scene;
 use crate::settings::{BumpView, MirrorView, RenderSettings};
-use crate::shaders::Wgsl;
+use crate::shaders::{Profile, Wgsl};
 use crate::volume::WIREFRAME_CELLS;
 use plan::{FramePlan, plan};
 
@@ -83,6 +84,9 @@ pub struct Renderer {
     environment: EnvironmentPass,
     overlays: Overlays,
     present: PresentPass,
+    /// Displacement tessellated on the GPU, adaptively; `None` where the device has no compute
+    /// shaders (WebGL2), which draws the uniform mesh.
+    tessellation: Option<TessellationPass>,
     /// Every view's group 2 (what its shading reads), kept while the images it reads are the
     /// same ones.
     view_groups: ViewGroups,
@@ -162,6 +166,11 @@ impl Renderer {
             transparency: TransparencyPass::new(device, &layouts, &surface),
             overlays: Overlays::new(device, &layouts),
             present: PresentPass::new(device, output_format),
+            tessellation: (gpu.profile() == Profile::Standard).then(|| {
+                let mut pass = TessellationPass::new(device);
+                pass.load(gpu, scene);
+                pass
+            }),
             scene_gpu,
             volumes,
             mirrors,
@@ -223,7 +232,16 @@ impl Renderer {
     pub fn load(&mut self, gpu: &Gpu, scene: &Scene) {
         let passes = (&mut self.mirrors, &mut self.environment, &mut self.volumes);
         self.scene_gpu = load(gpu, scene, (&self.layouts, &self.mipmaps), passes);
+        if let Some(tessellation) = &mut self.tessellation {
+            tessellation.load(gpu, scene);
+        }
         self.traced.forget();
+    }
+
+    /// What the last frame's adaptive displacement made (`None` where nothing was tessellated
+    /// on the GPU).
+    pub fn tessellation_report(&self) -> Option<&super::tessellation::pass::TessellationReport> {
+        self.tessellation.as_ref()?.report.as_ref()
     }
 
     /// The scene as uploaded.
@@ -373,6 +391,20 @@ impl Renderer {
     ) -> FramePlan {
         let scene_gpu = &mut self.scene_gpu;
         scene_gpu.prepare_materials(&gpu.device, &self.layouts, &settings.textures);
+        if let Some(tessellation) = &mut self.tessellation {
+            let report = tessellation.prepare(gpu, &mut frame.encoder, scene, settings, &mut scene_gpu.geometry);
+            if let Some(report) = report.cloned() {
+                let count = |n: u64| Figure::Count(n);
+                let figures = [
+                    ("triangles", count(report.triangles)),
+                    ("vertices", count(report.vertices)),
+                    ("finest split", count(u64::from(report.finest))),
+                    ("bound forced", Figure::Flag(report.edge_pixels > report.asked)),
+                    ("made", Figure::Flag(report.made)),
+                ];
+                frame.end("tessellation", &figures);
+            }
+        }
         let (segments, adaptive) = (scene.sphere_segments(), settings.raster.adaptive_tessellation);
         scene_gpu.geometry.prepare(&gpu.device, scene, &scene.camera, segments, adaptive);
         let bounds = scene_gpu.geometry.bounds;
@@ -410,7 +442,11 @@ impl Renderer {
             self.overlays.record_lines(ctx, frame, main, lines.as_flattened(), WIREFRAME_COLOUR);
         }
         if settings.bump.view == BumpView::Tessellation {
-            self.overlays.record_lines(ctx, frame, main, &mesh_edges(ctx.scene), TESSELLATION_COLOUR);
+            let adaptive = match &self.tessellation {
+                Some(tessellation) if tessellation.report.is_some() => tessellation.cpu_meshes(ctx.scene),
+                _ => Vec::new(),
+            };
+            self.overlays.record_lines(ctx, frame, main, &mesh_edges(ctx.scene, &adaptive), TESSELLATION_COLOUR);
         }
         if settings.mirrors.view == MirrorView::Camera {
             let edges = box_edges(&mirror_volumes(&plan.mirror_nodes));

@@ -1065,6 +1065,7 @@ fn empty_scene(path: &Path) -> Scene {
         meshes: Vec::new(),
         objects: Vec::new(),
         volumes: Vec::new(),
+        displaced: Vec::new(),
         settings: RenderSettings::default(),
     }
 }
