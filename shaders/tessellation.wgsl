@@ -244,18 +244,32 @@ fn vertex_index(n: u32, a: u32, b: u32) -> u32 {
     return b * (n + 1u) - b * (max(b, 1u) - 1u) / 2u + a;
 }
 
+// A thread's item: its vertex (which 0) or triangle (1), the patch that owns it, and its place
+// among the patch's.
+struct Item {
+    index: u32,
+    owner: u32,
+    local: u32,
+}
+
+fn item_of(id: vec3u, which: u32) -> Item {
+    let index = id.x + id.y * params.row;
+    let p = patch_of(index, which);
+    return Item(index, p, index - levels[p].first[which]);
+}
+
 @compute @workgroup_size(64)
 fn cs_vertices(@builtin(global_invocation_id) id: vec3u) {
-    let v = id.x + id.y * params.row;
-    if v >= params.vertex_count {
+    if id.x + id.y * params.row >= params.vertex_count {
         return;
     }
-    let p = patch_of(v, 0u);
-    let level = levels[p];
-    let n = level.split.w;
-    let edges = level.split.xyz;
+    let item = item_of(id, 0u);
+    let v = item.index;
+    let p = item.owner;
+    let n = levels[p].split.w;
+    let edges = levels[p].split.xyz;
     // Row b holds n + 1 − b vertices.
-    var local = v - level.first.x;
+    var local = item.local;
     var b = 0u;
     while local > n - b {
         local -= n + 1u - b;
@@ -306,15 +320,15 @@ fn cs_vertices(@builtin(global_invocation_id) id: vec3u) {
 
 @compute @workgroup_size(64)
 fn cs_indices(@builtin(global_invocation_id) id: vec3u) {
-    let t = id.x + id.y * params.row;
-    if t >= params.triangle_count {
+    if id.x + id.y * params.row >= params.triangle_count {
         return;
     }
-    let p = patch_of(t, 1u);
-    let level = levels[p];
-    let n = level.split.w;
+    let item = item_of(id, 1u);
+    let t = item.index;
+    let n = levels[item.owner].split.w;
+    let first_vertex = levels[item.owner].first.x;
     // Row b holds 2(n − b) − 1 triangles: upright at a, then upside down beside it.
-    var local = t - level.first.y;
+    var local = item.local;
     var b = 0u;
     while local >= 2u * (n - b) - 1u {
         local -= 2u * (n - b) - 1u;
@@ -327,6 +341,6 @@ fn cs_indices(@builtin(global_invocation_id) id: vec3u) {
     }
     for (var i = 0u; i < 3u; i++) {
         let g = grid[i];
-        indices[3u * t + i] = level.first.x + vertex_index(n, g.x, g.y);
+        indices[3u * t + i] = first_vertex + vertex_index(n, g.x, g.y);
     }
 }
