@@ -390,3 +390,42 @@ fn explain_names_what_bump_mapping_leaves_out() {
     let plain = common::load("scenes/seed-simple.toml");
     assert_eq!(explained(&plain, (100, 100)), None);
 }
+
+/// Bad input on the GPU's path: a mesh with no texture coordinates or normals, a triangle with two
+/// corners at one point and an index out of range is tessellated without a panic, every position
+/// and normal a number (no coordinates: one height everywhere, the normals the faces'); a
+/// displacement of 10³⁰ is left to the uniform mesh, said, and the frame drawn.
+#[test]
+fn adaptive_tessellation_takes_bad_input() {
+    use mirador::scene::{Mesh, Shape};
+    let mut scene = common::load("scenes/course/displacement-plane.toml");
+    scene.meshes.push(Mesh {
+        name: "bare".into(),
+        positions: vec![Vec3::ZERO, Vec3::X, Vec3::Z, Vec3::Z, Vec3::new(1.0, 0.0, 1.0)],
+        normals: Vec::new(),
+        uvs: Vec::new(),
+        tangents: Vec::new(),
+        indices: vec![0, 2, 1, 0, 2, 3, 1, 2, 4, 0, 1, 9],
+    });
+    scene.objects[0].shape = Shape::Mesh(scene.meshes.len() - 1);
+    scene.settings.bump.method = BumpMethod::Displacement;
+    displacement::displace(&mut scene);
+    let (pass, _) = tessellated_on_the_gpu(&scene);
+    let made = pass.read_back(common::gpu());
+    let (vertices, indices) = &made[0];
+    assert!(!indices.is_empty() && indices.iter().all(|&i| (i as usize) < vertices.len()));
+    assert!(vertices.iter().all(|v| v.position.iter().chain(&v.normal).all(|x| x.is_finite())));
+
+    let mut scene = common::load("scenes/course/displacement-sphere.toml");
+    scene.settings.bump.method = BumpMethod::Displacement;
+    scene.settings.bump.scale = 1e30;
+    displacement::displace(&mut scene);
+    let gpu = common::gpu();
+    let mut pass = TessellationPass::new(&gpu.device);
+    pass.load(gpu, &scene);
+    let mut geometry = SceneGeometry::new(&scene, &[], &[]);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    assert!(pass.prepare(gpu, &mut encoder, &scene, &scene.settings, &mut geometry).is_none());
+    assert!(!geometry.has_displaced());
+    let _ = common::raster(&scene, &scene.settings);
+}

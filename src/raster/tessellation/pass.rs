@@ -20,6 +20,10 @@ use crate::texture::mipmap::MipLevel;
 /// object keeps the uniform mesh, said once.
 const MAX_HEIGHT_TEXELS: u64 = 16 << 20;
 
+/// The largest displacement `k` (world units per unit of height) tessellated on the GPU: beyond
+/// it the cross products of the normals' fan overflow f32.
+const MAX_K: f32 = 1e12;
+
 /// Threads per workgroup (`@workgroup_size` in `shaders/tessellation.wgsl`).
 const WORKGROUP: u32 = 64;
 
@@ -276,6 +280,18 @@ impl Object {
         if patches.patches.is_empty() {
             return None;
         }
+        let name = &scene.objects[patches.object].name;
+        // A displacement so large that the surface leaves f32's range (or its normals' products
+        // would): the uniform mesh, which leaves such points unmoved, is drawn instead.
+        if !(patches.k.abs() <= MAX_K)
+            || patches.patches.iter().any(|p| p.moved.iter().flatten().any(|x| !x.is_finite()))
+        {
+            log::warn!(
+                "`{name}`: a displacement of {} is too large to tessellate on the GPU; it keeps the uniform mesh",
+                patches.k
+            );
+            return None;
+        }
         let material = &scene.materials[patches.material];
         let mut params = GpuParams { k: patches.k, ..GpuParams::default() };
         let (heights, size): (Vec<f32>, [u32; 2]) = match material.height_field {
@@ -294,11 +310,10 @@ impl Object {
                 let texels = u64::from(texture.width) * u64::from(texture.height);
                 if texels > MAX_HEIGHT_TEXELS || texture.width.max(texture.height) > largest {
                     log::warn!(
-                        "{}: a height map of {}×{} is too large to tessellate on the GPU; `{}` keeps the uniform mesh",
+                        "{}: a height map of {}×{} is too large to tessellate on the GPU; `{name}` keeps the uniform mesh",
                         texture.path.display(),
                         texture.width,
                         texture.height,
-                        scene.objects[patches.object].name
                     );
                     return None;
                 }
