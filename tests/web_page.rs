@@ -179,6 +179,30 @@ fn the_page_draws_what_the_native_renderers_draw() {
         flip(&common::raster(&scene, &straight), &crop(&refraction, view), "screen-refraction-against-none", &dir);
     assert!(against >= MIN_TOGGLE_RATIO * error, "the page's refraction is as near no refraction ({against})");
 
+    // Displacement in the page: tessellated on the GPU for the view with WebGPU (a compute
+    // shader), the uniform mesh with WebGL2 (no compute), each as `render` draws it on that kind
+    // of device; two-sided against the bump-mapped ball (its outline a circle).
+    let (displaced, displaced_view) = shot(&dir, "displaced.png");
+    assert_eq!(displaced_view, view);
+    let path = mirador::scene::builtin_path("course/displacement-sphere.toml");
+    let mut bumped = Scene::load(&path).expect("the displaced ball's scene");
+    (bumped.camera.width, bumped.camera.height) = (view[2], view[3]);
+    let mut scene = bumped.clone();
+    scene.settings.bump.method = mirador::settings::BumpMethod::Displacement;
+    if dir.file_name().is_some_and(|name| name == "webgl2") {
+        scene.settings.bump.tessellation = mirador::settings::Tessellation::Uniform;
+    }
+    mirador::texture::displacement::displace(&mut scene);
+    let expected = common::raster(&scene, &scene.settings);
+    let error = flip(&expected, &crop(&displaced, view), "displaced", &dir);
+    assert!(error <= MAX_CROSS_GPU_FLIP, "the displaced ball in the page differs from `render`'s: {error}");
+    let against =
+        flip(&common::raster(&bumped, &bumped.settings), &crop(&displaced, view), "displaced-against-bump", &dir);
+    assert!(
+        against >= MIN_TOGGLE_RATIO * error,
+        "the page's displaced ball is as near the bump-mapped one ({against})"
+    );
+
     // The lab in the page: the planar-mirrors lab's scene drawn with the stub's functions and with
     // Mirador's, each against the native renderer compiled from the same WGSL (the editor beside
     // the view leaves the view narrower).

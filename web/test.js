@@ -2,7 +2,7 @@
 // page's own interface, `mirador.step(...)`, which the scene menu and the file picker use too:
 // the showcase as it opens, the shadows toggled off, the split view once the tracer has finished
 // in the page, the difference view, the hybrid's traced shadows over acned shadow maps, a lab's
-// stub, reference and difference, a student's edits, a scene whose volume the page fetches, screen-space refraction, and the lab's checks run in the page on a wrong solution
+// stub, reference and difference, a student's edits, a scene whose volume the page fetches, screen-space refraction, a displaced ball, and the lab's checks run in the page on a wrong solution
 // and a right one (their results.json posted as `lab-wrong.json`, `lab-right.json`, with the
 // texts checked). Each screenshot (the whole canvas, PNG) is posted to the
 // test server with the 3D view's rectangle; `done` ends the run, `failed` says why it stopped.
@@ -80,6 +80,13 @@ export function run(mirador) {
     "set transparency.refraction=screen",
     "wait 4s",
     "screenshot refraction.png",
+    "wait 2s",
+    // Displacement: with WebGPU tessellated by the page's compute shader, with WebGL2 (no compute)
+    // the uniform mesh the tracer draws.
+    "load assets/scenes/course/displacement-sphere.toml",
+    "set bump.method=displacement",
+    "wait 4s",
+    "screenshot displaced.png",
     "wait 2s",
     // The lab in the page: the planar-mirrors lab's stub (its neutral reflection: the mirror
     // shows the room unreflected), then the reference; the editor narrows the view.
