@@ -180,7 +180,7 @@ fn ball_near_with_a_seam() -> Scene {
 /// them to.
 fn tessellated_on_the_gpu(scene: &Scene) -> (TessellationPass, SceneGeometry) {
     let gpu = common::gpu();
-    let mut pass = TessellationPass::new(&gpu.device);
+    let mut pass = TessellationPass::default();
     pass.load(gpu, scene);
     let mut geometry = SceneGeometry::new(scene, &[], &[]);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
@@ -421,7 +421,7 @@ fn adaptive_tessellation_takes_bad_input() {
     scene.settings.bump.scale = 1e30;
     displacement::displace(&mut scene);
     let gpu = common::gpu();
-    let mut pass = TessellationPass::new(&gpu.device);
+    let mut pass = TessellationPass::default();
     pass.load(gpu, &scene);
     let mut geometry = SceneGeometry::new(&scene, &[], &[]);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());

@@ -167,7 +167,7 @@ impl Renderer {
             overlays: Overlays::new(device, &layouts),
             present: PresentPass::new(device, output_format),
             tessellation: (gpu.profile() == Profile::Standard).then(|| {
-                let mut pass = TessellationPass::new(device);
+                let mut pass = TessellationPass::default();
                 pass.load(gpu, scene);
                 pass
             }),

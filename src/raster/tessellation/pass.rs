@@ -94,17 +94,25 @@ struct Object {
 }
 
 /// Adaptive displacement's compute pass and the scene's displaced objects.
+#[derive(Default)]
 pub struct TessellationPass {
-    layout: wgpu::BindGroupLayout,
-    vertices: wgpu::ComputePipeline,
-    indices: wgpu::ComputePipeline,
+    /// Made when a scene first has something to tessellate: a scene without displacement
+    /// compiles no compute shader.
+    pipelines: Option<Pipelines>,
     objects: Vec<Object>,
     /// The last frame's report.
     pub report: Option<TessellationReport>,
 }
 
-impl TessellationPass {
-    pub fn new(device: &wgpu::Device) -> TessellationPass {
+/// The pass's group layout and its two entry points.
+struct Pipelines {
+    layout: wgpu::BindGroupLayout,
+    vertices: wgpu::ComputePipeline,
+    indices: wgpu::ComputePipeline,
+}
+
+impl Pipelines {
+    fn new(device: &wgpu::Device) -> Pipelines {
         let storage = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -151,19 +159,18 @@ impl TessellationPass {
                 cache: None,
             })
         };
-        TessellationPass {
-            vertices: pipeline("cs_vertices"),
-            indices: pipeline("cs_indices"),
-            layout,
-            objects: Vec::new(),
-            report: None,
-        }
+        Pipelines { vertices: pipeline("cs_vertices"), indices: pipeline("cs_indices"), layout }
     }
+}
 
+impl TessellationPass {
     /// Takes `scene`'s displaced objects in place of the last scene's.
     pub fn load(&mut self, gpu: &Gpu, scene: &Scene) {
         self.objects = (0..scene.displaced.len()).filter_map(|i| Object::new(gpu, scene, i)).collect();
         self.report = None;
+        if !self.objects.is_empty() && self.pipelines.is_none() {
+            self.pipelines = Some(Pipelines::new(&gpu.device));
+        }
     }
 
     /// Tessellates the displaced objects for `scene`'s camera when `settings` ask for adaptive
@@ -222,8 +229,9 @@ impl TessellationPass {
 
     /// Writes each object's levels and records its two dispatches.
     fn record(&mut self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, levels: Vec<Levels>) {
+        let Some(pipelines) = &self.pipelines else { return };
         for (object, levels) in self.objects.iter_mut().zip(levels) {
-            object.upload(gpu, &self.layout, levels);
+            object.upload(gpu, &pipelines.layout, levels);
         }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("tessellation::pass"),
@@ -233,7 +241,8 @@ impl TessellationPass {
             let Some(group) = &object.group else { continue };
             pass.set_bind_group(0, group, &[]);
             let row = object.params.row / WORKGROUP;
-            let counts = [(&self.vertices, object.params.vertex_count), (&self.indices, object.params.triangle_count)];
+            let counts =
+                [(&pipelines.vertices, object.params.vertex_count), (&pipelines.indices, object.params.triangle_count)];
             for (pipeline, count) in counts {
                 pass.set_pipeline(pipeline);
                 let groups = count.div_ceil(WORKGROUP);
