@@ -232,10 +232,10 @@ pub struct SceneGeometry {
     pub bounds: Option<(Vec3, Vec3)>,
     /// The draw list was built at least once.
     prepared: bool,
-    /// The objects drawn from the GPU's adaptive tessellation (`MeshKey::Displaced`), and how
-    /// many times it changed, against how many times the draw list has seen.
+    /// The objects drawn from the GPU's adaptive tessellation (`MeshKey::Displaced`), and whether
+    /// it changed since the draw list was made.
     displaced: Vec<usize>,
-    displaced_changes: (u64, u64),
+    displaced_changed: bool,
 }
 
 /// The name of one draw list: its instance buffer, made anew for every list (wgpu's handles
@@ -269,7 +269,7 @@ impl SceneGeometry {
             bounds: scene.bounds(),
             prepared: false,
             displaced: Vec::new(),
-            displaced_changes: (0, 0),
+            displaced_changed: false,
         }
     }
 
@@ -284,7 +284,7 @@ impl SceneGeometry {
         for (object, mesh) in meshes {
             self.meshes.insert(MeshKey::Displaced(object), mesh);
         }
-        self.displaced_changes.0 += 1;
+        self.displaced_changed = true;
     }
 
     /// Whether some object is drawn from the GPU's tessellation.
@@ -304,10 +304,10 @@ impl SceneGeometry {
         adaptive: bool,
     ) -> bool {
         let segments = self.segments_for(scene, camera, max_segments, adaptive);
-        if segments == self.segments && self.prepared && self.displaced_changes.0 == self.displaced_changes.1 {
+        if segments == self.segments && self.prepared && !self.displaced_changed {
             return false;
         }
-        self.displaced_changes.1 = self.displaced_changes.0;
+        self.displaced_changed = false;
         let entries = self.entries(scene, &segments);
         for (_, _, _, key, ..) in &entries {
             if !self.meshes.contains_key(key) {

@@ -206,14 +206,7 @@ pub fn displaced_mesh(mesh: &Mesh, field: &dyn HeightField, k: f32, world_from_l
     let normal_from_local = glam::Mat3::from_mat4(world_from_local).inverse().transpose();
     // Every vertex at one position moves alike: by the mean height, along the mean normal.
     for members in welded(&split.positions) {
-        let (mut height, mut normal) = (0.0, Vec3::ZERO);
-        for &i in &members {
-            let f = field.height(split.uvs[i]);
-            height += if f.is_finite() { f } else { 0.0 };
-            normal += split.normals[i];
-        }
-        height /= members.len() as f32;
-        let Some(normal) = normal.try_normalize() else { continue };
+        let Some((height, normal)) = welded_mean(&members, (&split.normals, &split.uvs), field) else { continue };
         let world_normal = (normal_from_local * normal).normalize_or_zero();
         let offset = local_from_world.transform_vector3(k * height * world_normal);
         let moved = split.positions[members[0]] + if offset.is_finite() { offset } else { Vec3::ZERO };
@@ -224,6 +217,23 @@ pub fn displaced_mesh(mesh: &Mesh, field: &dyn HeightField, k: f32, world_from_l
     split.normals = displaced_normals(&split);
     split.tangents.clear();
     split
+}
+
+/// The mean height of the vertices `members` (at one point: a seam's, a pole's, a box's corner's)
+/// and the unit mean of their normals, along which they move together; `None` where the normals
+/// cancel. A height that is not a number counts as 0.
+pub(crate) fn welded_mean(
+    members: &[usize],
+    (normals, uvs): (&[Vec3], &[Vec2]),
+    field: &dyn HeightField,
+) -> Option<(f32, Vec3)> {
+    let (mut height, mut normal) = (0.0, Vec3::ZERO);
+    for &i in members {
+        let f = field.height(uvs[i]);
+        height += if f.is_finite() { f } else { 0.0 };
+        normal += normals[i];
+    }
+    Some((height / members.len() as f32, normal.try_normalize()?))
 }
 
 /// The vertices at one point, as groups of indices: within a millionth of the mesh's size of

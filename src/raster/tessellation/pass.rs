@@ -9,6 +9,7 @@ use wgpu::util::DeviceExt;
 use super::patches::bounded_levels;
 use super::{Levels, MAX_TRIANGLES, MAX_VERTICES, Patches};
 use crate::gpu::Gpu;
+use crate::gpu::uniform::UniformBuffer;
 use crate::raster::geometry::{GpuMesh, SceneGeometry};
 use crate::raster::uniforms::Vertex;
 use crate::scene::{ProceduralHeight, Scene};
@@ -82,8 +83,12 @@ impl TessellationReport {
 /// One displaced object on the GPU.
 struct Object {
     patches: Patches,
+    /// What the shader's `params` holds, and the buffer it is written to.
     params: GpuParams,
+    uniform: UniformBuffer<GpuParams>,
     patch_buffer: wgpu::Buffer,
+    /// The centre of the box around the moved corners.
+    centre: Vec3,
     /// The height map's red channel as 32-bit floats (1×1 for a procedural field).
     heights: wgpu::TextureView,
     /// The levels buffer and the output buffers, with what they hold room for (patches,
@@ -196,7 +201,7 @@ impl TessellationPass {
         for object in &mut self.objects {
             object.follow(&gpu.device, scene);
         }
-        let patches: Vec<Patches> = self.objects.iter().map(|o| o.patches.clone()).collect();
+        let patches: Vec<&Patches> = self.objects.iter().map(|o| &o.patches).collect();
         let (levels, edge_pixels) = bounded_levels(&patches, &scene.camera, bump);
         let triangles: u64 = levels.iter().map(|l| l.triangles).sum();
         let vertices: u64 = levels.iter().map(|l| l.vertices).sum();
@@ -210,18 +215,20 @@ impl TessellationPass {
             self.report = None;
             return None;
         }
+        let finest = levels.iter().flat_map(|l| l.patches.iter().map(|p| p[3])).max().unwrap_or(1);
         let made = self.objects.iter().zip(&levels).any(|(o, l)| o.levels != *l) || !geometry.has_displaced();
         if made {
-            self.record(gpu, encoder, levels.clone());
+            self.record(gpu, encoder, levels);
             geometry.set_displaced(self.objects.iter().map(|o| (o.patches.object, o.mesh())).collect());
         }
+        let asked = bump.edge_pixels;
         self.report = Some(TessellationReport {
             objects: self.objects.len(),
             triangles,
             vertices,
             edge_pixels,
-            asked: bump.edge_pixels,
-            finest: levels.iter().flat_map(|l| l.patches.iter().map(|p| p[3])).max().unwrap_or(1),
+            asked,
+            finest,
             made,
         });
         self.report.as_ref()
@@ -347,13 +354,11 @@ impl Object {
             bytemuck::cast_slice(&heights),
         );
         Some(Object {
-            patch_buffer: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("tessellation::patches"),
-                contents: bytemuck::cast_slice(&patches.patches),
-                usage: wgpu::BufferUsages::STORAGE,
-            }),
+            patch_buffer: patch_buffer(device, &patches),
             heights: heights.create_view(&wgpu::TextureViewDescriptor::default()),
+            centre: centre(&patches),
             patches,
+            uniform: UniformBuffer::new(device, "tessellation::params", &params),
             params,
             buffers: None,
             levels: Levels::default(),
@@ -369,11 +374,8 @@ impl Object {
         }
         let index = scene.displaced.iter().position(|s| s.object == self.patches.object);
         if let Some(moved) = index.and_then(|i| Patches::new(scene, i)) {
-            self.patch_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("tessellation::patches"),
-                contents: bytemuck::cast_slice(&moved.patches),
-                usage: wgpu::BufferUsages::STORAGE,
-            });
+            self.patch_buffer = patch_buffer(device, &moved);
+            self.centre = centre(&moved);
             self.patches = moved;
             self.levels = Levels::default();
             self.group = None;
@@ -381,13 +383,14 @@ impl Object {
     }
 
     /// Writes `levels` and the parameters, growing the buffers (and making the group again)
-    /// where they lack room. The totals are within the bound, so they fit in 32 bits.
+    /// where they lack room or the patches were placed again. The totals are within the bound,
+    /// so they fit in 32 bits.
     fn upload(&mut self, gpu: &Gpu, layout: &wgpu::BindGroupLayout, levels: Levels) {
         let device = &gpu.device;
         let (vertex_count, triangle_count) = (levels.vertices as u32, levels.triangles as u32);
         let need = [levels.patches.len() as u32, vertex_count, triangle_count];
         let fits = self.buffers.as_ref().is_some_and(|(.., room)| room.iter().zip(need).all(|(&r, n)| r >= n));
-        if !fits || self.group.is_none() {
+        if !fits {
             // Room for a little more than asked, so a moving camera does not grow them every frame.
             let room = need.map(|n| n + n / 4 + 1);
             let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
@@ -402,6 +405,7 @@ impl Object {
             let vertices = buffer("tessellation::vertices", u64::from(room[1]) * 48, wgpu::BufferUsages::VERTEX);
             let indices = buffer("tessellation::indices", u64::from(room[2]) * 12, wgpu::BufferUsages::INDEX);
             self.buffers = Some((level_buffer, vertices, indices, room));
+            self.group = None;
         }
         let (level_buffer, vertices, indices, _) = self.buffers.as_ref().expect("made above");
         let count = vertex_count.max(triangle_count).div_ceil(WORKGROUP);
@@ -410,43 +414,54 @@ impl Object {
         self.params.triangle_count = triangle_count;
         self.params.row = count.clamp(1, 65_535) * WORKGROUP;
         gpu.queue.write_buffer(level_buffer, 0, bytemuck::cast_slice(&levels.patches));
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("tessellation::params"),
-            contents: bytemuck::bytes_of(&self.params),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let buffers = [(0, &params), (1, &self.patch_buffer), (2, level_buffer), (4, vertices), (5, indices)];
-        let mut entries: Vec<wgpu::BindGroupEntry> = buffers
-            .iter()
-            .map(|(binding, buffer)| wgpu::BindGroupEntry { binding: *binding, resource: buffer.as_entire_binding() })
-            .collect();
-        entries.push(wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&self.heights) });
-        self.group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("tessellation::group"),
-            layout,
-            entries: &entries,
-        }));
+        self.uniform.write(&gpu.queue, &self.params);
+        if self.group.is_none() {
+            let buffers = [(1, &self.patch_buffer), (2, level_buffer), (4, vertices), (5, indices)];
+            let mut entries: Vec<wgpu::BindGroupEntry> = buffers
+                .iter()
+                .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                    binding: *binding,
+                    resource: buffer.as_entire_binding(),
+                })
+                .collect();
+            entries.push(wgpu::BindGroupEntry { binding: 0, resource: self.uniform.binding() });
+            entries
+                .push(wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::TextureView(&self.heights) });
+            self.group = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("tessellation::group"),
+                layout,
+                entries: &entries,
+            }));
+        }
         self.levels = levels;
     }
 
     /// The object's mesh as the GPU made it, in world coordinates.
     fn mesh(&self) -> GpuMesh {
         let (_, vertices, indices, _) = self.buffers.as_ref().expect("uploaded before it is drawn");
-        let (low, high) = self
-            .patches
-            .patches
-            .iter()
-            .flat_map(|p| p.moved)
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(low, high), p| {
-                (low.min(Vec3::from_slice(&p[..3])), high.max(Vec3::from_slice(&p[..3])))
-            });
         GpuMesh {
             vertices: vertices.clone(),
             indices: indices.clone(),
             index_count: self.params.triangle_count * 3,
-            centre: (low + high) / 2.0,
+            centre: self.centre,
         }
     }
+}
+
+/// The storage buffer of `patches`.
+fn patch_buffer(device: &wgpu::Device, patches: &Patches) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("tessellation::patches"),
+        contents: bytemuck::cast_slice(&patches.patches),
+        usage: wgpu::BufferUsages::STORAGE,
+    })
+}
+
+/// The centre of the box around the patches' moved corners (the transparency pass sorts by it).
+fn centre(patches: &Patches) -> Vec3 {
+    let corners = patches.patches.iter().flat_map(|p| p.moved).map(|p| Vec3::from_slice(&p[..3]));
+    let (low, high) = corners.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| (l.min(p), h.max(p)));
+    (low + high) / 2.0
 }
 
 /// The first `size` bytes of `buffer`, copied to one the CPU can map.

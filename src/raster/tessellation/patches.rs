@@ -10,7 +10,7 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 use super::{GridPoint, MAX_LEVEL, MAX_TRIANGLES, MAX_VERTICES, grid_point, grid_triangle, vertex_count, vertex_index};
 use crate::scene::{Camera, Mesh, Scene};
 use crate::settings::BumpSettings;
-use crate::texture::displacement::{face_normals, welded, with_field};
+use crate::texture::displacement::{face_normals, welded, welded_mean, with_field};
 use crate::texture::height::HeightField;
 
 /// One triangle of the object's mesh as the compute shader reads it (`Patch` in
@@ -192,7 +192,7 @@ impl Patches {
 /// Every object's levels for `camera` under the bound: `bump.edge_pixels`, or longer edges where
 /// the objects would have more than [`MAX_TRIANGLES`] triangles or [`MAX_VERTICES`] vertices
 /// together. Returns the levels and the edge length used.
-pub fn bounded_levels(objects: &[Patches], camera: &Camera, bump: &BumpSettings) -> (Vec<Levels>, f32) {
+pub fn bounded_levels(objects: &[&Patches], camera: &Camera, bump: &BumpSettings) -> (Vec<Levels>, f32) {
     let mut edge_pixels = bump.edge_pixels.max(0.5);
     loop {
         let levels: Vec<Levels> =
@@ -337,23 +337,17 @@ fn derivatives(p: [Vec3; 3], n: [Vec3; 3], uv: [Vec2; 3]) -> [Vec3; 4] {
     if all.iter().all(|v| v.is_finite()) { all } else { [Vec3::ZERO; 4] }
 }
 
-/// The welded point `members` moved: by their mean height along their mean normal (a seam's, a
-/// pole's, a box's corner's vertices move together).
+/// The welded point `members` moved by their mean height along their mean normal
+/// ([`welded_mean`], the uniform mesh's rule).
 fn moved_point(
     members: &[usize],
     (positions, normals, uvs): (&[Vec3], &[Vec3], &[Vec2]),
     field: &dyn HeightField,
     k: f32,
 ) -> Vec3 {
-    let (mut height, mut normal) = (0.0, Vec3::ZERO);
-    for &i in members {
-        let f = field.height(uvs[i]);
-        height += if f.is_finite() { f } else { 0.0 };
-        normal += normals[i];
-    }
     let at = positions[members[0]];
-    let Some(normal) = normal.try_normalize() else { return at };
-    let offset = k * height / members.len() as f32 * normal;
+    let Some((height, normal)) = welded_mean(members, (normals, uvs), field) else { return at };
+    let offset = k * height * normal;
     at + if offset.is_finite() { offset } else { Vec3::ZERO }
 }
 
