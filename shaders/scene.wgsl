@@ -15,7 +15,7 @@ fn scene_fragment(in: VertexOut) -> vec4f {
     }
     // The hybrid's traced transmission (src/raster/traced.rs): the frame draws transparent
     // surfaces here, each its own α·Im and, where traced on it, what it lets through.
-    if (TRACED & TRACED_TRANSMISSION) != 0u && material.transparent != 0u && !FLAT_COLOUR && BUMP_VIEW == 0u {
+    if HYBRID && (frame.traced & TRACED_TRANSMISSION) != 0u && material.transparent != 0u && !FLAT_COLOUR && BUMP_VIEW == 0u {
         var alpha = 1.0;
         if ALPHA_MODE == ALPHA_BLEND {
             alpha = coverage(in.uv);

@@ -168,3 +168,30 @@ fn a_frame_like_the_last_keeps_its_traced_terms() {
     headless.render(gpu, &scene, &settings);
     assert!(rays(&headless) > 0, "a moved camera traces anew");
 }
+
+/// The terms traced are a uniform of the frame, not a pipeline constant: the budget swaps each
+/// term in turn, and each swap drew with shading variants of its own (72 made, about 50 ms each
+/// on lavapipe, for the showcase's budget). Two-sided: each swap must still draw its own term
+/// (an image unlike the others'), and the image a fresh renderer draws.
+#[test]
+fn swapping_a_traced_term_makes_no_new_shading_variant() {
+    let gpu = common::gpu();
+    let scene = smaller(common::load("scenes/showcase.toml"), 160);
+    let mut headless = mirador::raster::Headless::new(gpu, &scene);
+    let plain = headless.render(gpu, &scene, &scene.settings);
+    let plain_variants = headless.renderer.shader_variants();
+    let first = traced(&scene.settings, &[Traced::Shadows]);
+    let mut images = vec![plain, headless.render(gpu, &scene, &first)];
+    let variants = headless.renderer.shader_variants();
+    assert!(variants > plain_variants, "a frame tracing a term draws with the hybrid's variants");
+    let swaps = [&[Traced::Reflections][..], &[Traced::Transmission], &[Traced::Textures], Traced::ALL];
+    for terms in swaps {
+        let settings = traced(&scene.settings, terms);
+        let image = headless.render(gpu, &scene, &settings);
+        assert_eq!(headless.renderer.shader_variants(), variants, "{terms:?} traced made a new variant");
+        let fresh = mirador::raster::Headless::new(gpu, &scene).render(gpu, &scene, &settings);
+        assert_eq!(image, fresh, "{terms:?}: the kept variants draw what fresh ones draw");
+        assert!(!images.contains(&image), "{terms:?}: the swap drew another swap's image");
+        images.push(image);
+    }
+}

@@ -101,7 +101,7 @@ fn gpu_structs_match_their_wgsl_twins_field_by_field() {
         &scene,
         "Frame",
         size_of::<GpuFrame>(),
-        &fields!(GpuFrame { ambient, light_count, terms, lod_bias, bump_scale, bump_delta_texels, lights }),
+        &fields!(GpuFrame { ambient, light_count, terms, lod_bias, bump_scale, bump_delta_texels, traced, lights }),
     );
     check_struct(
         &scene,

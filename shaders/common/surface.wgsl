@@ -26,8 +26,9 @@ override BUMP_ANALYTIC: bool = false;
 // bump.method = "parallax": the relief's point the view ray meets first is shaded.
 override PARALLAX: bool = false;
 override FLAT_COLOUR: bool = false;
-// TRACED_* bits: the hybrid's terms read from the view's traced image (src/raster/traced.rs).
-override TRACED: u32 = 0u;
+// Whether the frame traces any of the hybrid's terms; which ones, `frame.traced` says. A constant,
+// so that a frame tracing none runs none of their code (lavapipe runs both sides of a branch).
+override HYBRID: bool = false;
 // The material's inputs (MaterialKey).
 override COLOR_TEXTURE: bool = false;
 override HEIGHT_KIND: u32 = 0u;
@@ -354,14 +355,14 @@ fn shade_surface(in: VertexOut) -> Shaded {
     let duv_dy = dpdy(in.uv);
     let tangents = surface_tangents(in);
     // The hybrid's terms hold at this pixel only if they were traced on this fragment's surface.
-    let here = TRACED != 0u && traced_object(in.clip.xy) == in.object + 1u;
+    let here = HYBRID && frame.traced != 0u && traced_object(in.clip.xy) == in.object + 1u;
     // Parallax mapping shades the point of the relief the view ray meets first.
     var at = in;
     if PARALLAX && HEIGHT_KIND != HEIGHT_NONE {
         at.uv = parallax_uv(in.uv, normalize(in.normal), tangents, -view_vector(in.world));
     }
     var color = surface_color(at.uv, duv_dx, duv_dy);
-    if (TRACED & TRACED_TEXTURES) != 0u && here {
+    if (frame.traced & TRACED_TEXTURES) != 0u && here {
         color = traced_term(in.clip.xy, TRACED_SURFACE_LAYER);
     }
     if INSPECT {
@@ -412,7 +413,7 @@ fn lit_by_lights(ambient: vec3f, in: VertexOut, surface: Surface, n: vec3f, v: v
     var radiance = ambient;
     var checker = -1.0;
     // The hybrid's traced lights: where traced, the lights without a shadow map are the tracer's.
-    let traced_lights = (TRACED & TRACED_LIGHTS) != 0u && here;
+    let traced_lights = (frame.traced & TRACED_LIGHTS) != 0u && here;
     for (var i = 0u; i < min(frame.light_count, MAX_LIGHTS); i++) {
         let light = frame.lights[i];
         let incidence = light_incidence(light, in.world);
@@ -424,7 +425,7 @@ fn lit_by_lights(ambient: vec3f, in: VertexOut, surface: Surface, n: vec3f, v: v
                 probe.lights[i].lit = 1.0;
             }
             var visible: vec3f;
-            if (TRACED & TRACED_SHADOWS) != 0u && here && light.shadow_slot >= 0 {
+            if (frame.traced & TRACED_SHADOWS) != 0u && here && light.shadow_slot >= 0 {
                 visible = traced_term(in.clip.xy, TRACED_SHADOWS_LAYER + light.shadow_slot);
             } else {
                 visible = visibility(light, in.world, facing, in.clip.xy);
@@ -472,7 +473,7 @@ fn with_mirror_term(lit: vec3f, in: VertexOut, n: vec3f, v: vec3f, here: bool) -
         environment_radiance = select(vec3f(0.0), environment_lookup(in.world, r, in.env_layer), in.env_layer != ENV_LAYER_NONE);
         // Where the hybrid traced this surface's reflection, that is added below instead (the
         // lookup stays: glass reads it).
-        if (TRACED & TRACED_REFLECTIONS) == 0u || !here {
+        if (frame.traced & TRACED_REFLECTIONS) == 0u || !here {
             radiance += material.reflectance * environment_radiance;
         }
         if INSPECT {
@@ -481,7 +482,7 @@ fn with_mirror_term(lit: vec3f, in: VertexOut, n: vec3f, v: vec3f, here: bool) -
             probe.env_layer = in.env_layer;
         }
     }
-    if (TRACED & TRACED_REFLECTIONS) != 0u && here {
+    if (frame.traced & TRACED_REFLECTIONS) != 0u && here {
         // kps·MPS·L(r), L(r) traced: in place of the mirrored camera's image and the environment
         // maps, which the frame leaves out when this is on.
         let traced_reflection = material.reflectance * traced_term(in.clip.xy, TRACED_REFLECTIONS_LAYER);

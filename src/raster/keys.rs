@@ -92,9 +92,9 @@ pipeline_constants! {
         flat_colour: bool = "FLAT_COLOUR" <- settings.raster.flat_colour,
         /// `ENV_MAP_*`: where curved mirrors look their reflection up; 0: nowhere.
         environment: u32 = "ENVIRONMENT" <- environment_code(&settings.environment),
-        /// `TRACED_*` bits, one a row of the approximations table (`crate::settings::hybrid`): the
-        /// hybrid's terms read from the view's traced image.
-        traced: u32 = "TRACED" <- settings.hybrid.traced().0,
+        /// Whether any of the hybrid's terms is traced: which ones is `GpuFrame::traced`, so that
+        /// swapping one term for another makes no new variant.
+        hybrid: bool = "HYBRID" <- !settings.hybrid.traced().is_empty(),
         /// Record what the shading computes at the inspected pixel (`shaders/common/inspect.wgsl`): the
         /// main view of an inspected frame only.
         inspect: bool = "INSPECT" <- false,

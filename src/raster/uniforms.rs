@@ -68,6 +68,11 @@ pub struct GpuFrame {
     pub lod_bias: f32,
     pub bump_scale: f32,
     pub bump_delta_texels: f32,
+    /// `TRACED_*` bits, one a row of the approximations table (`crate::settings::hybrid`): the
+    /// hybrid's terms read from the view's traced image. A uniform, not a pipeline constant, so
+    /// that swapping a term makes no new shading variant.
+    pub traced: u32,
+    pub _pad: [u32; 3],
     pub lights: [GpuLight; MAX_LIGHTS],
 }
 
@@ -99,6 +104,8 @@ impl GpuFrame {
             lod_bias: settings.textures.lod_bias,
             bump_scale: settings.bump.scale,
             bump_delta_texels: settings.bump.delta_texels,
+            traced: settings.hybrid.traced().0,
+            _pad: [0; 3],
             lights: gpu_lights,
         }
     }

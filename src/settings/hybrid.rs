@@ -8,8 +8,8 @@
 //! the viewer shows the switch in, when a scene makes the approximation at all, what the raster
 //! frame leaves out while it is traced, how many layers of a view's traced image its term fills,
 //! the budget's name and sentence for it; and, numbered from the row's place, its bit in the
-//! shading's `TRACED` constant and its first layer, which `crate::shaders::constants` writes
-//! into the WGSL. What stays by hand is what no table can say: the tracer's term
+//! frame's `traced` uniform (`Frame::traced` in the WGSL) and its first layer, which
+//! `crate::shaders::constants` writes into the WGSL. What stays by hand is what no table can say: the tracer's term
 //! (`crate::trace::terms`), the shading's branch that reads it (`shaders/common/surface.wgsl`)
 //! and the frame's phases. A new traced approximation is a row, a term and a branch.
 
@@ -224,7 +224,7 @@ impl Traced {
         &APPROXIMATIONS[self as usize]
     }
 
-    /// Its bit in the shading's `TRACED` constant (`TRACED_NAME` in the WGSL).
+    /// Its bit in the frame's `traced` uniform (`TRACED_NAME` in the WGSL).
     pub const fn bit(self) -> u32 {
         1 << self as u32
     }

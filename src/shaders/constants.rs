@@ -150,7 +150,7 @@ wgsl_constants! {
 }
 
 /// The WGSL `const`s of [`ALL`] and of the approximations table: `TRACED_NAME`, the row's bit in
-/// the `TRACED` pipeline constant, and `TRACED_NAME_LAYER`, its term's first layer in the view's
+/// the frame's `traced` uniform, and `TRACED_NAME_LAYER`, its term's first layer in the view's
 /// traced image (after `TRACED_SURFACE_LAYER`). Written once, the first time a module is
 /// composed.
 pub fn prelude() -> &'static str {
