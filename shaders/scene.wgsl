@@ -13,7 +13,7 @@ fn scene_fragment(in: VertexOut) -> vec4f {
     if masked_out(in.uv) {
         discard;
     }
-    // The hybrid's traced transmission (src/raster/traced.rs): the frame draws transparent
+    // The hybrid's traced transmission (src/raster/traced/mod.rs): the frame draws transparent
     // surfaces here, each its own α·Im and, where traced on it, what it lets through.
     if HYBRID && (frame.traced & TRACED_TRANSMISSION) != 0u && material.transparent != 0u && !FLAT_COLOUR && BUMP_VIEW == 0u {
         var alpha = 1.0;

@@ -1,4 +1,4 @@
-//! The hybrid (`settings.hybrid`, `src/raster/traced.rs`): with every approximation the rasterizer
+//! The hybrid (`settings.hybrid`, `src/raster/traced/mod.rs`): with every approximation the rasterizer
 //! makes swapped for its traced term, the raster frame is the tracer's image, up to what no swap
 //! removes (primary visibility). Checked on every scene of `assets/scenes/` and its course, and
 //! two-sided: each scene's plain raster frame must be measurably farther from the tracer wherever
@@ -194,4 +194,110 @@ fn swapping_a_traced_term_makes_no_new_shading_variant() {
         assert!(!images.contains(&image), "{terms:?}: the swap drew another swap's image");
         images.push(image);
     }
+}
+
+/// The hybrid's terms traced elsewhere (`TracedAt::Elsewhere`, the page's Web Workers): a frame
+/// asks for the views it does not keep and draws them meanwhile with the coarser terms it has, or
+/// with coarse terms it traces; once every view's terms are handed back, traced as a worker traces them (the request through
+/// JSON, in bands, the answer encoded and decoded), it draws the image of terms traced here, bit
+/// for bit, and traces nothing itself.
+#[test]
+fn terms_traced_elsewhere_draw_the_image_of_terms_traced_here() {
+    use mirador::raster::traced::{self, TermsRequest, TracedAt};
+    let gpu = common::gpu();
+    let scene = smaller(common::load("scenes/showcase.toml"), 160);
+    let settings = every_term_traced(&scene.settings);
+    let here = mirador::raster::Headless::new(gpu, &scene).render(gpu, &scene, &settings);
+    let mut headless = mirador::raster::Headless::new(gpu, &scene);
+    let count = |headless: &mirador::raster::Headless, figure| headless.report.count("traced terms", figure);
+    headless.renderer.traced_stride = 4;
+    let coarse = headless.render(gpu, &scene, &settings);
+    assert_ne!(coarse, here, "the coarse terms must show");
+
+    let elsewhere = TracedAt::Elsewhere { coarse: 4 };
+    let mut fresh = mirador::raster::Headless::new(gpu, &scene);
+    fresh.renderer.traced_at = elsewhere;
+    assert_eq!(fresh.render(gpu, &scene, &settings), coarse, "a new image's stand-ins are traced coarse");
+    assert!(count(&fresh, "rays") > 0 && !fresh.renderer.traced.take_requests().is_empty());
+
+    headless.renderer.traced_stride = 1;
+    headless.renderer.traced_at = elsewhere;
+    let waiting = headless.render(gpu, &scene, &settings);
+    assert_eq!(count(&headless, "rays"), 0, "the coarser terms kept stand in: nothing is traced here");
+    assert_eq!(waiting, coarse);
+    let requests = headless.renderer.traced.take_requests();
+    assert_eq!(requests.len() as u64, count(&headless, "views asked"));
+    // (The glass ball's cube faces are drawn in the first frame only, then kept with their terms.)
+    assert!(!requests.is_empty(), "the main view is asked for");
+    assert!(headless.renderer.traced.awaiting());
+    headless.render(gpu, &scene, &settings);
+    assert!(headless.renderer.traced.take_requests().is_empty(), "a view asked for is not asked again");
+
+    // As the page's workers trace: the frame's tracer, the request as JSON, bands of 8 rows.
+    let raster = settings.hybrid.raster_settings(&settings).unwrap_or(settings.clone());
+    let tracer = mirador::trace::Tracer::new(&scene, &raster);
+    for request in &requests {
+        let sent: TermsRequest = serde_json::from_str(&serde_json::to_string(request).unwrap()).unwrap();
+        assert_eq!(&sent, request);
+        let bands: Vec<_> = sent
+            .bands(8)
+            .iter()
+            .filter_map(|band| band.trace(&tracer))
+            .map(|terms| {
+                let (header, values) = traced::encode(&terms);
+                traced::decode(&header, &values).expect("an answer decodes")
+            })
+            .collect();
+        if bands.is_empty() {
+            continue;
+        }
+        let terms = traced::join(bands).expect("the bands follow one another");
+        assert!(headless.renderer.traced.receive(&gpu.device, (request.ticket, request.view), &terms));
+    }
+    assert!(!headless.renderer.traced.awaiting());
+    let done = headless.render(gpu, &scene, &settings);
+    assert_eq!(count(&headless, "rays"), 0);
+    assert_eq!(done, here, "terms traced elsewhere draw what terms traced here draw");
+
+    // An answer for inputs that changed since is dropped.
+    let stale = &requests[0];
+    let mut moved = scene.clone();
+    moved.camera.eye += glam::Vec3::new(0.1, 0.0, 0.0);
+    headless.render(gpu, &moved, &settings);
+    let terms = stale.trace(&tracer).expect("the main view has a window");
+    assert!(!headless.renderer.traced.receive(&gpu.device, (stale.ticket, stale.view), &terms));
+}
+
+/// The viewer's coarse terms refined (`traced_stride` 4, then 1) draw the image of terms traced
+/// at every pixel at once: the cube faces too, which a frame draws only when what they see
+/// changed, so they are drawn again at each stride, and again when their terms traced elsewhere
+/// come back.
+#[test]
+fn refined_terms_reach_the_cube_faces() {
+    use mirador::raster::traced::{TermsRequest, TracedAt};
+    let gpu = common::gpu();
+    let scene = smaller(common::load("scenes/showcase.toml"), 160);
+    let settings = traced(&scene.settings, &[Traced::Shadows]);
+    let whole = mirador::raster::Headless::new(gpu, &scene).render(gpu, &scene, &settings);
+    let mut headless = mirador::raster::Headless::new(gpu, &scene);
+    let faces = |headless: &mirador::raster::Headless| headless.report.count("environment cubes", "faces");
+    headless.renderer.traced_stride = 4;
+    headless.render(gpu, &scene, &settings);
+    assert_eq!(faces(&headless), 6, "the glass ball's cube is drawn");
+    headless.renderer.traced_stride = 1;
+    assert!(headless.render(gpu, &scene, &settings) == whole, "refined here, cube faces and all");
+
+    // Elsewhere: the faces' terms handed back are drawn.
+    let mut elsewhere = mirador::raster::Headless::new(gpu, &scene);
+    elsewhere.renderer.traced_at = TracedAt::Elsewhere { coarse: 4 };
+    elsewhere.render(gpu, &scene, &settings);
+    let requests: Vec<TermsRequest> = elsewhere.renderer.traced.take_requests();
+    assert!(requests.len() > 6, "the main view and the cube's faces are asked for");
+    let raster = settings.hybrid.raster_settings(&settings).unwrap_or(settings.clone());
+    let tracer = mirador::trace::Tracer::new(&scene, &raster);
+    for request in &requests {
+        let terms = request.trace(&tracer).expect("every view has a window");
+        assert!(elsewhere.renderer.traced.receive(&gpu.device, (request.ticket, request.view), &terms));
+    }
+    assert!(elsewhere.render(gpu, &scene, &settings) == whole, "the terms traced elsewhere, cube faces and all");
 }

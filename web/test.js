@@ -58,13 +58,14 @@ export function run(mirador) {
     "wait 1s",
     "screenshot difference.png",
     // The hybrid in the page: shadow maps without bias (acne everywhere), their visibility
-    // traced instead, refined on the page's thread.
+    // traced instead: coarse on the page's thread, then at every pixel by the tracer's workers
+    // (with WebGL2 too), or on the page's thread where there are none.
     "view raster",
     "set shadows.depth_bias=0",
     "set shadows.slope_bias=0",
     "set shadows.normal_offset=0",
     "set hybrid.shadows=true",
-    "wait 10s",
+    "wait traced",
     "screenshot hybrid.png",
     // (the screenshot is posted with the view's rectangle a frame or two later: the lab's editor
     // must not have narrowed the view by then)

@@ -52,7 +52,7 @@ struct Frame {
     bump_scale: f32,
     // The finite-difference step Δ in texels of the height map.
     bump_delta_texels: f32,
-    // TRACED_* bits: the hybrid's terms read from the view's traced image (src/raster/traced.rs).
+    // TRACED_* bits: the hybrid's terms read from the view's traced image (src/raster/traced/mod.rs).
     // A field, not a pipeline constant, though it switches code: swapping a term (mirador budget
     // swaps each in turn, the viewer's panel) then draws with the variants already made. The
     // constant HYBRID (shaders/common/surface.wgsl) leaves the code out where none is traced.

@@ -30,7 +30,7 @@
 // polygons cover this view's pixel.
 @group(2) @binding(4) var drawn_images: texture_2d_array<f32>;
 // Copied in from the CPU: from TRACED_FIRST_LAYER, the hybrid's traced terms
-// (src/raster/traced.rs) at the first opaque surface of this view's pixel: layer
+// (src/raster/traced/mod.rs) at the first opaque surface of this view's pixel: layer
 // TRACED_SURFACE_LAYER its colour C and object + 1, then each traced term's layers from
 // TRACED_NAME_LAYER (the approximations table, src/settings/hybrid.rs).
 @group(2) @binding(13) var copied_images: texture_2d_array<f32>;

@@ -236,7 +236,7 @@ impl Traced {
 }
 
 /// A set of traced terms: the bits of [`Traced::bit`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub struct TracedSet(pub u32);
 
 impl TracedSet {

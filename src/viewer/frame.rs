@@ -276,8 +276,17 @@ impl Viewer {
         {
             self.raster.set_wgsl(&screen.gpu, scene, lab.wgsl());
         }
+        // The page's workers trace the hybrid's terms at every pixel (`raster_view::terms`).
+        #[cfg(target_arch = "wasm32")]
+        self.raster.take_terms(&screen.gpu, self.traced.worker.pool());
         // Each pass is timed on its own only for the overlay, which lists them.
         let drawn = self.raster.render(screen, scene, &self.settings, (self.view.overlay_open, filter));
+        #[cfg(target_arch = "wasm32")]
+        if let Some(pool) = self.traced.worker.pool() {
+            let (scene, settings) = (&self.scene, &self.settings);
+            let recipe = || super::traced::SceneRecipe::of(&scene.scene, &scene.overrides, settings);
+            self.raster.give_terms(pool, || serde_json::to_string(&recipe()).unwrap_or_default());
+        }
         (self.scene.scene.camera.width, self.scene.scene.camera.height) = (width, height);
         if scale == 1.0
             && let Some(lab) = self.lab.as_mut().filter(|lab| lab.panel().shown == super::lab::LabShown::Difference)

@@ -24,6 +24,7 @@ use super::screen::{Composition, PendingImage, Screen};
 use super::upscale::Reencode;
 use crate::gpu::Gpu;
 use crate::gpu::texture::GpuTexture;
+use crate::raster::traced::TracedAt;
 use crate::raster::{FrameReport, FrameTargets, Renderer, drawn_size};
 use crate::scene::{Camera, Light};
 use crate::shaders::{Profile, Wgsl};
@@ -61,7 +62,19 @@ pub(in crate::viewer) struct RasterView {
     /// The stride the hybrid's traced terms of the image shown were traced at (1: every pixel):
     /// a new image's are traced coarse, and refined frame by frame while its inputs stay.
     traced_stride: u32,
+    /// The page's Web Workers trace the terms at every pixel (`TracedAt::Elsewhere`): a new
+    /// image's frame traces them coarse here and asks the workers for all, and is refined in one
+    /// step when their terms come back.
+    elsewhere: bool,
+    /// Terms came back from the workers, or they failed while some were due: draw again.
+    terms_arrived: bool,
+    /// The bands of each view asked of the workers, as they come back.
+    #[cfg(target_arch = "wasm32")]
+    terms: terms::TermsInWorkers,
 }
+
+#[cfg(target_arch = "wasm32")]
+mod terms;
 
 /// The stride a new image's traced terms start at: one pixel in 16, refined to 4, then to all.
 const COARSE_TRACED_STRIDE: u32 = 4;
@@ -139,6 +152,10 @@ impl RasterView {
             reencode: (screen.composition == Composition::Textured && gl_without_image_copies(gpu))
                 .then(|| Reencode::new(&gpu.device, DISPLAY_FORMAT)),
             traced_stride: 1,
+            elsewhere: false,
+            terms_arrived: false,
+            #[cfg(target_arch = "wasm32")]
+            terms: Default::default(),
         }
     }
 
@@ -178,9 +195,15 @@ impl RasterView {
             if !self.refining() {
                 return Drawn::Kept;
             }
-            self.traced_stride /= 2;
+            // Terms that came back are drawn at the stride they were asked at.
+            if !std::mem::take(&mut self.terms_arrived) {
+                self.traced_stride = if self.elsewhere { 1 } else { self.traced_stride / 2 };
+            }
         } else {
-            self.traced_stride = if settings.hybrid.any() { COARSE_TRACED_STRIDE } else { 1 };
+            // Elsewhere, the coarse terms are the stand-ins of the frame that asks for all.
+            let coarse = settings.hybrid.any() && !self.elsewhere;
+            self.traced_stride = if coarse { COARSE_TRACED_STRIDE } else { 1 };
+            self.terms_arrived = false;
         }
         let gpu = &screen.gpu;
         if revision != self.revision {
@@ -195,6 +218,8 @@ impl RasterView {
         let start = Instant::now();
         self.renderer.profile = profile;
         self.renderer.traced_stride = self.traced_stride;
+        self.renderer.traced_at =
+            if self.elsewhere { TracedAt::Elsewhere { coarse: COARSE_TRACED_STRIDE } } else { TracedAt::Here };
         self.report = self.renderer.render(gpu, scene, settings, &mut frame.targets, &frame.image.view);
         if let Some((display, display_view)) = &frame.display {
             let mut encoder = gpu
@@ -223,9 +248,16 @@ impl RasterView {
         Drawn::New(elapsed)
     }
 
+    /// Whether the image shown is drawn with `settings` and its hybrid's terms traced at every
+    /// pixel (here, or by the page's workers and drawn).
+    pub(in crate::viewer) fn terms_complete(&self, settings: &RenderSettings) -> bool {
+        let drawn = self.drawn.as_ref().is_some_and(|d| d.settings == *settings);
+        drawn && !self.refining() && !self.renderer.traced.awaiting()
+    }
+
     /// Whether the image shown has traced terms still to refine: the viewer draws again at once.
     pub(in crate::viewer) fn refining(&self) -> bool {
-        self.traced_stride > 1 && self.drawn.as_ref().is_some_and(|d| d.settings.hybrid.any())
+        (self.traced_stride > 1 || self.terms_arrived) && self.drawn.as_ref().is_some_and(|d| d.settings.hybrid.any())
     }
 
     fn sized_targets(&self, gpu: &Gpu, size: (u32, u32), settings: &RenderSettings) -> SizedTargets {

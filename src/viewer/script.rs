@@ -27,7 +27,8 @@
 //! overlay off                   hide the frame times over the 3D view
 //! wait 10                       let 10 frames pass
 //! wait 2s                       let 2 seconds pass (frames go on being drawn)
-//! wait traced                   until the ray-traced image (and difference) is complete
+//! wait traced                   until the ray-traced image (and difference) is complete; in
+//!                               the raster view with the hybrid on, its terms at every pixel
 //! measure                       start `--stats`' means at the next frame (else they start
 //!                               after the last step)
 //! screenshot FILE.png           the whole window, written atomically

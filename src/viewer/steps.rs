@@ -49,7 +49,10 @@ impl Viewer {
         }
         if let Some(since) = script.wait_traced_since {
             let reading = self.view.mode == ViewMode::Difference && !self.traced.worker.compared(self.traced.key);
-            let at_once = self.traced_waited() || !self.view.mode.needs_traced() || reading;
+            // (In the raster view without the hybrid the step fails at once; with it, the terms'
+            // last frames are due at once, `RasterView::refining`, and the workers wake the page.)
+            let nothing = !self.view.mode.needs_traced() && !self.settings.hybrid.any();
+            let at_once = self.traced_waited() || nothing || reading;
             return Some(if at_once { now } else { since + TRACE_TIMEOUT });
         }
         Some(now)
@@ -118,8 +121,10 @@ impl Viewer {
                 self.script.wait_traced_since = None;
             } else if since.elapsed() > TRACE_TIMEOUT {
                 bail!("`wait traced`: the traced image was not complete after {} s", TRACE_TIMEOUT.as_secs());
-            } else if !self.view.mode.needs_traced() {
-                bail!("`wait traced` in the raster view: switch to traced, split or difference first");
+            } else if !self.view.mode.needs_traced() && !self.settings.hybrid.any() {
+                bail!(
+                    "`wait traced` in the raster view without the hybrid: switch to traced, split or difference first"
+                );
             } else {
                 return Ok(true);
             }
@@ -128,8 +133,12 @@ impl Viewer {
     }
 
     /// Whether what `wait traced` waits for is there: the traced image of the current request,
-    /// complete, and in the difference view its FLIP map.
+    /// complete, and in the difference view its FLIP map; in the raster view with the hybrid on,
+    /// its traced terms at every pixel.
     pub(super) fn traced_waited(&self) -> bool {
+        if !self.view.mode.needs_traced() && self.settings.hybrid.any() {
+            return self.raster.terms_complete(&self.settings);
+        }
         let difference = self.view.mode == ViewMode::Difference;
         self.traced.request.is_some() && self.traced.complete(self.traced.key, difference)
     }

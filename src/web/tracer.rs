@@ -7,17 +7,25 @@
 //! settings. The rows it returns are the ones `Tracer::render_rows` returns on the page's thread,
 //! encoded as the page would encode them, to the bit (web/test.sh checks the finished image
 //! against `mirador trace`).
+//!
+//! The workers also trace the hybrid's terms of the page's raster frame
+//! (`crate::raster::traced::TermsRequest`), with a tracer of their own for them: the frame's
+//! scene, and its settings with what the traced terms replace left out, as the frame's own
+//! tracer has them.
 
 use std::cell::RefCell;
 
 use wasm_bindgen::prelude::*;
 
 use crate::output::{OutputTransform, encode_image};
+use crate::raster::traced::{TermsRequest, encode};
 use crate::trace::Tracer;
+use crate::trace::terms::TracedTerms;
 use crate::viewer::traced::{OwnedTracer, SceneRecipe};
 
 thread_local! {
     static TRACER: RefCell<Option<OwnedTracer>> = const { RefCell::new(None) };
+    static TERMS_TRACER: RefCell<Option<OwnedTracer>> = const { RefCell::new(None) };
 }
 
 /// Rebuilds the scene of `job` (JSON of [`SceneRecipe`]) and a tracer of it, for the rows asked
@@ -46,5 +54,37 @@ pub fn trace_rows(first: u32, end: u32) -> Result<Vec<u8>, JsError> {
         let height = end.saturating_sub(first);
         let width = rows.len() as u32 / height.max(1);
         Ok(encode_image(width, height, &rows, transform).into_raw())
+    })
+}
+
+/// Rebuilds the scene of `job` (JSON of [`SceneRecipe`]: the page's raster frame's) and a tracer
+/// of it for the hybrid's terms asked next.
+#[wasm_bindgen]
+pub fn terms_job(job: &str) -> Result<(), JsError> {
+    TERMS_TRACER.with(|t| *t.borrow_mut() = None);
+    let job: SceneRecipe = serde_json::from_str(job).map_err(|e| JsError::new(&format!("a terms job: {e}")))?;
+    let (scene, settings) = job.scene().map_err(|e| JsError::new(&e))?;
+    let settings = settings.hybrid.raster_settings(&settings).unwrap_or(settings);
+    let tracer = OwnedTracer::new(Box::new((scene, settings)), |owned| Tracer::new(&owned.0, &owned.1));
+    TERMS_TRACER.with(|t| *t.borrow_mut() = Some(tracer));
+    Ok(())
+}
+
+/// The hybrid's terms of `request` (JSON of [`TermsRequest`]), as `[header, numbers]`
+/// ([`crate::raster::traced::encode`]): a string and a `Float32Array`.
+#[wasm_bindgen]
+pub fn trace_terms(request: &str) -> Result<js_sys::Array, JsError> {
+    let request: TermsRequest =
+        serde_json::from_str(request).map_err(|e| JsError::new(&format!("a terms request: {e}")))?;
+    TERMS_TRACER.with(|t| {
+        let tracer = t.borrow();
+        let tracer = tracer.as_ref().ok_or_else(|| JsError::new("terms asked before a terms job"))?;
+        let terms = tracer.with_dependent(|_, tracer| request.trace(tracer)).unwrap_or(TracedTerms {
+            window: [0; 4],
+            layers: Vec::new(),
+            rays: Default::default(),
+        });
+        let (header, values) = encode(&terms);
+        Ok(js_sys::Array::of2(&header.into(), &js_sys::Float32Array::from(&values[..])))
     })
 }

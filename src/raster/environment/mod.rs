@@ -763,9 +763,11 @@ fn world_uniform(scene: &Scene) -> GpuEnvironment {
 }
 
 /// What the dynamic cubes see, hashed: every object's transform, every material, light and
-/// setting (the camera is left out: the cubes do not depend on it).
-pub fn capture_key(scene: &Scene, settings: &RenderSettings) -> u64 {
+/// setting, and `traced`, what their faces' traced terms are (the hybrid's; the camera is left out:
+/// the cubes do not depend on it).
+pub fn capture_key(scene: &Scene, settings: &RenderSettings, traced: u64) -> u64 {
     let mut hasher = std::collections::hash_map::DefaultHasher::new();
+    traced.hash(&mut hasher);
     for object in &scene.objects {
         object.world_from_local.to_cols_array().map(f32::to_bits).hash(&mut hasher);
         object.material.0.hash(&mut hasher);

@@ -64,15 +64,16 @@ impl EnvironmentPass {
     }
 
     /// Makes the maps the settings ask for and writes their uniform; returns the cube faces due
-    /// this frame (every face of every dynamic cube, when something they see changed or their
-    /// refresh came round; none otherwise).
+    /// this frame (every face of every dynamic cube, when something they see changed, their
+    /// faces' traced terms (`traced`, a key of them) changed, or their refresh came round; none
+    /// otherwise).
     pub fn prepare(
         &mut self,
         gpu: &Gpu,
         (mipmaps, frame): (&MipmapGenerator, &mut FrameEncoder),
         scene: &Scene,
         settings: &RenderSettings,
-        bounds: Option<(Vec3, Vec3)>,
+        (bounds, traced): (Option<(Vec3, Vec3)>, u64),
     ) -> Vec<CubeFace> {
         let env = &settings.environment;
         if self.maps.as_ref().is_none_or(|maps| maps.cube_size != env.cube_size) {
@@ -90,7 +91,7 @@ impl EnvironmentPass {
         let drawn = env.enabled && env.dynamic && env.map == EnvironmentMap::Cube;
         let due = (drawn || env.view == EnvironmentView::Cross)
             && !self.objects.is_empty()
-            && maps.capture_due(capture_key(scene, settings), env.refresh);
+            && maps.capture_due(capture_key(scene, settings, traced), env.refresh);
         frame.end("environment maps", &[("sphere map made", Figure::Flag(sphere_made))]);
         if !due {
             return Vec::new();

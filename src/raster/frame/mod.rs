@@ -35,7 +35,7 @@ use super::shadow::views::ShadowLayout;
 use super::shadow::{ShadowMaps, ShadowPass};
 use super::targets::{FrameTargets, ViewImage, drawn_size};
 use super::tessellation::pass::TessellationPass;
-use super::traced::{self, KeptTraced, PreparedTraced};
+use super::traced::{self, KeptTraced, PreparedTraced, TracedAt};
 use super::transparency::{PreparedTransparency, TransparencyPass};
 use super::view::{ViewKind, ViewTargets};
 use super::view_group::{FrameInputs, ViewGroups};
@@ -107,8 +107,12 @@ pub struct Renderer {
     /// side, the block given its terms: the viewer's coarse frames, refined while the camera
     /// rests (1, the default: every pixel).
     pub traced_stride: u32,
-    /// The last frame's traced terms, kept while nothing they depend on changes.
-    traced: KeptTraced,
+    /// Where they are traced: here (the default), or elsewhere, by whoever takes the views asked
+    /// for from [`Self::traced`] and hands their terms back (the page's Web Workers).
+    pub traced_at: TracedAt,
+    /// The last frame's traced terms, kept while nothing they depend on changes; the views asked
+    /// for elsewhere.
+    pub traced: KeptTraced,
 }
 
 /// The phases every view draws, prepared for one frame.
@@ -185,6 +189,7 @@ impl Renderer {
             facts: FrameFacts::default(),
             profile: false,
             traced_stride: 1,
+            traced_at: TracedAt::Here,
             traced: KeptTraced::default(),
         }
     }
@@ -305,7 +310,7 @@ impl Renderer {
             .collect();
         let traced = wanted.map(|terms| {
             let inputs = (&gpu.device, scene, settings);
-            self.traced.prepare(inputs, &mut frame, (terms, self.traced_stride), &plan.lights, &views)
+            self.traced.prepare(inputs, &mut frame, (terms, self.traced_stride, self.traced_at), &plan.lights, &views)
         });
         let inspection = self.inspector.as_ref().map(|i| &i.buffer);
         let inputs = frame_inputs(&maps, environment, inspection);
@@ -408,7 +413,9 @@ impl Renderer {
         let (segments, adaptive) = (scene.sphere_segments(), settings.raster.adaptive_tessellation);
         scene_gpu.geometry.prepare(&gpu.device, scene, &scene.camera, segments, adaptive);
         let bounds = scene_gpu.geometry.bounds;
-        let faces = self.environment.prepare(gpu, (&self.mipmaps, frame), scene, settings, bounds);
+        // The faces are drawn again with finer terms, or with those traced elsewhere.
+        let traced = traced::wanted(settings).map_or(0, |_| self.traced.faces_key(self.traced_stride));
+        let faces = self.environment.prepare(gpu, (&self.mipmaps, frame), scene, settings, (bounds, traced));
         let plan = plan(scene, &scene_gpu.geometry, settings, (size, &self.mirrors.mirrors), faces);
         for view in plan.views() {
             scene_gpu.views.write(&gpu.queue, view.slot, &view.view);

@@ -107,7 +107,7 @@ pub fn grid_triangle(n: u32, t: u32) -> [(u32, u32); 3] {
     }
     let r = t - first;
     let a = r / 2;
-    if r % 2 == 0 { [(a, b), (a + 1, b), (a, b + 1)] } else { [(a + 1, b), (a + 1, b + 1), (a, b + 1)] }
+    if r.is_multiple_of(2) { [(a, b), (a + 1, b), (a, b + 1)] } else { [(a + 1, b), (a + 1, b + 1), (a, b + 1)] }
 }
 
 #[cfg(test)]

@@ -480,6 +480,5 @@ fn read_buffer(gpu: &Gpu, buffer: &wgpu::Buffer, size: u64) -> Vec<u8> {
     gpu.queue.submit([encoder.finish()]);
     staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping the tessellation's readback"));
     gpu.wait();
-    let bytes = staging.slice(..).get_mapped_range().map(|b| b.to_vec()).unwrap_or_default();
-    bytes
+    staging.slice(..).get_mapped_range().map(|b| b.to_vec()).unwrap_or_default()
 }

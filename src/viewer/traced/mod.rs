@@ -32,6 +32,8 @@ use std::time::Duration;
 use image::RgbaImage;
 
 #[cfg(target_arch = "wasm32")]
+pub(in crate::viewer) use pool::Pool;
+#[cfg(target_arch = "wasm32")]
 pub(crate) use recipe::SceneRecipe;
 #[cfg(target_arch = "wasm32")]
 pub(crate) use slices::OwnedTracer;

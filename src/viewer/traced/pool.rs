@@ -13,6 +13,11 @@
 //! Each job has a number of its own, sent with its bands and returned with them: a request asked
 //! again (the traced view left and opened again) is a new job, and a band of the old one, still
 //! in flight, is not counted as the new one's.
+//!
+//! The same workers trace the hybrid's terms of the raster frame ([`Pool::terms`],
+//! `crate::raster::traced::TermsRequest`): a terms job (the frame's scene) and bands of each view
+//! asked for, answered with the terms' header and numbers. Their own job and tracer in each worker
+//! keep them apart from the traced image's; the page wakes when the last band asked for is in.
 
 use std::cell::RefCell;
 use std::collections::{HashMap, VecDeque};
@@ -40,14 +45,33 @@ pub(super) struct Band {
     pub arrived: Instant,
 }
 
+/// The hybrid's terms of a band of a view, traced: the key it was asked with ([`Pool::terms`]),
+/// and `crate::raster::traced::encode`'s header and numbers.
+pub(in crate::viewer) struct TermsAnswer {
+    pub key: String,
+    pub header: String,
+    pub values: Vec<f32>,
+}
+
+/// A piece of work for a worker.
+enum Work {
+    /// Rows `first..end` of the traced image of job number `job`.
+    Rows { job: u64, first: u32, end: u32 },
+    /// The terms request `request` (JSON), answered with `key`.
+    Terms { key: String, request: String },
+}
+
 /// What the workers' messages leave for the page's thread.
 #[derive(Default)]
 struct Inbox {
     bands: Vec<Band>,
+    terms: Vec<TermsAnswer>,
+    /// The terms asked for and not yet answered.
+    terms_left: usize,
     /// A worker's index for each band it may be given now (up to [`AHEAD`] a worker).
     idle: Vec<usize>,
-    /// The current job's bands not yet given to a worker: its number and rows.
-    pending: VecDeque<(u64, u32, u32)>,
+    /// The work not yet given to a worker: the current job's bands, the terms asked for.
+    pending: VecDeque<Work>,
     /// The current (or last) job's number, and how many of its bands have not come back (it
     /// stays as it was when the job is cancelled; the next job sets both).
     job: u64,
@@ -56,17 +80,20 @@ struct Inbox {
     failed: Option<String>,
 }
 
-pub(super) struct Pool {
+pub(in crate::viewer) struct Pool {
     workers: Vec<web_sys::Worker>,
     inbox: Rc<RefCell<Inbox>>,
     /// The opened files every worker has, as they were sent.
     sent: RefCell<HashMap<String, Rc<[u8]>>>,
+    /// The terms job every worker has.
+    terms_job: RefCell<String>,
     _listeners: Vec<Closure<dyn FnMut(web_sys::MessageEvent)>>,
     _on_error: Closure<dyn FnMut(JsValue)>,
 }
 
 impl Pool {
-    /// One worker a core (at most 16), or `None` where the browser gives one core or no workers.
+    /// One worker a core (at most 16), or `None` where the browser gives one core or no workers,
+    /// or the page's address asks for none (`?workers=0`).
     /// `wake` wakes the page when a job's last band is in, or a worker failed.
     pub fn start(wake: Rc<dyn Fn()>) -> Option<Pool> {
         // The workers load the module the page loaded (web/index.html), from the browser's cache.
@@ -75,8 +102,12 @@ impl Pool {
         } else {
             "./tracer.js?module=mirador.js"
         };
-        let cores = web_sys::window()?.navigator().hardware_concurrency() as usize;
-        if cores < 2 {
+        let window = web_sys::window()?;
+        let cores = window.navigator().hardware_concurrency() as usize;
+        // `?workers=0`: how a teacher sees the page as a one-core machine shows it, and how
+        // web/time.sh times the page's thread against the workers.
+        let search = window.location().search().unwrap_or_default();
+        if cores < 2 || search.trim_start_matches('?').split('&').any(|p| p == "workers=0") {
             return None;
         }
         let inbox = Rc::new(RefCell::new(Inbox::default()));
@@ -98,8 +129,8 @@ impl Pool {
             let (shared, answered, woken) = (inbox.clone(), worker.clone(), wake.clone());
             let listener = Closure::<dyn FnMut(web_sys::MessageEvent)>::new(move |event: web_sys::MessageEvent| {
                 let mut inbox = shared.borrow_mut();
-                let done = match band(&event.data()) {
-                    Ok(band) => {
+                let done = match answer(&event.data()) {
+                    Ok(Answer::Band(band)) => {
                         let last = band.job == inbox.job && inbox.left == 1;
                         if band.job == inbox.job {
                             inbox.left = inbox.left.saturating_sub(1);
@@ -107,13 +138,18 @@ impl Pool {
                         inbox.bands.push(band);
                         last
                     }
+                    Ok(Answer::Terms(terms)) => {
+                        inbox.terms.push(terms);
+                        inbox.terms_left = inbox.terms_left.saturating_sub(1);
+                        inbox.terms_left == 0
+                    }
                     Err(error) => {
                         inbox.failed = Some(error);
                         true
                     }
                 };
                 match inbox.pending.pop_front() {
-                    Some((job, first, end)) => ask(&answered, job, first, end),
+                    Some(work) => ask(&answered, work),
                     None => inbox.idle.push(index),
                 }
                 drop(inbox);
@@ -127,7 +163,14 @@ impl Pool {
             workers.push(worker);
             listeners.push(listener);
         }
-        Some(Pool { workers, inbox, sent: RefCell::default(), _listeners: listeners, _on_error: on_error })
+        Some(Pool {
+            workers,
+            inbox,
+            sent: RefCell::default(),
+            terms_job: RefCell::default(),
+            _listeners: listeners,
+            _on_error: on_error,
+        })
     }
 
     /// Gives every worker the job (JSON of [`super::SceneRecipe`]) and the files the person
@@ -136,6 +179,47 @@ impl Pool {
     /// rest as they answer. The previous job's bands not yet given are dropped. Returns the job's
     /// number, which its [`Band`]s carry.
     pub fn job(&self, job: &str, files: &[(String, Rc<[u8]>)], height: u32) -> u64 {
+        let list = self.new_files(files);
+        let mut inbox = self.inbox.borrow_mut();
+        let number = inbox.job + 1;
+        for worker in &self.workers {
+            let message = message(&number.to_string());
+            set(&message, "job", &job.into());
+            set(&message, "files", &list);
+            let _ = worker.post_message(&message);
+        }
+        inbox.pending.retain(|work| matches!(work, Work::Terms { .. }));
+        let rows = (0..height).step_by(BAND as usize).map(|first| (first, (first + BAND).min(height)));
+        inbox.pending.extend(rows.map(|(first, end)| Work::Rows { job: number, first, end }));
+        (inbox.job, inbox.left) = (number, height.div_ceil(BAND) as usize);
+        self.give_out(&mut inbox);
+        number
+    }
+
+    /// Asks for the hybrid's terms of `requests` (each its key and JSON), with `job` (JSON of
+    /// [`super::SceneRecipe`], the raster frame's scene) and the files the person opened. Terms
+    /// asked for before and not yet given out are dropped: they were for older inputs.
+    pub fn terms(&self, job: &str, files: &[(String, Rc<[u8]>)], requests: Vec<(String, String)>) {
+        let list = self.new_files(files);
+        if *self.terms_job.borrow() != job || list.length() > 0 {
+            for worker in &self.workers {
+                let message = message("terms");
+                set(&message, "termsJob", &job.into());
+                set(&message, "files", &list);
+                let _ = worker.post_message(&message);
+            }
+            *self.terms_job.borrow_mut() = job.to_owned();
+        }
+        let mut inbox = self.inbox.borrow_mut();
+        inbox.pending.retain(|work| matches!(work, Work::Rows { .. }));
+        inbox.terms_left = requests.len();
+        inbox.pending.extend(requests.into_iter().map(|(key, request)| Work::Terms { key, request }));
+        self.give_out(&mut inbox);
+    }
+
+    /// The opened files not sent to the workers yet (the same bytes are sent once), as a list of
+    /// `[name, bytes]`; marked sent.
+    fn new_files(&self, files: &[(String, Rc<[u8]>)]) -> js_sys::Array {
         let list = js_sys::Array::new();
         let mut sent = self.sent.borrow_mut();
         for (name, bytes) in files {
@@ -145,35 +229,33 @@ impl Pool {
             list.push(&js_sys::Array::of2(&name.into(), &js_sys::Uint8Array::from(&bytes[..])));
             sent.insert(name.clone(), bytes.clone());
         }
-        let mut inbox = self.inbox.borrow_mut();
-        let number = inbox.job + 1;
-        for worker in &self.workers {
-            let message = message(number);
-            set(&message, "job", &job.into());
-            set(&message, "files", &list);
-            let _ = worker.post_message(&message);
-        }
-        inbox.pending =
-            (0..height).step_by(BAND as usize).map(|first| (number, first, (first + BAND).min(height))).collect();
-        (inbox.job, inbox.left) = (number, inbox.pending.len());
+        list
+    }
+
+    /// Gives pending work to the workers that may take some.
+    fn give_out(&self, inbox: &mut Inbox) {
         while let Some(index) = inbox.idle.pop() {
-            let Some((job, first, end)) = inbox.pending.pop_front() else {
+            let Some(work) = inbox.pending.pop_front() else {
                 inbox.idle.push(index);
                 break;
             };
-            ask(&self.workers[index], job, first, end);
+            ask(&self.workers[index], work);
         }
-        number
     }
 
     /// Drops the bands not yet given: the job was stopped or replaced. The workers finish only
     /// the ones they hold.
     pub fn cancel(&self) {
-        self.inbox.borrow_mut().pending.clear();
+        self.inbox.borrow_mut().pending.retain(|work| matches!(work, Work::Terms { .. }));
+    }
+
+    /// The hybrid's terms that came back since the last call.
+    pub fn terms_answers(&self) -> Vec<TermsAnswer> {
+        std::mem::take(&mut self.inbox.borrow_mut().terms)
     }
 
     /// The bands that came back since the last call.
-    pub fn bands(&self) -> Vec<Band> {
+    pub(super) fn bands(&self) -> Vec<Band> {
         std::mem::take(&mut self.inbox.borrow_mut().bands)
     }
 
@@ -191,18 +273,28 @@ impl Drop for Pool {
     }
 }
 
-/// Asks `worker` for rows `first..end` of job number `job`.
-fn ask(worker: &web_sys::Worker, job: u64, first: u32, end: u32) {
-    let message = message(job);
-    set(&message, "rows", &js_sys::Array::of2(&first.into(), &end.into()));
+/// Gives `worker` a piece of work.
+fn ask(worker: &web_sys::Worker, work: Work) {
+    let message = match work {
+        Work::Rows { job, first, end } => {
+            let message = message(&job.to_string());
+            set(&message, "rows", &js_sys::Array::of2(&first.into(), &end.into()));
+            message
+        }
+        Work::Terms { key, request } => {
+            let message = message(&key);
+            set(&message, "terms", &request.into());
+            message
+        }
+    };
     let _ = worker.post_message(&message);
 }
 
-/// A message about job number `job` (`key`, which the worker returns with the band).
-fn message(job: u64) -> js_sys::Object {
+/// A message with `key`, which the worker returns with its answer (as text: a u64 does not fit a
+/// JavaScript number).
+fn message(key: &str) -> js_sys::Object {
     let message = js_sys::Object::new();
-    // As text: a u64 does not fit a JavaScript number.
-    set(&message, "key", &job.to_string().into());
+    set(&message, "key", &key.into());
     message
 }
 
@@ -210,14 +302,26 @@ fn set(object: &js_sys::Object, name: &str, value: &JsValue) {
     let _ = js_sys::Reflect::set(object, &name.into(), value);
 }
 
-/// A worker's answer: `{key, first, pixels}` (a `Uint8Array` of r, g, b, a), or `{error}`.
-fn band(data: &JsValue) -> Result<Band, String> {
+/// A worker's answer.
+enum Answer {
+    Band(Band),
+    Terms(TermsAnswer),
+}
+
+/// A worker's answer: `{key, first, pixels}` (a `Uint8Array` of r, g, b, a), `{key, header,
+/// values}` (a `Float32Array`), or `{error}`.
+fn answer(data: &JsValue) -> Result<Answer, String> {
     let get = |name: &str| js_sys::Reflect::get(data, &name.into()).unwrap_or(JsValue::UNDEFINED);
     if let Some(error) = get("error").as_string() {
         return Err(error);
     }
+    if let Some(header) = get("header").as_string() {
+        let key = get("key").as_string().ok_or("terms without their key")?;
+        let values = js_sys::Float32Array::new(&get("values")).to_vec();
+        return Ok(Answer::Terms(TermsAnswer { key, header, values }));
+    }
     let job = get("key").as_string().and_then(|k| k.parse().ok()).ok_or("a band without its job's number")?;
     let first = get("first").as_f64().ok_or("a band without its first row")? as u32;
     let rgba = js_sys::Uint8Array::new(&get("pixels")).to_vec();
-    Ok(Band { job, first, rgba, arrived: Instant::now() })
+    Ok(Answer::Band(Band { job, first, rgba, arrived: Instant::now() }))
 }

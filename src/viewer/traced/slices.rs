@@ -136,6 +136,20 @@ impl TracedWorker {
         }
     }
 
+    /// The workers, for the raster frame's hybrid terms (`super::Pool::terms`); `None` before they
+    /// start, after they fail, or where the browser gives none. A failure found here gives them
+    /// up as one found by the traced image does: its rows are traced on this thread, from the top.
+    pub(in crate::viewer) fn pool(&mut self) -> Option<&Pool> {
+        if let Some(error) = self.pool.as_ref().and_then(Pool::failed) {
+            log::warn!("the tracer workers failed ({error}); tracing on the page's thread");
+            self.pool = None;
+            if let Some(full) = self.job.as_mut().and_then(|job| job.full.as_mut()) {
+                (full.received, full.next) = (0, 0);
+            }
+        }
+        self.pool.as_ref()
+    }
+
     /// Stops the current request (the view no longer shows traced images).
     pub fn stop(&mut self) {
         self.job = None;

@@ -16,18 +16,18 @@
 //! overwritten by the next face's. A view drawn again as the last frame drew it, with nothing else
 //! changed, copies the buffer it was traced into then ([`KeptTraced`]).
 
-use glam::{Vec2, Vec3, Vec4};
+mod request;
+
+pub use request::{TermsRequest, decode, encode, join};
 
 use super::context::{Figure, FrameEncoder};
 use super::shadow::views::{MAX_SHADOWED_LIGHTS, ShadowLayout};
 use super::targets::{FrameTargets, ViewImage};
-use super::view::{FrameView, View, ViewKind, ViewSlot, ViewTargets};
-use crate::base::Ray;
+use super::view::{FrameView, ViewKind, ViewSlot, ViewTargets};
 use crate::scene::{Camera, Scene};
 use crate::settings::RenderSettings;
-use crate::texture::RayCone;
 use crate::trace::Tracer;
-use crate::trace::terms::{TracedTerms, ViewRays, Wanted};
+use crate::trace::terms::{TracedTerms, Wanted};
 
 const _: () = assert!(crate::trace::terms::MAX_SLOTS == MAX_SHADOWED_LIGHTS);
 
@@ -46,16 +46,43 @@ pub struct PreparedTraced {
 /// scene, its camera and lights and the settings are the same, a view drawn again from the same
 /// camera at the same size has the same terms, and the frame copies them again rather than
 /// tracing them again (as a raster frame keeps its shadow maps). A view that changed, or any
-/// change of the scene or the settings, is traced anew.
+/// change of the scene or the settings, is traced anew: here, or elsewhere ([`TracedAt`]).
 #[derive(Default)]
 pub struct KeptTraced {
-    last: Option<(SceneInputs, Vec<(ViewInputs, Upload)>)>,
+    last: Option<(SceneInputs, Vec<Kept>)>,
     /// Counts the scenes loaded ([`Self::forget`]): a new scene is never the last one.
     generation: u64,
+    /// Counts the inputs traced elsewhere: an answer for older inputs is dropped.
+    ticket: u64,
+    /// The views asked for and not yet taken ([`Self::take_requests`]).
+    requests: Vec<TermsRequest>,
+    /// Counts the cube faces whose terms were handed back ([`Self::faces_key`]).
+    faces_received: u64,
+}
+
+/// Where a frame's traced terms are traced.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum TracedAt {
+    /// Here, before the frame is recorded (on the tracer's threads, where there are some).
+    #[default]
+    Here,
+    /// Elsewhere (the page's Web Workers): a view not kept is asked for ([`TermsRequest`],
+    /// [`KeptTraced::take_requests`]) and drawn, until its terms are handed back
+    /// ([`KeptTraced::receive`]), with the terms the last frame drew it with (a coarser stride's),
+    /// else with terms traced here at one pixel in each block of `coarse` pixels on a side.
+    Elsewhere { coarse: u32 },
+}
+
+/// A view's terms kept: traced, or (elsewhere) asked for and drawn meanwhile with `upload`.
+struct Kept {
+    key: ViewInputs,
+    upload: Upload,
+    /// Asked for elsewhere, under this ticket and number, and not yet handed back.
+    asked: Option<(u64, usize)>,
 }
 
 /// What every view's traced terms depend on.
-#[derive(PartialEq)]
+#[derive(Clone, PartialEq)]
 struct SceneInputs {
     generation: u64,
     camera: Camera,
@@ -74,17 +101,19 @@ impl KeptTraced {
     /// Forgets the kept terms: the renderer loaded another scene.
     pub fn forget(&mut self) {
         self.last = None;
+        self.requests.clear();
         self.generation += 1;
     }
 
     /// The terms `wanted` for every view of `views`, each into a buffer of its image's layers:
-    /// the last frame's where nothing they depend on changed, else traced ([`trace`]); and kept.
-    /// `lights` are the frame's shadowed lights, whose slots the visibility layers follow.
+    /// the last frame's where nothing they depend on changed, else traced `at` ([`TracedAt`]);
+    /// and kept. `lights` are the frame's shadowed lights, whose slots the visibility layers
+    /// follow.
     pub fn prepare(
         &mut self,
         (device, scene, settings): (&wgpu::Device, &Scene, &RenderSettings),
         frame: &mut FrameEncoder,
-        (wanted, stride): (Wanted, u32),
+        (wanted, stride, at): (Wanted, u32, TracedAt),
         lights: &ShadowLayout,
         views: &[ViewTargets<'_>],
     ) -> PreparedTraced {
@@ -100,29 +129,99 @@ impl KeptTraced {
             stride,
             slots,
         };
-        let last = self.last.take().filter(|(kept, _)| *kept == inputs).map(|(_, views)| views).unwrap_or_default();
-        let (mut rays, mut kept) = (0, 0);
+        let (last_inputs, mut last) = self.last.take().unwrap_or_else(|| (inputs.clone(), Vec::new()));
+        let same = last_inputs == inputs;
+        // Elsewhere, a view's coarser terms stand in while its finer ones are traced.
+        let elsewhere = matches!(at, TracedAt::Elsewhere { .. });
+        let coarser = elsewhere && last_inputs == SceneInputs { stride: last_inputs.stride, ..inputs.clone() };
+        if !same {
+            self.ticket += 1;
+            self.requests.clear();
+            last.retain(|_| coarser);
+            last.iter_mut().for_each(|kept| kept.asked = None);
+        }
+        let (mut rays, mut kept, mut asked) = (0, 0, 0);
         let mut now = Vec::new();
         let tracer = std::cell::OnceCell::new();
+        let mut trace_here = |request: &TermsRequest| {
+            let terms = request.trace(tracer.get_or_init(|| Tracer::new(scene, settings)))?;
+            rays += terms.rays.total();
+            Some(upload(device, &terms))
+        };
         for &(view, targets) in views {
             let key = (view.clone(), targets.size);
-            let upload = match last.iter().find(|(k, _)| *k == key) {
-                Some((_, upload)) => {
+            let found = last.iter().position(|k| k.key == key).map(|i| last.swap_remove(i));
+            let entry = match (found, at) {
+                // Kept; elsewhere, also while asked for (and drawn with a stand-in).
+                (Some(found), _) if same && (found.asked.is_none() || elsewhere) => {
                     kept += 1;
-                    Some(upload.clone())
+                    Some(found)
                 }
-                None => {
-                    let tracer = tracer.get_or_init(|| Tracer::new(scene, settings));
-                    trace(device, tracer, (view, targets), (wanted, stride), &inputs.slots, &mut rays)
+                (found, TracedAt::Elsewhere { coarse }) => {
+                    let number = (self.ticket, self.requests.len());
+                    let request = TermsRequest::new(number, (view, targets.size), &inputs);
+                    let stand_in = found.map(|k| k.upload).or_else(|| trace_here(&request.with_stride(coarse)));
+                    stand_in.map(|stand_in| {
+                        asked += 1;
+                        self.requests.push(request);
+                        Kept { key: key.clone(), upload: stand_in, asked: Some(number) }
+                    })
+                }
+                (_, TracedAt::Here) => {
+                    let request = TermsRequest::new((0, 0), (view, targets.size), &inputs);
+                    trace_here(&request).map(|upload| Kept { key: key.clone(), upload, asked: None })
                 }
             };
-            now.extend(upload.map(|upload| (key, upload)));
+            now.extend(entry);
         }
-        frame.end("traced terms", &[("rays", Figure::Count(rays)), ("views kept", Figure::Count(kept))]);
-        let prepared =
-            PreparedTraced { views: now.iter().map(|((view, _), upload)| (view.slot, upload.clone())).collect() };
+        frame.end(
+            "traced terms",
+            &[
+                ("rays", Figure::Count(rays)),
+                ("views kept", Figure::Count(kept)),
+                ("views asked", Figure::Count(asked)),
+            ],
+        );
+        let prepared = PreparedTraced { views: now.iter().map(|k| (k.key.0.slot, k.upload.clone())).collect() };
+        // Views not drawn this frame keep their terms while nothing else changed: a cube's faces
+        // are drawn only now and then, and their terms asked for elsewhere come back meanwhile.
+        if same {
+            now.extend(last);
+        }
         self.last = Some((inputs, now));
         prepared
+    }
+
+    /// The views the frames since the last call asked to be traced elsewhere.
+    pub fn take_requests(&mut self) -> Vec<TermsRequest> {
+        std::mem::take(&mut self.requests)
+    }
+
+    /// Whether views asked for elsewhere are still to come back.
+    pub fn awaiting(&self) -> bool {
+        self.last.as_ref().is_some_and(|(_, views)| views.iter().any(|k| k.asked.is_some()))
+    }
+
+    /// Hands back the terms of view `view` of request ticket `ticket`, traced elsewhere
+    /// ([`TermsRequest::trace`]): the next frame like the last draws them. Returns whether they
+    /// were taken; the terms of a view no longer asked for (the view or its inputs changed since)
+    /// are dropped.
+    pub fn receive(&mut self, device: &wgpu::Device, (ticket, view): (u64, usize), terms: &TracedTerms) -> bool {
+        let Some((_, views)) = &mut self.last else { return false };
+        let Some(kept) = views.iter_mut().find(|k| k.asked == Some((ticket, view))) else { return false };
+        kept.upload = upload(device, terms);
+        kept.asked = None;
+        if let ViewKind::CubeFace { .. } = kept.key.0.kind {
+            self.faces_received += 1;
+        }
+        true
+    }
+
+    /// A key of the terms the cube faces are drawn with at `stride`: it changes with the stride
+    /// and when a face's terms traced elsewhere come back. A cube's faces are drawn only when what
+    /// they see changes (`crate::raster::environment`), so the frame draws them again then.
+    pub fn faces_key(&self, stride: u32) -> u64 {
+        (u64::from(stride) << 48) ^ (self.faces_received + 1)
     }
 }
 
@@ -136,28 +235,6 @@ struct Upload {
 
 /// Bytes of one pixel of one layer (`Rgba32Float`).
 const PIXEL_BYTES: u32 = 16;
-
-/// Traces one view's terms into a buffer of its image's layers, adding its rays to `rays`; `None`
-/// for a view with an empty window (a mirror at the screen's edge may leave its camera one).
-fn trace(
-    device: &wgpu::Device,
-    tracer: &Tracer,
-    (view, targets): ViewTargets<'_>,
-    (wanted, stride): (Wanted, u32),
-    slots: &[usize],
-    rays: &mut u64,
-) -> Option<Upload> {
-    let size = targets.size;
-    let window = view.scissor.unwrap_or([0, 0, size.0, size.1]);
-    if window[2] == 0 || window[3] == 0 {
-        return None;
-    }
-    let (ray, cone) = camera_rays(tracer.scene, view, size);
-    let view_rays = ViewRays { size, window, ray: &*ray, cone, skip: view.skip, lights: slots, stride };
-    let terms = tracer.terms(&view_rays, wanted);
-    *rays += terms.rays.total();
-    Some(upload(device, &terms))
-}
 
 impl PreparedTraced {
     /// Copies `view`'s terms into its traced image, which the view's shading then reads.
@@ -218,81 +295,4 @@ fn upload(device: &wgpu::Device, terms: &TracedTerms) -> Upload {
     }
     buffer.unmap();
     Upload { buffer, window: terms.window, layers: layers.iter().map(|(layer, _)| *layer).collect() }
-}
-
-type RayFn = Box<dyn Fn(f32, f32) -> Option<(Ray, f32)> + Sync>;
-
-/// The rays of `view` drawn at `size`, and a pixel's cone along them.
-fn camera_rays(scene: &Scene, view: &FrameView, size: (u32, u32)) -> (RayFn, RayCone) {
-    let camera = scene.camera.clone();
-    if view.kind == ViewKind::Main {
-        // The tracer's own primary rays, scaled from the drawn size to the camera's, and a pixel
-        // of the drawn size's cone.
-        let (sx, sy) = (camera.width as f32 / size.0 as f32, camera.height as f32 / size.1 as f32);
-        let cone = crate::trace::primary_cone(&Camera { width: size.0, height: size.1, ..camera.clone() });
-        return (Box::new(move |x, y| Some((camera.ray_through(x * sx, y * sy), 0.0))), cone);
-    }
-    let unprojected = Unprojected::new(&view.view, size);
-    let centre = (size.0 as f32 / 2.0, size.1 as f32 / 2.0);
-    let (a, b) = (unprojected.line(centre.0, centre.1), unprojected.line(centre.0 + 1.0, centre.1));
-    let cone = if view.view.orthographic {
-        RayCone::orthographic(a.origin.distance(b.origin))
-    } else {
-        RayCone { width: 0.0, spread: a.direction.angle_between(b.direction) }
-    };
-    (Box::new(move |x, y| unprojected.ray(x, y)), cone)
-}
-
-/// A view's rays, unprojected from its `clip_from_world`.
-struct Unprojected {
-    world_from_clip: glam::Mat4,
-    size: Vec2,
-    eye: Option<Vec3>,
-    view_axis: Vec3,
-    clip_plane: Option<Vec4>,
-}
-
-impl Unprojected {
-    fn new(view: &View, size: (u32, u32)) -> Unprojected {
-        Unprojected {
-            world_from_clip: view.clip_from_world.inverse(),
-            size: Vec2::new(size.0 as f32, size.1 as f32),
-            eye: (!view.orthographic).then_some(view.eye),
-            view_axis: view.view_axis,
-            clip_plane: view.clip_plane,
-        }
-    }
-
-    /// The line through image point `(x, y)`: from the eye through the point of the near plane,
-    /// or from that point along the view axis (orthographic). Not through the far plane's point:
-    /// a mirrored camera's far plane is tilted ([`super::mirror::oblique_near_plane`]) and may
-    /// lie behind the eye at a corner.
-    fn line(&self, x: f32, y: f32) -> Ray {
-        let ndc = Vec2::new(2.0 * x / self.size.x - 1.0, 1.0 - 2.0 * y / self.size.y);
-        let near = self.world_from_clip.project_point3(ndc.extend(0.0));
-        match self.eye {
-            Some(eye) => Ray { origin: eye, direction: (near - eye).normalize() },
-            None => Ray { origin: near, direction: -self.view_axis },
-        }
-    }
-
-    /// The ray through `(x, y)` from where the view starts seeing, its clip plane if the line
-    /// starts behind it, and how far along the line that is; `None` if the line never crosses
-    /// into what the view sees.
-    fn ray(&self, x: f32, y: f32) -> Option<(Ray, f32)> {
-        let mut ray = self.line(x, y);
-        let mut start = 0.0;
-        if let Some(plane) = self.clip_plane {
-            let side = plane.truncate().dot(ray.origin) + plane.w;
-            if side < 0.0 {
-                let towards = plane.truncate().dot(ray.direction);
-                if towards <= 0.0 {
-                    return None;
-                }
-                start = -side / towards;
-                ray.origin = ray.at(start);
-            }
-        }
-        Some((ray, start))
-    }
 }
