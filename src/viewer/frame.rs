@@ -285,7 +285,7 @@ impl Viewer {
         if let Some(pool) = self.traced.worker.pool() {
             let (scene, settings) = (&self.scene, &self.settings);
             let recipe = || super::traced::SceneRecipe::of(&scene.scene, &scene.overrides, settings);
-            self.raster.give_terms(pool, || serde_json::to_string(&recipe()).unwrap_or_default());
+            self.raster.give_terms(pool, recipe);
         }
         (self.scene.scene.camera.width, self.scene.scene.camera.height) = (width, height);
         if scale == 1.0

@@ -20,7 +20,6 @@ use wasm_bindgen::prelude::*;
 use crate::output::{OutputTransform, encode_image};
 use crate::raster::traced::{TermsRequest, encode};
 use crate::trace::Tracer;
-use crate::trace::terms::TracedTerms;
 use crate::viewer::traced::{OwnedTracer, SceneRecipe};
 
 thread_local! {
@@ -79,11 +78,10 @@ pub fn trace_terms(request: &str) -> Result<js_sys::Array, JsError> {
     TERMS_TRACER.with(|t| {
         let tracer = t.borrow();
         let tracer = tracer.as_ref().ok_or_else(|| JsError::new("terms asked before a terms job"))?;
-        let terms = tracer.with_dependent(|_, tracer| request.trace(tracer)).unwrap_or(TracedTerms {
-            window: [0; 4],
-            layers: Vec::new(),
-            rays: Default::default(),
-        });
+        // The page asks for no view with an empty window.
+        let terms = tracer
+            .with_dependent(|_, tracer| request.trace(tracer))
+            .ok_or_else(|| JsError::new("terms asked for an empty window"))?;
         let (header, values) = encode(&terms);
         Ok(js_sys::Array::of2(&header.into(), &js_sys::Float32Array::from(&values[..])))
     })

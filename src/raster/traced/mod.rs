@@ -221,7 +221,7 @@ impl KeptTraced {
     /// and when a face's terms traced elsewhere come back. A cube's faces are drawn only when what
     /// they see changes (`crate::raster::environment`), so the frame draws them again then.
     pub fn faces_key(&self, stride: u32) -> u64 {
-        (u64::from(stride) << 48) ^ (self.faces_received + 1)
+        (u64::from(stride) << 48) | self.faces_received
     }
 }
 

@@ -138,17 +138,12 @@ pub fn join(bands: Vec<TracedTerms>) -> Result<TracedTerms, String> {
 struct Header {
     window: [u32; 4],
     layers: Vec<u32>,
-    rays: u64,
 }
 
 /// `terms` as a header (JSON) and their numbers, layer after layer, four a pixel: what a worker
 /// posts back (the numbers as a `Float32Array`, moved, not copied).
 pub fn encode(terms: &TracedTerms) -> (String, Vec<f32>) {
-    let header = Header {
-        window: terms.window,
-        layers: terms.layers.iter().map(|(layer, _)| *layer).collect(),
-        rays: terms.rays.total(),
-    };
+    let header = Header { window: terms.window, layers: terms.layers.iter().map(|(layer, _)| *layer).collect() };
     let values = terms.layers.iter().flat_map(|(_, values)| values.iter().flatten().copied()).collect();
     (serde_json::to_string(&header).expect("a header is plain data"), values)
 }
@@ -166,9 +161,8 @@ pub fn decode(header: &str, values: &[f32]) -> Result<TracedTerms, String> {
         .zip(values.chunks(pixels * 4))
         .map(|(&layer, values)| (layer, values.chunks(4).map(|p| [p[0], p[1], p[2], p[3]]).collect()))
         .collect();
-    // The counts by kind stay with the worker: the frame's figures count rays traced here.
-    let rays = crate::trace::whitted::RayCounts { primary: header.rays, ..Default::default() };
-    Ok(TracedTerms { window: header.window, layers, rays })
+    // The rays stay uncounted: the frame's figures count the rays traced here.
+    Ok(TracedTerms { window: header.window, layers, rays: Default::default() })
 }
 
 type RayFn = Box<dyn Fn(f32, f32) -> Option<(Ray, f32)> + Sync>;

@@ -13,7 +13,7 @@ use web_time::Instant;
 use crate::gpu::Gpu;
 use crate::raster::traced;
 use crate::trace::terms::TracedTerms;
-use crate::viewer::traced::Pool;
+use crate::viewer::traced::{Pool, SceneRecipe};
 
 /// Rows in a band of a view's terms: a few tens of milliseconds of a worker's time on the
 /// showcase, so that the workers share a view evenly.
@@ -63,9 +63,9 @@ impl super::RasterView {
         }
     }
 
-    /// After a frame: the views it asked for, in bands, to the workers, with `job` (JSON of the
-    /// scene the frame drew, `crate::viewer::traced::SceneRecipe`).
-    pub(in crate::viewer) fn give_terms(&mut self, pool: &Pool, job: impl FnOnce() -> String) {
+    /// After a frame: the views it asked for, in bands, to the workers, with `job`, the scene the
+    /// frame drew (made only when a view was asked for).
+    pub(in crate::viewer) fn give_terms(&mut self, pool: &Pool, job: impl FnOnce() -> SceneRecipe) {
         let requests = self.renderer.traced.take_requests();
         let Some(ticket) = requests.first().map(|r| r.ticket) else { return };
         self.terms.views.retain(|(t, _), _| *t == ticket);
@@ -79,7 +79,8 @@ impl super::RasterView {
                 asked.push((format!("{}:{}:{k}", request.ticket, request.view), text));
             }
         }
-        pool.terms(&job(), &crate::files::opened(), asked);
+        let job = serde_json::to_string(&job()).expect("a recipe is plain data");
+        pool.terms(&job, &crate::files::opened(), asked);
     }
 }
 
