@@ -24,12 +24,13 @@
 //! 8. Scenes that grow: Haines' sphereflake at sizes 2 to 4 (91 to 7,381 spheres) and a mesh of
 //!    about a million triangles: upload, frame, triangles, beside `trace` of the same scene.
 //! 9. The hybrid (`-- hybrid`): the showcase with its four per-pixel terms traced, still and
-//!    with the camera turning, as ratios to the plain frame still and turning.
+//!    with the camera turning (traced at every pixel, and at one in 16 as the viewer traces a
+//!    moving view), as ratios to the plain frame still and turning.
 //! 10. Displacement (`-- displacement`): the cobbled ball at 1280×720, bump-mapped, displaced with
-//!    the tracer's uniform mesh, and tessellated on the GPU for the view at several edge lengths,
-//!    still and turning (made again every frame), as ratios to the bump-mapped frame; the
-//!    triangles and the buffers' memory of each; the tracer on the displaced ball against the
-//!    bump-mapped one.
+//!     the tracer's uniform mesh, and tessellated on the GPU for the view at several edge lengths,
+//!     still and turning (made again every frame), as ratios to the bump-mapped frame; the
+//!     triangles and the buffers' memory of each; the tracer on the displaced ball against the
+//!     bump-mapped one.
 //!
 //! Times are wall-clock from submit to the queue being idle (the median of several frames after
 //! warm-up), so they include the driver's work on the CPU: on lavapipe that is all of it.
@@ -657,7 +658,8 @@ fn volume_costs(gpu: &Gpu) {
 /// textures) against the plain frame, the showcase at 1280×720: the view still (the terms kept
 /// while nothing changes, `raster::traced::KeptTraced`) and moving (the camera turned a quarter
 /// of a degree about the target every frame, so every view is traced again, as the plain frame
-/// draws its views again). Each a median of [`FRAMES`] after two warm-up frames.
+/// draws its views again), at every pixel and at one pixel in 16 (`Renderer::traced_stride`, as
+/// the viewer draws a moving view). Each a median of [`FRAMES`] after two warm-up frames.
 fn hybrid_costs(gpu: &Gpu) {
     let scene = Scene::showcase().expect("the built-in showcase loads");
     let plain = scene.settings.clone();
@@ -665,9 +667,10 @@ fn hybrid_costs(gpu: &Gpu) {
     for term in ["shadows", "reflections", "transmission", "textures"] {
         hybrid.set(&format!("hybrid.{term}=true")).expect("a hybrid switch");
     }
-    let moving = |settings: &RenderSettings| {
+    let moving = |settings: &RenderSettings, stride: u32| {
         let mut scene = scene.clone();
         let mut bench = Bench::new(gpu, &scene);
+        bench.renderer.traced_stride = stride;
         let times = (0..FRAMES + 2)
             .map(|_| {
                 let (c, e) = (scene.camera.center, scene.camera.eye - scene.camera.center);
@@ -681,10 +684,13 @@ fn hybrid_costs(gpu: &Gpu) {
     };
     println!("\nthe hybrid, showcase 1280×720, median of {FRAMES} frames, ratios to the plain frame");
     let (still, still_plain) = (frame_time(gpu, &scene, &hybrid), frame_time(gpu, &scene, &plain));
-    let (turning, turning_plain) = (moving(&hybrid), moving(&plain));
-    for (name, frame, base) in [("still", still, still_plain), ("moving", turning, turning_plain)] {
+    let turning_plain = moving(&plain, 1);
+    let (turning, coarse) = (moving(&hybrid, 1), moving(&hybrid, 4));
+    let rows =
+        [("still", still, still_plain), ("moving", turning, turning_plain), ("moving, 1 in 16", coarse, turning_plain)];
+    for (name, frame, base) in rows {
         println!(
-            "{name:>8}: plain {:>7.1} ms, all four traced {:>7.1} ms, {:>5.2}×",
+            "{name:>16}: plain {:>7.1} ms, all four traced {:>7.1} ms, {:>5.2}×",
             ms(base),
             ms(frame),
             frame.as_secs_f64() / base.as_secs_f64()

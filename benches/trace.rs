@@ -385,7 +385,9 @@ fn packet_table(tris: &[[Vec3; 3]], primary: &[Query], light: Vec3) {
     };
     let (primary_closest, reflected_closest) = (closest(0.0), closest(SHADOW_T_MIN));
     type Packets<'a> = &'a (dyn Fn((&[Ray], &[f32])) -> usize + Sync);
-    let kinds: [(&str, &[Query], &(Vec<Ray>, Vec<f32>), Packets); 3] = [
+    /// A kind of ray: its name, its queries, their rays and far bounds, and its packets' walk.
+    type Kind<'a> = (&'a str, &'a [Query], &'a (Vec<Ray>, Vec<f32>), Packets<'a>);
+    let kinds: [Kind; 3] = [
         ("primary", &blocks, &blocks_rays, &primary_closest),
         ("shadow", &shadow, &shadow_rays, &occluded),
         ("reflected", &reflected, &reflected_rays, &reflected_closest),

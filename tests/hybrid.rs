@@ -301,3 +301,32 @@ fn refined_terms_reach_the_cube_faces() {
     }
     assert!(elsewhere.render(gpu, &scene, &settings) == whole, "the terms traced elsewhere, cube faces and all");
 }
+
+/// A moving view's terms are traced into the buffers of terms no frame draws any more (mapped
+/// again once the frames that copied from them are done), not into new ones: the frames count
+/// the buffers reused. Two-sided by the images: every frame of a turning camera, on the showcase
+/// (its main view and a glass ball's cube) and on the mirrors (whose windows change size as the
+/// camera turns), at every pixel and at one in 16, is the image a fresh renderer draws.
+#[test]
+fn a_moving_views_terms_reuse_the_buffers_of_the_last() {
+    let gpu = common::gpu();
+    for name in ["showcase", "mirrors"] {
+        let mut scene = smaller(common::load(&format!("scenes/{name}.toml")), 160);
+        let settings = every_term_traced(&scene.settings);
+        for stride in [1, 4] {
+            let mut moving = mirador::raster::Headless::new(gpu, &scene);
+            moving.renderer.traced_stride = stride;
+            let mut reused = 0;
+            for frame in 0..5 {
+                let (c, e) = (scene.camera.center, scene.camera.eye - scene.camera.center);
+                scene.camera.eye = c + glam::Quat::from_rotation_y(3f32.to_radians()) * e;
+                let image = moving.render(gpu, &scene, &settings);
+                reused += moving.report.count("traced terms", "buffers reused");
+                let mut fresh = mirador::raster::Headless::new(gpu, &scene);
+                fresh.renderer.traced_stride = stride;
+                assert!(image == fresh.render(gpu, &scene, &settings), "{name}, stride {stride}, frame {frame}");
+            }
+            assert!(reused >= 3, "{name}, stride {stride}: {reused} buffers reused in 5 frames");
+        }
+    }
+}

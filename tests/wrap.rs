@@ -29,6 +29,12 @@ fn wrap_index_known_answers() {
     assert_eq!(repeat, vec![3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0]);
     assert_eq!(clamp, vec![0, 0, 0, 0, 0, 0, 1, 2, 3, 3, 3, 3, 3, 3]);
     assert_eq!(mirror, vec![3, 3, 2, 1, 0, 0, 1, 2, 3, 3, 2, 1, 0, 0]);
+    // A side that is not a power of two takes the remainder's other road.
+    let repeat: Vec<i64> = (-5..9).map(|i| Wrap::Repeat.index(i, 3)).collect();
+    assert_eq!(repeat, vec![1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2]);
+    for n in 1..=17 {
+        assert!((-70..70).all(|i| Wrap::Repeat.index(i, n) == i.rem_euclid(n)), "repeat over {n} texels");
+    }
 }
 
 /// A plane whose texture coordinates run over [0, 3]²: the ramp texture repeats, stretches its

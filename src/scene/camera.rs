@@ -63,6 +63,40 @@ pub struct EyeFrame {
     pub ze: Vec3,
 }
 
+/// A camera's primary rays ([`Camera::rays`]): what every ray shares, worked out once.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRays {
+    frame: EyeFrame,
+    /// The view window's `(w, h)`.
+    window: (f32, f32),
+    /// The image's `(width, height)` in pixels.
+    size: (f32, f32),
+    /// The window's centre: `eye − near·ze` (perspective), or the eye.
+    plane: Vec3,
+    /// The eye all rays leave from; `None` for an orthographic camera.
+    perspective: Option<Vec3>,
+}
+
+impl CameraRays {
+    /// `q(x, y)`, the point of the window the ray through image point `(x, y)` passes.
+    pub fn window_point(&self, x: f32, y: f32) -> Vec3 {
+        let EyeFrame { xe, ye, .. } = self.frame;
+        let (w, h) = self.window;
+        let s = w * (x / self.size.0 - 0.5);
+        let t = h * (0.5 - y / self.size.1);
+        self.plane + s * xe + t * ye
+    }
+
+    /// The ray through image point `(x, y)`.
+    pub fn through(&self, x: f32, y: f32) -> Ray {
+        let q = self.window_point(x, y);
+        match self.perspective {
+            Some(eye) => Ray { origin: eye, direction: (q - eye).normalize() },
+            None => Ray { origin: q, direction: -self.frame.ze },
+        }
+    }
+}
+
 /// Why a camera cannot form an image.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum CameraError {
@@ -146,25 +180,25 @@ impl Camera {
     /// The world-space centre of the view-window cell of pixel `(x, y)`, for any real `x, y`
     /// (pixel centres are at `x + ½`): the point the primary ray passes through.
     pub fn window_point(&self, x: f32, y: f32) -> Vec3 {
-        let EyeFrame { xe, ye, ze } = self.frame();
-        let (w, h) = self.window();
-        let s = w * (x / self.width as f32 - 0.5);
-        let t = h * (0.5 - y / self.height as f32);
-        let plane = match self.projection {
-            Projection::Perspective => self.eye - self.near * ze,
-            Projection::Orthographic => self.eye,
-        };
-        plane + s * xe + t * ye
+        self.rays().window_point(x, y)
     }
 
     /// The primary ray through the image point `(x, y)`; pixel `(i, j)` has its centre at
     /// `(i + ½, j + ½)`.
     pub fn ray_through(&self, x: f32, y: f32) -> Ray {
-        let q = self.window_point(x, y);
-        match self.projection {
-            Projection::Perspective => Ray { origin: self.eye, direction: (q - self.eye).normalize() },
-            Projection::Orthographic => Ray { origin: q, direction: -self.frame().ze },
-        }
+        self.rays().through(x, y)
+    }
+
+    /// The camera's primary rays, its eye frame and window worked out once for all of them.
+    pub fn rays(&self) -> CameraRays {
+        let frame = self.frame();
+        let plane = match self.projection {
+            Projection::Perspective => self.eye - self.near * frame.ze,
+            Projection::Orthographic => self.eye,
+        };
+        let perspective = (self.projection == Projection::Perspective).then_some(self.eye);
+        let size = (self.width as f32, self.height as f32);
+        CameraRays { frame, window: self.window(), size, plane, perspective }
     }
 
     /// The primary ray through the centre of pixel `(i, j)`.

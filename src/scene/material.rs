@@ -42,6 +42,8 @@ impl Wrap {
     /// Texel index `i` of an axis `n` texels long, brought into `0..n`.
     pub fn index(self, i: i64, n: i64) -> i64 {
         match self {
+            // A power of two's remainder is its low bits (two's complement: below 0 too).
+            Wrap::Repeat if n & (n - 1) == 0 => i & (n - 1),
             Wrap::Repeat => i.rem_euclid(n),
             Wrap::Clamp => i.clamp(0, n - 1),
             Wrap::Mirror => {

@@ -212,9 +212,13 @@ impl MipLevel {
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
         let (i, j) = (x0 as i64, y0 as i64);
-        let texel = |i, j| self.texel_wrapped(i, j, wrap);
-        let top = texel(i, j).lerp(texel(i + 1, j), fx);
-        let bottom = texel(i, j + 1).lerp(texel(i + 1, j + 1), fx);
+        // Each column and row wrapped once, for the two texels on it.
+        let (width, height) = (i64::from(self.width), i64::from(self.height));
+        let [i0, i1] = [i, i + 1].map(|i| wrap[0].index(i, width) as usize);
+        let [j0, j1] = [j, j + 1].map(|j| wrap[1].index(j, height) as usize * self.width as usize);
+        let texel = |i, j| self.texels[j + i];
+        let top = texel(i0, j0).lerp(texel(i1, j0), fx);
+        let bottom = texel(i0, j1).lerp(texel(i1, j1), fx);
         top.lerp(bottom, fy)
     }
 

@@ -31,6 +31,7 @@ pub mod whitted;
 
 use glam::{Vec2, Vec3};
 
+use crate::scene::camera::CameraRays;
 use crate::scene::{Camera, Projection, Scene};
 use crate::settings::{RenderSettings, TraceSettings};
 use crate::texture::RayCone;
@@ -47,6 +48,8 @@ pub struct Tracer<'s> {
     pub whitted: Whitted<'s>,
     /// The ray cone every primary ray carries (one pixel, see [`primary_cone`]).
     pub primary_cone: RayCone,
+    /// The camera's primary rays.
+    pub primary_rays: CameraRays,
 }
 
 /// The footprint of one pixel as a ray cone: the angle a pixel subtends for a perspective
@@ -80,13 +83,14 @@ impl<'s> Tracer<'s> {
                 volumes: volume::TracedVolumes::new(scene, &settings.volume),
             },
             primary_cone: primary_cone(&scene.camera),
+            primary_rays: scene.camera.rays(),
         }
     }
 
     /// The radiance seen through image point `p` (pixel `(i, j)` spans `[i, i+1] × [j, j+1]`).
     pub fn primary(&self, p: Vec2, counts: &mut RayCounts) -> Vec3 {
         counts.primary += 1;
-        let ray = self.scene.camera.ray_through(p.x, p.y);
+        let ray = self.primary_rays.through(p.x, p.y);
         self.whitted.radiance(&ray, self.primary_cone, 0, counts)
     }
 
@@ -96,7 +100,7 @@ impl<'s> Tracer<'s> {
     pub fn explain_pixel(&self, (x, y): (u32, u32), observer: &mut impl explain::Observer) -> Vec3 {
         let mut counts = RayCounts::default();
         counts.primary += 1;
-        let ray = self.scene.camera.ray_through(x as f32 + 0.5, y as f32 + 0.5);
+        let ray = self.primary_rays.through(x as f32 + 0.5, y as f32 + 0.5);
         let kind = (0, explain::RayKind::Primary);
         self.whitted.radiance_observed(&ray, self.primary_cone, kind, &mut counts, observer)
     }

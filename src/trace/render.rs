@@ -175,8 +175,8 @@ impl Tracer<'_> {
                 }
             }
         }
-        let camera = &self.scene.camera;
-        let rays: Vec<Ray> = order.iter().map(|&(i, j)| camera.ray_through(i as f32 + 0.5, j as f32 + 0.5)).collect();
+        let camera = self.primary_rays;
+        let rays: Vec<Ray> = order.iter().map(|&(i, j)| camera.through(i as f32 + 0.5, j as f32 + 0.5)).collect();
         let mut hits = vec![None; rays.len()];
         let whitted = &self.whitted;
         whitted.accelerator.closest_packets(&whitted.primitives, &rays, 0.0, f32::INFINITY, &mut hits);

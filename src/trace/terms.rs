@@ -94,58 +94,98 @@ impl TracedTerms {
 /// One pixel's terms, by layer of the traced image.
 struct Pixel([[f32; 4]; TRACED_LAYERS as usize]);
 
-impl Tracer<'_> {
-    /// The terms `wanted` at every pixel of `view`'s window.
-    pub fn terms(&self, view: &ViewRays, wanted: Wanted) -> TracedTerms {
+/// Where a view's terms go, row after row of its window: each row holds every layer's pixels of
+/// that row, layer after layer.
+pub struct TermsLayout {
+    /// The window of the view's image the terms cover: `[x, y, width, height]`.
+    pub window: [u32; 4],
+    /// The layers traced, in the order each row holds them: [`SURFACE_LAYER`], then those of each
+    /// term asked for (of the visibility, a layer per slot).
+    pub layers: Vec<u32>,
+    /// The shadowed lights whose visibility is traced.
+    slots: usize,
+    /// One pixel traced in each block of `stride × stride`.
+    stride: u32,
+}
+
+impl TermsLayout {
+    /// The layout of `wanted` over `view`'s window.
+    pub fn new(view: &ViewRays, wanted: Wanted) -> TermsLayout {
         let (width, height) = view.size;
         let [x0, y0, w, h] = view.window;
         let (x1, y1) = ((x0 + w).min(width), (y0 + h).min(height));
         let (x0, y0) = (x0.min(x1), y0.min(y1));
         let slots = if wanted.contains(Traced::Shadows) { view.lights.len().min(MAX_SLOTS) } else { 0 };
-        let stride = view.stride.max(1);
-        // The layers asked for, each row holding them one after another: no image of whole
-        // pixels is made.
         let mut layers = vec![SURFACE_LAYER];
         for &term in Traced::ALL.iter().filter(|&&t| wanted.contains(t)) {
             let count = if term == Traced::Shadows { slots as u32 } else { term.row().layers };
             layers.extend(term.layer()..term.layer() + count);
         }
-        // The traced rows and columns: the first of each block.
-        let row_width = (x1 - x0).div_ceil(stride) as usize;
-        let traced_rows: Vec<(Vec<[f32; 4]>, RayCounts)> = (y0..y1)
-            .step_by(stride as usize)
-            .collect::<Vec<_>>()
-            .into_par_iter()
-            .map(|y| {
+        let window = [x0, y0, x1 - x0, y1 - y0];
+        TermsLayout { window, layers, slots, stride: view.stride.max(1) }
+    }
+
+    /// The pixels of one row: every layer's.
+    pub fn row_len(&self) -> usize {
+        self.layers.len() * self.window[2] as usize
+    }
+
+    /// Layer `k`'s pixels of row `y` of the window, in `rows` laid out so.
+    pub fn line<'r>(&self, rows: &'r [[f32; 4]], k: usize, y: usize) -> &'r [[f32; 4]] {
+        let width = self.window[2] as usize;
+        &rows[y * self.row_len() + k * width..][..width]
+    }
+
+    /// The pixels of every row.
+    pub fn pixels(&self) -> usize {
+        self.row_len() * self.window[3] as usize
+    }
+}
+
+impl Tracer<'_> {
+    /// The terms `wanted` at every pixel of `view`'s window.
+    pub fn terms(&self, view: &ViewRays, wanted: Wanted) -> TracedTerms {
+        let layout = TermsLayout::new(view, wanted);
+        let mut rows = vec![[0.0; 4]; layout.pixels()];
+        let rays = self.terms_into(view, wanted, &layout, &mut rows);
+        // Each layer in turn.
+        let height = layout.window[3] as usize;
+        let layers = (layout.layers.iter().enumerate())
+            .map(|(k, &layer)| (layer, (0..height).flat_map(|y| layout.line(&rows, k, y)).copied().collect()))
+            .collect();
+        TracedTerms { window: layout.window, layers, rays }
+    }
+
+    /// The terms `wanted` at every pixel of `view`'s window, written in `layout` into `out` (at
+    /// least [`TermsLayout::pixels`] long), its blocks of `stride` rows traced in parallel: each
+    /// block's first row is traced, one pixel in each run of `stride` pixels given to all of them,
+    /// and the block's other rows are copies of it. Returns the rays traced.
+    pub fn terms_into(&self, view: &ViewRays, wanted: Wanted, layout: &TermsLayout, out: &mut [[f32; 4]]) -> RayCounts {
+        let [x0, y0, width, _] = layout.window;
+        let stride = layout.stride;
+        let row_len = layout.row_len().max(1);
+        out[..layout.pixels()]
+            .par_chunks_mut(row_len * stride as usize)
+            .enumerate()
+            .map(|(b, block)| {
                 let mut counts = RayCounts::default();
-                let mut row = vec![[0.0; 4]; row_width * layers.len()];
-                for (i, x) in (x0..x1).step_by(stride as usize).enumerate() {
-                    let pixel = self.pixel_terms(view, (x, y), wanted, slots, &mut counts);
-                    for (k, &layer) in layers.iter().enumerate() {
-                        row[k * row_width + i] = pixel.0[layer as usize];
+                let (row, rest) = block.split_at_mut(row_len.min(block.len()));
+                let y = y0 + b as u32 * stride;
+                for x in (0..width).step_by(stride as usize) {
+                    let pixel = self.pixel_terms(view, (x0 + x, y), wanted, layout.slots, &mut counts);
+                    let covered = x as usize..(x + stride).min(width) as usize;
+                    for (k, &layer) in layout.layers.iter().enumerate() {
+                        let start = k * width as usize;
+                        row[start + covered.start..start + covered.end].fill(pixel.0[layer as usize]);
                     }
                 }
-                (row, counts)
+                rest.chunks_mut(row_len).for_each(|copy| copy.copy_from_slice(row));
+                counts
             })
-            .collect();
-        let rays = traced_rows.iter().fold(RayCounts::default(), |mut all, (_, counts)| {
-            all += *counts;
-            all
-        });
-        // Each layer in turn, every pixel given its block's terms.
-        let layers = layers
-            .iter()
-            .enumerate()
-            .map(|(k, &layer)| {
-                let mut values = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-                for y in 0..y1 - y0 {
-                    let row = &traced_rows[(y / stride) as usize].0[k * row_width..][..row_width];
-                    values.extend((0..x1 - x0).map(|x| row[(x / stride) as usize]));
-                }
-                (layer, values)
+            .reduce(RayCounts::default, |mut all, counts| {
+                all += counts;
+                all
             })
-            .collect();
-        TracedTerms { window: [x0, y0, x1 - x0, y1 - y0], layers, rays }
     }
 
     fn pixel_terms(

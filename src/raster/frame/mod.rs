@@ -312,6 +312,9 @@ impl Renderer {
             let inputs = (&gpu.device, scene, settings);
             self.traced.prepare(inputs, &mut frame, (terms, self.traced_stride, self.traced_at), &plan.lights, &views)
         });
+        if traced.is_none() {
+            self.traced.release();
+        }
         let inspection = self.inspector.as_ref().map(|i| &i.buffer);
         let inputs = frame_inputs(&maps, environment, inspection);
         self.view_groups.prepare(&gpu.device, &self.layouts.view, &inputs, &views);

@@ -17,8 +17,10 @@
 //! changed, copies the buffer it was traced into then ([`KeptTraced`]).
 
 mod request;
+mod upload;
 
 pub use request::{TermsRequest, decode, encode, join};
+use upload::{SpareBuffers, Upload};
 
 use super::context::{Figure, FrameEncoder};
 use super::shadow::views::{MAX_SHADOWED_LIGHTS, ShadowLayout};
@@ -58,6 +60,8 @@ pub struct KeptTraced {
     requests: Vec<TermsRequest>,
     /// Counts the cube faces whose terms were handed back ([`Self::faces_key`]).
     faces_received: u64,
+    /// The buffers of terms no frame draws any more, for the next terms.
+    spare: SpareBuffers,
 }
 
 /// Where a frame's traced terms are traced.
@@ -100,9 +104,15 @@ type ViewInputs = (FrameView, (u32, u32));
 impl KeptTraced {
     /// Forgets the kept terms: the renderer loaded another scene.
     pub fn forget(&mut self) {
+        self.release();
+        self.generation += 1;
+    }
+
+    /// Lets go of the kept terms and their buffers: a frame traces none.
+    pub fn release(&mut self) {
         self.last = None;
         self.requests.clear();
-        self.generation += 1;
+        self.spare.clear();
     }
 
     /// The terms `wanted` for every view of `views`, each into a buffer of its image's layers:
@@ -134,19 +144,25 @@ impl KeptTraced {
         // Elsewhere, a view's coarser terms stand in while its finer ones are traced.
         let elsewhere = matches!(at, TracedAt::Elsewhere { .. });
         let coarser = elsewhere && last_inputs == SceneInputs { stride: last_inputs.stride, ..inputs.clone() };
+        // The buffers of terms no frame will draw again, for the terms traced next.
+        let mut spare = std::mem::take(&mut self.spare);
         if !same {
             self.ticket += 1;
             self.requests.clear();
-            last.retain(|_| coarser);
+            if !coarser {
+                last.drain(..).for_each(|old| spare.give_back(old.upload));
+            }
             last.iter_mut().for_each(|kept| kept.asked = None);
         }
         let (mut rays, mut kept, mut asked) = (0, 0, 0);
-        let mut now = Vec::new();
+        let (mut now, mut replaced) = (Vec::new(), Vec::new());
         let tracer = std::cell::OnceCell::new();
         let mut trace_here = |request: &TermsRequest| {
-            let terms = request.trace(tracer.get_or_init(|| Tracer::new(scene, settings)))?;
-            rays += terms.rays.total();
-            Some(upload(device, &terms))
+            let tracer = tracer.get_or_init(|| Tracer::new(scene, settings));
+            let (upload, counts) =
+                request.trace_with(tracer, |view, wanted| spare.traced(device, tracer, (view, wanted)))?;
+            rays += counts.total();
+            Some(upload)
         };
         for &(view, targets) in views {
             let key = (view.clone(), targets.size);
@@ -167,7 +183,8 @@ impl KeptTraced {
                         Kept { key: key.clone(), upload: stand_in, asked: Some(number) }
                     })
                 }
-                (_, TracedAt::Here) => {
+                (found, TracedAt::Here) => {
+                    replaced.extend(found.map(|old| old.upload));
                     let request = TermsRequest::new((0, 0), (view, targets.size), &inputs);
                     trace_here(&request).map(|upload| Kept { key: key.clone(), upload, asked: None })
                 }
@@ -180,6 +197,7 @@ impl KeptTraced {
                 ("rays", Figure::Count(rays)),
                 ("views kept", Figure::Count(kept)),
                 ("views asked", Figure::Count(asked)),
+                ("buffers reused", Figure::Count(spare.reused())),
             ],
         );
         let prepared = PreparedTraced { views: now.iter().map(|k| (k.key.0.slot, k.upload.clone())).collect() };
@@ -187,7 +205,11 @@ impl KeptTraced {
         // are drawn only now and then, and their terms asked for elsewhere come back meanwhile.
         if same {
             now.extend(last);
+        } else {
+            replaced.extend(last.into_iter().map(|old| old.upload));
         }
+        replaced.into_iter().for_each(|old| spare.give_back(old));
+        self.spare = spare;
         self.last = Some((inputs, now));
         prepared
     }
@@ -209,7 +231,8 @@ impl KeptTraced {
     pub fn receive(&mut self, device: &wgpu::Device, (ticket, view): (u64, usize), terms: &TracedTerms) -> bool {
         let Some((_, views)) = &mut self.last else { return false };
         let Some(kept) = views.iter_mut().find(|k| k.asked == Some((ticket, view))) else { return false };
-        kept.upload = upload(device, terms);
+        let stand_in = std::mem::replace(&mut kept.upload, self.spare.terms(device, terms));
+        self.spare.give_back(stand_in);
         kept.asked = None;
         if let ViewKind::CubeFace { .. } = kept.key.0.kind {
             self.faces_received += 1;
@@ -225,74 +248,11 @@ impl KeptTraced {
     }
 }
 
-/// One view's terms in a buffer: the window they cover and the image layer of each.
-#[derive(Clone)]
-struct Upload {
-    buffer: wgpu::Buffer,
-    window: [u32; 4],
-    layers: Vec<u32>,
-}
-
-/// Bytes of one pixel of one layer (`Rgba32Float`).
-const PIXEL_BYTES: u32 = 16;
-
 impl PreparedTraced {
     /// Copies `view`'s terms into its traced image, which the view's shading then reads.
     pub fn record(&self, frame: &mut FrameEncoder, view: &FrameView, targets: &FrameTargets) {
         let Some((_, upload)) = self.views.iter().find(|(slot, _)| *slot == view.slot) else { return };
         let image = &targets.images.array_of(ViewImage::Traced).texture;
-        let [x, y, width, height] = upload.window;
-        let layer_bytes = u64::from(padded_row(width) * height);
-        for (k, &layer) in upload.layers.iter().enumerate() {
-            frame.encoder.copy_buffer_to_texture(
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &upload.buffer,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: k as u64 * layer_bytes,
-                        bytes_per_row: Some(padded_row(width)),
-                        rows_per_image: Some(height),
-                    },
-                },
-                wgpu::TexelCopyTextureInfo {
-                    texture: image,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d { x, y, z: ViewImage::Traced.first_layer() + layer },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-            );
-        }
+        upload.copy(&mut frame.encoder, image, ViewImage::Traced.first_layer());
     }
-}
-
-/// A row's bytes, padded to wgpu's copy alignment.
-fn padded_row(width: u32) -> u32 {
-    (width * PIXEL_BYTES).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-}
-
-/// The terms traced, layer after layer, each row padded; and each one's layer in the image.
-fn upload(device: &wgpu::Device, terms: &TracedTerms) -> Upload {
-    let layers = &terms.layers;
-    let [_, _, width, height] = terms.window;
-    let row = padded_row(width) as usize;
-    let layer_bytes = row * height as usize;
-    // Written where the copy reads it, in the buffer as it is made.
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("traced::terms"),
-        size: (layer_bytes * layers.len()).max(PIXEL_BYTES as usize) as u64,
-        usage: wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: true,
-    });
-    {
-        let mut bytes = buffer.slice(..).get_mapped_range_mut().expect("a buffer mapped at its creation");
-        for (k, (_, values)) in layers.iter().enumerate() {
-            for (y, line) in values.chunks(width.max(1) as usize).enumerate() {
-                let start = layer_bytes * k + y * row;
-                let line: &[u8] = bytemuck::cast_slice(line);
-                bytes.slice(start..start + line.len()).copy_from_slice(line);
-            }
-        }
-    }
-    buffer.unmap();
-    Upload { buffer, window: terms.window, layers: layers.iter().map(|(layer, _)| *layer).collect() }
 }

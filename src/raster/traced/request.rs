@@ -15,7 +15,7 @@ use crate::scene::{Camera, Scene};
 use crate::settings::TracedSet;
 use crate::texture::RayCone;
 use crate::trace::Tracer;
-use crate::trace::terms::{TracedTerms, ViewRays};
+use crate::trace::terms::{TracedTerms, ViewRays, Wanted};
 
 /// The terms of one view (or of a band of its rows) to trace.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -87,6 +87,12 @@ impl TermsRequest {
     /// The terms, traced by `tracer` (of the scene the request was made from); `None` for an
     /// empty window.
     pub fn trace(&self, tracer: &Tracer) -> Option<TracedTerms> {
+        self.trace_with(tracer, |view, wanted| tracer.terms(view, wanted))
+    }
+
+    /// `trace(view, wanted)` of the request's view and terms, as `tracer` (of the scene the
+    /// request was made from) looks through it; `None` for an empty window.
+    pub fn trace_with<T>(&self, tracer: &Tracer, trace: impl FnOnce(&ViewRays, Wanted) -> T) -> Option<T> {
         let window = self.window?;
         let (ray, cone) = camera_rays(tracer.scene, &self.camera, self.size);
         let view_rays = ViewRays {
@@ -98,7 +104,7 @@ impl TermsRequest {
             lights: &self.slots,
             stride: self.stride,
         };
-        Some(tracer.terms(&view_rays, self.wanted))
+        Some(trace(&view_rays, self.wanted))
     }
 
     /// The request split into bands of at least `rows` rows (rounded up to the stride, so that
@@ -172,10 +178,11 @@ fn camera_rays(scene: &Scene, camera: &ViewCamera, size: (u32, u32)) -> (RayFn, 
     let &ViewCamera::Unprojected { clip_from_world, eye, orthographic, view_axis, clip_plane } = camera else {
         // The tracer's own primary rays, scaled from the drawn size to the camera's, and a pixel
         // of the drawn size's cone.
-        let camera = scene.camera.clone();
+        let camera = &scene.camera;
         let (sx, sy) = (camera.width as f32 / size.0 as f32, camera.height as f32 / size.1 as f32);
         let cone = crate::trace::primary_cone(&Camera { width: size.0, height: size.1, ..camera.clone() });
-        return (Box::new(move |x, y| Some((camera.ray_through(x * sx, y * sy), 0.0))), cone);
+        let rays = camera.rays();
+        return (Box::new(move |x, y| Some((rays.through(x * sx, y * sy), 0.0))), cone);
     };
     let unprojected = Unprojected {
         world_from_clip: clip_from_world.inverse(),
