@@ -155,7 +155,7 @@ impl KeptTraced {
             last.iter_mut().for_each(|kept| kept.asked = None);
         }
         let (mut rays, mut kept, mut asked) = (0, 0, 0);
-        let (mut now, mut replaced) = (Vec::new(), Vec::new());
+        let mut now = Vec::new();
         let tracer = std::cell::OnceCell::new();
         let mut trace_here = |request: &TermsRequest| {
             let tracer = tracer.get_or_init(|| Tracer::new(scene, settings));
@@ -183,8 +183,7 @@ impl KeptTraced {
                         Kept { key: key.clone(), upload: stand_in, asked: Some(number) }
                     })
                 }
-                (found, TracedAt::Here) => {
-                    replaced.extend(found.map(|old| old.upload));
+                (_, TracedAt::Here) => {
                     let request = TermsRequest::new((0, 0), (view, targets.size), &inputs);
                     trace_here(&request).map(|upload| Kept { key: key.clone(), upload, asked: None })
                 }
@@ -206,9 +205,8 @@ impl KeptTraced {
         if same {
             now.extend(last);
         } else {
-            replaced.extend(last.into_iter().map(|old| old.upload));
+            last.into_iter().for_each(|old| spare.give_back(old.upload));
         }
-        replaced.into_iter().for_each(|old| spare.give_back(old));
         self.spare = spare;
         self.last = Some((inputs, now));
         prepared
