@@ -1,7 +1,7 @@
 //! The hybrid's traced terms (`mirador::trace::terms`) against the tracer's own image, on the CPU
 //! alone, in the same run: the showcase's main view at 1280×720, its traced colour alone, the
-//! visibility of its two lights alone, and `Tracer::render` of the whole image (every ray of every
-//! kind).
+//! visibility of its two lights alone, that with the lights term (the lights without a shadow map:
+//! none here), and `Tracer::render` of the whole image (every ray of every kind).
 //!
 //! `cargo bench --bench hybrid`; prints the median of five runs, the rays and the rate of each.
 
@@ -53,10 +53,19 @@ fn main() {
     let colour = rate("terms: colour", &mut || tracer.terms(&view, TracedSet::of(&[Traced::Textures])).rays.total());
     let visibility =
         rate("terms: visibility", &mut || tracer.terms(&view, TracedSet::of(&[Traced::Shadows])).rays.total());
+    // The showcase's two lights both have shadow maps: the lights term has no light to add.
+    let other_lights = rate("terms: visibility, other lights", &mut || {
+        tracer.terms(&view, TracedSet::of(&[Traced::Shadows, Traced::Lights])).rays.total()
+    });
     let render = rate("Tracer::render (the whole image)", &mut || {
         let (_, stats) = tracer.render(&RenderControl::default()).expect("nothing cancels it");
         stats.rays.total()
     });
     let ratio = |t: Duration| t.as_secs_f64() / render.as_secs_f64();
-    println!("time / render's: colour {:.2}, visibility {:.2}", ratio(colour), ratio(visibility));
+    println!(
+        "time / render's: colour {:.2}, visibility {:.2}, visibility and other lights {:.2}",
+        ratio(colour),
+        ratio(visibility),
+        ratio(other_lights)
+    );
 }

@@ -796,8 +796,31 @@ fn fan(eye: Vec3, target: Vec3, size: f32, side: usize) -> Vec<Ray> {
     rays
 }
 
+/// Rays from a `side × side` grid of points on a square `size` wide around `from`, in blocks of
+/// 4 × 4 as [`fan`]'s: towards `to` if `converging` (as shadow rays towards a light), else all
+/// along `to − from` (an orthographic camera). Each packet's rays start at different points.
+fn grid_rays(from: Vec3, to: Vec3, size: f32, side: usize, converging: bool) -> Vec<Ray> {
+    let forward = (to - from).normalize();
+    let right = forward.cross(Vec3::Y).try_normalize().unwrap_or(Vec3::X);
+    let up = right.cross(forward);
+    let mut rays = Vec::new();
+    for by in (0..side).step_by(4) {
+        for bx in (0..side).step_by(4) {
+            for y in by..(by + 4).min(side) {
+                for x in bx..(bx + 4).min(side) {
+                    let (s, t) = ((x as f32 + 0.5) / side as f32 - 0.5, (y as f32 + 0.5) / side as f32 - 0.5);
+                    let origin = from + size * (s * right + t * up);
+                    rays.push(ray(origin, if converging { to - origin } else { to - from }));
+                }
+            }
+        }
+    }
+    rays
+}
+
 /// The scenes and rays the packet tests trace: a sphere mesh, the showcase, and a triangle soup
-/// with analytic shapes; for each, a fan of coherent rays, random rays, rays along the axes
+/// with analytic shapes; for each, a fan of coherent rays, rays from a grid of points (parallel,
+/// and converging on a point beyond the scene), random rays, rays along the axes
 /// (walked alone inside a packet) and a ray that misses, so that the last packet is short. Each
 /// with its reach, the size of what the rays aim at.
 fn packet_cases(rng: &mut Pcg) -> Vec<(&'static str, Vec<Primitive>, Vec<Ray>, f32)> {
@@ -817,7 +840,10 @@ fn packet_cases(rng: &mut Pcg) -> Vec<(&'static str, Vec<Primitive>, Vec<Ray>, f
             };
             let centre = (focus.min + focus.max) / 2.0;
             let reach = focus.extent().max_element();
-            let mut rays = fan(centre + Vec3::new(0.3, 0.4, 1.6) * reach, centre, reach, 37);
+            let eye = centre + Vec3::new(0.3, 0.4, 1.6) * reach;
+            let mut rays = fan(eye, centre, reach, 37);
+            rays.extend(grid_rays(eye, centre, reach, 29, false));
+            rays.extend(grid_rays(centre - Vec3::new(0.2, 1.0, 0.5) * reach, eye, reach, 29, true));
             rays.extend(random_queries(rng, &focus, 500).into_iter().map(|(r, _, _)| r));
             rays.extend(axis_rays(&prims, rng, 60).into_iter().map(|(r, _, _)| r));
             rays.push(ray(centre + Vec3::splat(10.0 * reach), Vec3::ONE));

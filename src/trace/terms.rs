@@ -246,7 +246,8 @@ impl Tracer<'_> {
             pixel.0[Traced::Transmission.layer() as usize] = through.extend(1.0).into();
         }
         if wanted.contains(Traced::Lights) {
-            let light = self.unshadowed_light((&ray, cone), (&hit, n), view.lights, counts);
+            let known = wanted.contains(Traced::Textures).then_some(colour);
+            let light = self.unshadowed_light((&ray, cone), (&hit, n, known), view.lights, counts);
             pixel.0[Traced::Lights.layer() as usize] = light.extend(1.0).into();
         }
         pixel
@@ -254,28 +255,35 @@ impl Tracer<'_> {
 
     /// The direct light of the lights the rasterizer draws without a shadow (of its first
     /// [`MAX_LIGHTS`], those not in `shadowed`), as [`super::whitted`] adds it: each weighted by
-    /// its shadow ray's `V_i`.
+    /// its shadow ray's `V_i`. The surface's colour is filtered only where such a light reaches it,
+    /// if not `known` already.
     fn unshadowed_light(
         &self,
         (ray, cone): (&Ray, RayCone),
-        (hit, n): (&SurfaceHit, Vec3),
+        (hit, n, known): (&SurfaceHit, Vec3, Option<Vec3>),
         shadowed: &[usize],
         counts: &mut RayCounts,
     ) -> Vec3 {
         let whitted = &self.whitted;
         let material = &self.scene.materials[hit.material.0];
-        let colour = whitted.textures.colour(material, hit, ray.direction, &cone, &whitted.texture_settings);
-        let sample = SurfaceSample::new(material, colour);
         let v = -ray.direction;
-        let origin = hit.point + surface_offset(hit.point) * facing_viewer(hit.geometric_normal, v);
+        let mut sample = None;
         let mut light = Vec3::ZERO;
         for (index, source) in self.scene.lights.iter().enumerate().take(MAX_LIGHTS) {
-            let Some(incidence) = source.incidence(hit.point).filter(|_| !shadowed.contains(&index)) else {
+            if shadowed.contains(&index) {
                 continue;
-            };
-            if lights_surface(n, incidence.l, sample.ka, whitted.terms) {
+            }
+            let Some(incidence) = source.incidence(hit.point) else { continue };
+            if lights_surface(n, incidence.l, material.ka, whitted.terms) {
+                let sample = sample.get_or_insert_with(|| {
+                    let colour = known.unwrap_or_else(|| {
+                        whitted.textures.colour(material, hit, ray.direction, &cone, &whitted.texture_settings)
+                    });
+                    SurfaceSample::new(material, colour)
+                });
+                let origin = hit.point + surface_offset(hit.point) * facing_viewer(hit.geometric_normal, v);
                 let visibility = whitted.visibility(origin, incidence.l, incidence.distance, counts);
-                light += visibility * direct(&sample, n, v, &incidence, whitted.terms);
+                light += visibility * direct(sample, n, v, &incidence, whitted.terms);
             }
         }
         light

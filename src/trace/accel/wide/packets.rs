@@ -22,6 +22,24 @@
 //! (its light's distance), and a ray leaves the packet at its first hit: whether anything is hit
 //! is the single ray's answer, since a ray enters every box the single-ray walk enters until then.
 //!
+//! **The packet as one interval** (Boulos et al., "Geometric and Arithmetic Culling Methods for
+//! Entire Ray Packets", 2006). Where every ray of the packet points the same way along each
+//! axis, they enter each slab through the same plane, and the packet's rays are bounded by
+//! intervals: of their origins, per axis, and of their inverse directions ([`Bounds`]). At a node
+//! the slab test run on those intervals ([`enter_together`]) bounds every ray's entry and exit
+//! distances at once, for the eight boxes: a box whose lowest entry lies beyond its highest exit
+//! is entered by no ray, a box whose highest entry comes before its lowest exit by all of them.
+//! Where each of the eight boxes is one or the other, the node is settled for the whole packet by
+//! one test instead of one a ray. Near the root, where a 4 × 4 block of pixels is small beside the
+//! boxes, that is every node; where a box's edge falls between the rays, the node is tested ray
+//! by ray as above, and so is everything under it.
+//!
+//! The bounds are exact, not padded: each ray's `(plane − origin)·(1/d)` is rounded from a
+//! difference and a product, and rounding keeps order, so it lies between the same expression at
+//! the corners of the intervals. So the packet never leaves out a box a ray enters, and the hits
+//! stay the single-ray walk's: a ray the interval test takes into a box it does not enter only
+//! tests triangles it misses.
+//!
 //! What a packet costs instead: a ray that left the others' path is carried along, masked, until
 //! the nodes it enters run out. Incoherent rays (reflections off curved surfaces, refraction)
 //! gain nothing, and are traced one by one.
@@ -36,6 +54,59 @@ struct Member<'a> {
     query: Query<'a>,
     box_ray: BoxRay,
     packet_ray: PacketRay,
+}
+
+/// The packet's rays as intervals, for the box test on all of them at once: per axis the planes
+/// they all enter and leave a slab through, and the least and greatest of their origins, their
+/// inverse directions and those scaled for the exits ([`BoxRay`]'s three), as `[least, greatest]`.
+struct Bounds {
+    /// The packet's near bound, every ray's.
+    t_min: f32,
+    near: [usize; 3],
+    far: [usize; 3],
+    origin: [[f32; 3]; 2],
+    inv_direction: [[f32; 3]; 2],
+    exit_inv_direction: [[f32; 3]; 2],
+}
+
+impl Bounds {
+    /// The bounds of `members`' rays; `None` for a packet of one ray or none, and where the rays
+    /// point different ways along an axis (the interval of their inverse directions would hold
+    /// ±∞) or a bound is not finite.
+    fn new(members: &[Option<Member>; RAYS], t_min: f32) -> Option<Bounds> {
+        let mut rays = members.iter().flatten().map(|m| &m.box_ray);
+        let first = rays.next()?;
+        let mut bounds = Bounds {
+            t_min,
+            near: first.near,
+            far: first.far,
+            origin: [first.origin; 2],
+            inv_direction: [first.inv_direction; 2],
+            exit_inv_direction: [first.exit_inv_direction; 2],
+        };
+        let mut count = 1;
+        for ray in rays {
+            if ray.near != bounds.near {
+                return None;
+            }
+            for k in 0..3 {
+                widen(&mut bounds.origin, k, ray.origin[k]);
+                widen(&mut bounds.inv_direction, k, ray.inv_direction[k]);
+                widen(&mut bounds.exit_inv_direction, k, ray.exit_inv_direction[k]);
+            }
+            count += 1;
+        }
+        let finite = [bounds.origin, bounds.inv_direction, bounds.exit_inv_direction]
+            .iter()
+            .all(|b| b.iter().flatten().all(|x| x.is_finite()));
+        (count > 1 && finite).then_some(bounds)
+    }
+}
+
+/// Widens `[least, greatest]`'s axis `k` to hold `x`.
+fn widen(bounds: &mut [[f32; 3]; 2], k: usize, x: f32) {
+    bounds[0][k] = bounds[0][k].min(x);
+    bounds[1][k] = bounds[1][k].max(x);
 }
 
 impl Wide {
@@ -108,20 +179,21 @@ impl Wide {
         if active == 0 {
             return;
         }
-        let members = &members;
+        let bounds = Bounds::new(&members, t_min);
+        let packet = (&members, bounds.as_ref());
         let small = self.stack_bound <= SMALL_STACK;
         #[cfg(target_arch = "x86_64")]
         if self.avx {
             // SAFETY: `avx` is set only where the CPU reports AVX.
-            unsafe { self.packet_avx::<ANY>(members, active, small, hits) };
+            unsafe { self.packet_avx::<ANY>(packet, active, small, hits) };
             return;
         }
         // SAFETY: `Halves` uses what every target has (SSE2 on x86-64).
         unsafe {
             if small {
-                self.walk::<Halves, ANY, SMALL_STACK>(members, active, hits)
+                self.walk::<Halves, ANY, SMALL_STACK>(packet, active, hits)
             } else {
-                self.walk::<Halves, ANY, LARGE_STACK>(members, active, hits)
+                self.walk::<Halves, ANY, LARGE_STACK>(packet, active, hits)
             }
         }
     }
@@ -131,7 +203,7 @@ impl Wide {
     #[target_feature(enable = "avx")]
     fn packet_avx<const ANY: bool>(
         &self,
-        members: &[Option<Member>; RAYS],
+        packet: (&[Option<Member>; RAYS], Option<&Bounds>),
         active: u32,
         small: bool,
         hits: &mut [Option<Hit>],
@@ -139,23 +211,25 @@ impl Wide {
         // SAFETY: this function runs only where the CPU has AVX (its caller checks).
         unsafe {
             if small {
-                self.walk::<Octet, ANY, SMALL_STACK>(members, active, hits)
+                self.walk::<Octet, ANY, SMALL_STACK>(packet, active, hits)
             } else {
-                self.walk::<Octet, ANY, LARGE_STACK>(members, active, hits)
+                self.walk::<Octet, ANY, LARGE_STACK>(packet, active, hits)
             }
         }
     }
 
     /// The packet's nearest-first walk: the rays of `active` (those `members` holds), each with
     /// its own far bound. With `ANY`, a ray's first hit ends its walk: its far bound becomes
-    /// −∞, so it enters no more boxes and leaves every pending child.
+    /// −∞, so it enters no more boxes and leaves every pending child. Nodes are tested on the
+    /// rays' `bounds` where there are bounds, until a node needs its rays tested one by one;
+    /// under that node they all are.
     ///
     /// # Safety
     /// The CPU must have the instructions `L` uses.
     #[inline(always)]
     unsafe fn walk<L: Lanes, const ANY: bool, const STACK: usize>(
         &self,
-        members: &[Option<Member>; RAYS],
+        (members, bounds): (&[Option<Member>; RAYS], Option<&Bounds>),
         active: u32,
         hits: &mut [Option<Hit>],
     ) {
@@ -165,16 +239,24 @@ impl Wide {
                 t_max[i] = member.query.t_max;
             }
         }
-        let mut stack = Stack::<(u32, u32, f32), STACK>::new();
+        // Each pending child with its rays, their nearest entry, and whether they are together.
+        let mut stack = Stack::<(u32, u32, f32, bool), STACK>::new();
         let (mut current, mut rays) = (0u32, active);
+        let mut together = bounds.is_some();
         let mut done = 0u32;
         loop {
             if current & LEAF == 0 {
                 // SAFETY: `current` is 0 or an inner child's entry of a node.
                 let node = unsafe { self.node(current) };
+                let settled = match bounds {
+                    // SAFETY: the caller's promise about `L`.
+                    Some(bounds) if together => unsafe { enter_together::<L>(node, bounds, rays, &t_max) },
+                    _ => None,
+                };
+                together = settled.is_some();
                 // SAFETY: the caller's promise about `L`.
-                let entered = unsafe { enter_all::<L>(node, members, rays, &t_max) };
-                if let Some((child, next)) = entered.nearest_pushing_others(node, &mut stack) {
+                let entered = settled.unwrap_or_else(|| unsafe { enter_each::<L>(node, members, rays, &t_max) });
+                if let Some((child, next)) = entered.nearest_pushing_others(node, together, &mut stack) {
                     (current, rays) = (child, next);
                     continue;
                 }
@@ -204,10 +286,10 @@ impl Wide {
             }
             // Next: the nearest pending child, with the rays whose nearest hit is not nearer.
             loop {
-                let Some((child, pending, entry)) = stack.pop() else { return };
+                let Some((child, pending, entry, with_bounds)) = stack.pop() else { return };
                 let still = bits(pending).filter(|&i| entry < t_max[i]).fold(0, |m, i| m | 1 << i);
                 if still != 0 {
-                    (current, rays) = (child, still);
+                    (current, rays, together) = (child, still, with_bounds);
                     break;
                 }
             }
@@ -221,12 +303,66 @@ struct Entered {
     entry: [f32; WIDTH],
 }
 
+/// The node's eight boxes tested once for all of `rays`, on the packet's `bounds` (the module's
+/// "packet as one interval"): `Some` where each box is entered by every ray or by none, with the
+/// nearest entry any ray can have; `None` where a box may be entered by some rays only.
+///
+/// # Safety
+/// The CPU must have the instructions `L` uses.
+#[inline(always)]
+unsafe fn enter_together<L: Lanes>(node: &Node, bounds: &Bounds, rays: u32, t_max: &[f32; RAYS]) -> Option<Entered> {
+    let (mut least_far, mut greatest_far) = (f32::INFINITY, f32::NEG_INFINITY);
+    for i in bits(rays) {
+        (least_far, greatest_far) = (least_far.min(t_max[i]), greatest_far.max(t_max[i]));
+    }
+    // SAFETY: the caller's promise about `L`.
+    let (all, none, entry) = unsafe {
+        let (mut enter_least, mut enter_greatest) = (L::splat(bounds.t_min), L::splat(bounds.t_min));
+        let (mut exit_least, mut exit_greatest) = (L::splat(least_far), L::splat(greatest_far));
+        for k in 0..3 {
+            let near = L::load(&node.planes[bounds.near[k]]);
+            let (near_least, near_greatest) = corners(near, bounds.origin, bounds.inv_direction, k);
+            let far = L::load(&node.planes[bounds.far[k]]);
+            let (far_least, far_greatest) = corners(far, bounds.origin, bounds.exit_inv_direction, k);
+            (enter_least, enter_greatest) = (enter_least.max(near_least), enter_greatest.max(near_greatest));
+            (exit_least, exit_greatest) = (exit_least.min(far_least), exit_greatest.min(far_greatest));
+        }
+        (enter_greatest.le(exit_least), enter_least.gt(exit_greatest), enter_least.to_array())
+    };
+    if (all | none) != (1 << WIDTH) - 1 {
+        return None;
+    }
+    let mut entered = Entered { rays: [0; WIDTH], entry: [f32::INFINITY; WIDTH] };
+    for child in bits(all) {
+        (entered.rays[child], entered.entry[child]) = (rays, entry[child]);
+    }
+    Some(entered)
+}
+
+/// The least and the greatest of `(plane − origin)·inv` along axis `k` over the intervals
+/// `[least, greatest]` of `origin` and `inv`: among its values at the intervals' corners, since
+/// rounding keeps order (of the difference, then of the product in each factor).
+///
+/// # Safety
+/// The CPU must have the instructions `L` uses.
+#[inline(always)]
+unsafe fn corners<L: Lanes>(plane: L, origin: [[f32; 3]; 2], inv: [[f32; 3]; 2], k: usize) -> (L, L) {
+    // SAFETY: the caller's promise about `L`.
+    unsafe {
+        let (from_greatest, from_least) = (plane - L::splat(origin[1][k]), plane - L::splat(origin[0][k]));
+        let (least_inv, greatest_inv) = (L::splat(inv[0][k]), L::splat(inv[1][k]));
+        let (a, b) = (from_greatest * least_inv, from_greatest * greatest_inv);
+        let (c, d) = (from_least * least_inv, from_least * greatest_inv);
+        (a.min(b).min(c.min(d)), a.max(b).max(c.max(d)))
+    }
+}
+
 /// Tests every ray of `rays` against the node's eight boxes.
 ///
 /// # Safety
 /// The CPU must have the instructions `L` uses.
 #[inline(always)]
-unsafe fn enter_all<L: Lanes>(
+unsafe fn enter_each<L: Lanes>(
     node: &Node,
     members: &[Option<Member>; RAYS],
     rays: u32,
@@ -246,13 +382,14 @@ unsafe fn enter_all<L: Lanes>(
 }
 
 impl Entered {
-    /// Pushes every entered child but the nearest, farthest first, and returns the nearest with
-    /// its rays; `None` when no ray enters any.
+    /// Pushes every entered child but the nearest, farthest first (each marked `together` or not),
+    /// and returns the nearest with its rays; `None` when no ray enters any.
     #[inline(always)]
     fn nearest_pushing_others<const N: usize>(
         &self,
         node: &Node,
-        stack: &mut Stack<(u32, u32, f32), N>,
+        together: bool,
+        stack: &mut Stack<(u32, u32, f32, bool), N>,
     ) -> Option<(u32, u32)> {
         let mut order = [0usize; WIDTH];
         let mut count = 0;
@@ -268,7 +405,7 @@ impl Entered {
         }
         let (&nearest, others) = order[..count].split_last()?;
         for &child in others {
-            stack.push((node.child[child], self.rays[child], self.entry[child]));
+            stack.push((node.child[child], self.rays[child], self.entry[child], together));
         }
         Some((node.child[nearest], self.rays[nearest]))
     }
