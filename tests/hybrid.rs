@@ -134,9 +134,10 @@ fn the_lights_past_the_fourth_traced_cast_their_shadows() {
     assert!(shadows > 4.0 * lights, "without the row the two unshadowed lights show: {shadows} against {lights}");
 }
 
-/// A frame drawn like the last one (the same scene, camera, lights, settings and views) copies
-/// its traced terms rather than tracing them again: no ray, and the image a frame that traced them
-/// draws. A dimmer light, a moved camera or another setting traces them anew.
+/// A frame drawn like the last one (the same scene, camera, lights, settings and views) keeps
+/// its traced terms rather than tracing them again: no ray, no copy (the main view's image holds
+/// them still), and the image a frame that traced them draws. A dimmer light, a moved camera or
+/// another setting traces them anew, and copies them in: the image a fresh renderer draws.
 #[test]
 fn a_frame_like_the_last_keeps_its_traced_terms() {
     let gpu = common::gpu();
@@ -152,6 +153,8 @@ fn a_frame_like_the_last_keeps_its_traced_terms() {
     let kept = headless.render(gpu, &scene, &settings);
     assert_eq!(rays(&headless), 0, "a frame like the last traces nothing");
     assert!(headless.report.count("traced terms", "views kept") > 0);
+    let copied = |headless: &mirador::raster::Headless| headless.report.count("traced terms", "views copied");
+    assert_eq!(copied(&headless), 0, "a frame like the last copies nothing: its image holds the terms");
     // Traced again after another setting, then the first settings traced again: the same image.
     let mut other = settings.clone();
     other.exposure *= 0.5;
@@ -162,8 +165,10 @@ fn a_frame_like_the_last_keeps_its_traced_terms() {
     assert_eq!(kept, traced, "kept terms draw the image traced terms draw");
     // The scene's own values: a light and the camera.
     scene.lights[0].intensity *= 0.5;
-    headless.render(gpu, &scene, &settings);
-    assert!(rays(&headless) > 0, "a dimmer light traces anew");
+    let dimmer = headless.render(gpu, &scene, &settings);
+    assert!(rays(&headless) > 0 && copied(&headless) > 0, "a dimmer light traces anew, and copies");
+    let fresh = mirador::raster::Headless::new(gpu, &scene).render(gpu, &scene, &settings);
+    assert_eq!(dimmer, fresh, "the terms traced anew are drawn, not the image's last");
     scene.camera.eye += glam::Vec3::new(0.1, 0.0, 0.0);
     headless.render(gpu, &scene, &settings);
     assert!(rays(&headless) > 0, "a moved camera traces anew");

@@ -3,6 +3,8 @@
 //! show them (`super::mirror`, `super::environment`). Every view draws into its own, so the
 //! phases of one view never read what another is writing.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use crate::gpu::texture::{GpuTexture, Layers};
 use crate::shaders::constants;
 
@@ -136,6 +138,9 @@ pub struct ViewImages {
     arrays: Vec<GpuTexture>,
     /// A 2D view of each layer of [`ViewArray::Drawn`], which its passes draw into.
     drawn_layers: Vec<wgpu::TextureView>,
+    /// The number of the traced terms [`ViewImage::Traced`] holds, copied in by a frame
+    /// (`super::traced`); 0: none known.
+    traced: AtomicU64,
 }
 
 impl ViewImages {
@@ -154,7 +159,18 @@ impl ViewImages {
                 })
             })
             .collect();
-        ViewImages { arrays, drawn_layers }
+        ViewImages { arrays, drawn_layers, traced: AtomicU64::new(0) }
+    }
+
+    /// The number of the traced terms [`ViewImage::Traced`] holds (0: none known).
+    pub fn traced(&self) -> u64 {
+        self.traced.load(Ordering::Relaxed)
+    }
+
+    /// Records that the frame being recorded copies the traced terms numbered `number` into
+    /// [`ViewImage::Traced`] (0: terms the next frames cannot count on).
+    pub fn hold_traced(&self, number: u64) {
+        self.traced.store(number, Ordering::Relaxed);
     }
 
     /// The array `array`, viewed whole.
@@ -181,6 +197,7 @@ impl ViewImages {
         let made = self.arrays[array.index()].texture.size();
         if (made.width, made.height) != size {
             self.arrays[array.index()] = make(device, array, size);
+            self.hold_traced(0);
         }
     }
 }

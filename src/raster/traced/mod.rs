@@ -14,7 +14,9 @@
 //! is traced into a buffer before the frame is recorded, and copied into its image just before
 //! the view draws: the cube faces share one set of targets, so a copy made earlier would be
 //! overwritten by the next face's. A view drawn again as the last frame drew it, with nothing else
-//! changed, copies the buffer it was traced into then ([`KeptTraced`]).
+//! changed, draws the terms it was traced with then ([`KeptTraced`]): where its image is its own
+//! (the main view's, a mirrored camera's), the image still holds them and nothing is copied;
+//! where views share an image (the cube faces), they are copied again from the buffer kept.
 
 mod request;
 mod upload;
@@ -46,7 +48,7 @@ pub struct PreparedTraced {
 
 /// The last frame's terms and what they were traced from, kept for the next frames: while the
 /// scene, its camera and lights and the settings are the same, a view drawn again from the same
-/// camera at the same size has the same terms, and the frame copies them again rather than
+/// camera at the same size has the same terms, and the frame draws them again rather than
 /// tracing them again (as a raster frame keeps its shadow maps). A view that changed, or any
 /// change of the scene or the settings, is traced anew: here, or elsewhere ([`TracedAt`]).
 #[derive(Default)]
@@ -190,6 +192,7 @@ impl KeptTraced {
             };
             now.extend(entry);
         }
+        let prepared = PreparedTraced::copies(views, &now);
         frame.end(
             "traced terms",
             &[
@@ -197,9 +200,9 @@ impl KeptTraced {
                 ("views kept", Figure::Count(kept)),
                 ("views asked", Figure::Count(asked)),
                 ("buffers reused", Figure::Count(spare.reused())),
+                ("views copied", Figure::Count(prepared.views.len() as u64)),
             ],
         );
-        let prepared = PreparedTraced { views: now.iter().map(|k| (k.key.0.slot, k.upload.clone())).collect() };
         // Views not drawn this frame keep their terms while nothing else changed: a cube's faces
         // are drawn only now and then, and their terms asked for elsewhere come back meanwhile.
         if same {
@@ -247,6 +250,26 @@ impl KeptTraced {
 }
 
 impl PreparedTraced {
+    /// The copies the frame's `views` need of their terms `now`: none for a view whose image is
+    /// its own and holds them already (drawn so by the last frame); each image's record of what
+    /// it holds kept up to date.
+    fn copies(views: &[ViewTargets<'_>], now: &[Kept]) -> PreparedTraced {
+        let mut copies = Vec::new();
+        for &(view, targets) in views {
+            let Some(kept) = now.iter().find(|k| k.key.0.slot == view.slot) else { continue };
+            let images = &targets.images;
+            let shared = views.iter().filter(|(_, other)| std::ptr::eq(*other, targets)).count() > 1;
+            if !shared && images.traced() == kept.upload.number {
+                continue;
+            }
+            // Views sharing an image copy in the order they draw: what it holds after them is
+            // not counted on.
+            images.hold_traced(if shared { 0 } else { kept.upload.number });
+            copies.push((view.slot, kept.upload.clone()));
+        }
+        PreparedTraced { views: copies }
+    }
+
     /// Copies `view`'s terms into its traced image, which the view's shading then reads.
     pub fn record(&self, frame: &mut FrameEncoder, view: &FrameView, targets: &FrameTargets) {
         let Some((_, upload)) = self.views.iter().find(|(slot, _)| *slot == view.slot) else { return };

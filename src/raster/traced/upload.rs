@@ -6,7 +6,7 @@
 //! pages for, as they did before (docs/performance.md).
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use crate::trace::Tracer;
 use crate::trace::terms::{TermsLayout, TracedTerms, ViewRays, Wanted};
@@ -25,7 +25,14 @@ pub(super) struct Upload {
     buffer: wgpu::Buffer,
     window: [u32; 4],
     layers: Vec<u32>,
+    /// A number no other terms written have ([`WRITTEN`]): an image that holds these terms
+    /// records it, and a frame that would copy them into it again need not.
+    pub(super) number: u64,
 }
+
+/// Numbers the terms written into buffers, in the whole process (a spare buffer's next terms
+/// are new terms: a new number).
+static WRITTEN: AtomicU64 = AtomicU64::new(1);
 
 /// Buffers whose terms no frame draws any more, each mapped again once the frames that copy from
 /// it are done.
@@ -130,7 +137,7 @@ impl SpareBuffers {
         }
         drop(mapping);
         buffer.unmap();
-        Upload { buffer, window, layers: layers.to_vec() }
+        Upload { buffer, window, layers: layers.to_vec(), number: WRITTEN.fetch_add(1, Ordering::Relaxed) }
     }
 }
 
