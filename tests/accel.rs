@@ -776,46 +776,37 @@ fn analytic_texture_coordinates_follow_the_rasterizer_tessellation() {
     assert_uv_matches_tessellation("rounded box", rounded, 1e-2, false, 0.0, false);
 }
 
-/// Rays from `eye` through a `side × side` grid of points on a square `size` wide around
-/// `target`, in blocks of 4 × 4 as the tracer hands a packet its pixels: coherent rays.
-fn fan(eye: Vec3, target: Vec3, size: f32, side: usize) -> Vec<Ray> {
-    let forward = (target - eye).normalize();
+/// A `side × side` grid of points on a square `size` wide around `centre`, facing along
+/// `forward`, in blocks of 4 × 4 as the tracer hands a packet its pixels.
+fn block_grid(centre: Vec3, forward: Vec3, size: f32, side: usize) -> Vec<Vec3> {
     let right = forward.cross(Vec3::Y).try_normalize().unwrap_or(Vec3::X);
     let up = right.cross(forward);
-    let mut rays = Vec::new();
+    let mut points = Vec::new();
     for by in (0..side).step_by(4) {
         for bx in (0..side).step_by(4) {
             for y in by..(by + 4).min(side) {
                 for x in bx..(bx + 4).min(side) {
                     let (s, t) = ((x as f32 + 0.5) / side as f32 - 0.5, (y as f32 + 0.5) / side as f32 - 0.5);
-                    rays.push(ray(eye, target + size * (s * right + t * up) - eye));
+                    points.push(centre + size * (s * right + t * up));
                 }
             }
         }
     }
-    rays
+    points
 }
 
-/// Rays from a `side × side` grid of points on a square `size` wide around `from`, in blocks of
-/// 4 × 4 as [`fan`]'s: towards `to` if `converging` (as shadow rays towards a light), else all
-/// along `to − from` (an orthographic camera). Each packet's rays start at different points.
+/// Rays from `eye` through [`block_grid`]'s points around `target`: coherent rays.
+fn fan(eye: Vec3, target: Vec3, size: f32, side: usize) -> Vec<Ray> {
+    let points = block_grid(target, (target - eye).normalize(), size, side);
+    points.into_iter().map(|p| ray(eye, p - eye)).collect()
+}
+
+/// Rays from [`block_grid`]'s points around `from`: towards `to` if `converging` (as shadow rays
+/// towards a light), else all along `to − from` (an orthographic camera). Each packet's rays start
+/// at different points.
 fn grid_rays(from: Vec3, to: Vec3, size: f32, side: usize, converging: bool) -> Vec<Ray> {
-    let forward = (to - from).normalize();
-    let right = forward.cross(Vec3::Y).try_normalize().unwrap_or(Vec3::X);
-    let up = right.cross(forward);
-    let mut rays = Vec::new();
-    for by in (0..side).step_by(4) {
-        for bx in (0..side).step_by(4) {
-            for y in by..(by + 4).min(side) {
-                for x in bx..(bx + 4).min(side) {
-                    let (s, t) = ((x as f32 + 0.5) / side as f32 - 0.5, (y as f32 + 0.5) / side as f32 - 0.5);
-                    let origin = from + size * (s * right + t * up);
-                    rays.push(ray(origin, if converging { to - origin } else { to - from }));
-                }
-            }
-        }
-    }
-    rays
+    let points = block_grid(from, (to - from).normalize(), size, side);
+    points.into_iter().map(|p| ray(p, if converging { to - p } else { to - from })).collect()
 }
 
 /// The scenes and rays the packet tests trace: a sphere mesh, the showcase, and a triangle soup

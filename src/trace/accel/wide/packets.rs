@@ -31,8 +31,9 @@
 //! is entered by no ray, a box whose highest entry comes before its lowest exit by all of them.
 //! Where each of the eight boxes is one or the other, the node is settled for the whole packet by
 //! one test instead of one a ray. Near the root, where a 4 × 4 block of pixels is small beside the
-//! boxes, that is every node; where a box's edge falls between the rays, the node is tested ray
-//! by ray as above, and so is everything under it.
+//! boxes, that is most nodes; where a box's edge falls between the rays, the node is tested ray
+//! by ray as above, and so is everything under it (on the benchmark's sphere, 29 % of the nodes
+//! a packet visits are settled whole: docs/performance.md).
 //!
 //! The bounds are exact, not padded: each ray's `(plane − origin)·(1/d)` is rounded from a
 //! difference and a product, and rounding keeps order, so it lies between the same expression at
