@@ -441,7 +441,7 @@ pub fn sampler_descriptor(filter: Filter, max_anisotropy: u16) -> wgpu::SamplerD
 pub fn read_level_rgba8(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, level: u32) -> Vec<u8> {
     let size = texture.size().mip_level_size(level, texture.dimension());
     let row = 4 * size.width;
-    let padded_row = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let padded_row = super::readback::padded_row(u64::from(row)) as u32;
     let buffer = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("mipmap::readback_buffer"),
         size: u64::from(padded_row) * u64::from(size.height),

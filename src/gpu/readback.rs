@@ -56,7 +56,7 @@ impl Pending {
     ) -> Result<Pending, ReadbackError> {
         let (width, height) = (texture.width(), texture.height());
         let row = u64::from(width) * u64::from(bytes_per_texel);
-        let padded_row = row.next_multiple_of(u64::from(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT));
+        let padded_row = padded_row(row);
         let bytes = padded_row * u64::from(height);
         let limit = device.limits().max_buffer_size;
         if bytes > limit {
@@ -140,6 +140,12 @@ pub fn poll_once<F: std::future::Future + ?Sized>(future: std::pin::Pin<&mut F>)
     }
 }
 
+/// A row of `bytes` bytes in a buffer a texture is copied from or to, padded to wgpu's copy
+/// alignment.
+pub fn padded_row(bytes: u64) -> u64 {
+    bytes.next_multiple_of(u64::from(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT))
+}
+
 /// Records the copy of rows `rows` of mip level 0 into `buffer`, `padded_row` bytes a row.
 fn copy_rows(
     encoder: &mut wgpu::CommandEncoder,
@@ -214,7 +220,7 @@ pub fn read_texels_in_bands(
 ) -> Result<Vec<u8>, ReadbackError> {
     let (width, height) = (texture.width(), texture.height());
     let row = u64::from(width) * u64::from(bytes_per_texel);
-    let padded_row = row.next_multiple_of(u64::from(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT));
+    let padded_row = padded_row(row);
     let band_rows = max_band_bytes / padded_row;
     if band_rows == 0 {
         return Err(ReadbackError::RowTooWide { width, row_bytes: padded_row, limit: max_band_bytes });

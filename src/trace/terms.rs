@@ -267,6 +267,7 @@ impl Tracer<'_> {
         let whitted = &self.whitted;
         let material = &self.scene.materials[hit.material.0];
         let v = -ray.direction;
+        let origin = hit.point + surface_offset(hit.point) * facing_viewer(hit.geometric_normal, v);
         let mut sample = None;
         let mut light = Vec3::ZERO;
         for (index, source) in self.scene.lights.iter().enumerate().take(MAX_LIGHTS) {
@@ -281,7 +282,6 @@ impl Tracer<'_> {
                     });
                     SurfaceSample::new(material, colour)
                 });
-                let origin = hit.point + surface_offset(hit.point) * facing_viewer(hit.geometric_normal, v);
                 let visibility = whitted.visibility(origin, incidence.l, incidence.distance, counts);
                 light += visibility * direct(sample, n, v, &incidence, whitted.terms);
             }

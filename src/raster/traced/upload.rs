@@ -170,5 +170,5 @@ impl Upload {
 
 /// A layer's row, in bytes, padded to wgpu's copy alignment.
 fn padded_row(width: u32) -> usize {
-    (width as usize * PIXEL_BYTES).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT as usize)
+    crate::gpu::readback::padded_row((width as usize * PIXEL_BYTES) as u64) as usize
 }
