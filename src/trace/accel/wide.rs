@@ -473,19 +473,40 @@ impl Wide {
         &self,
         query: &Query,
     ) -> Option<Hit> {
-        let Query { t_min, mut t_max, .. } = *query;
+        let (mut best, mut t_max) = (None, query.t_max);
+        // SAFETY: the caller's promise about `L`; 0 is the root, and the walk runs only in a
+        // tree with nodes.
+        let first = unsafe { self.traverse_from::<L, ANY, CAREFUL, STACK>(query, 0, &mut best, &mut t_max) };
+        first.or(best)
+    }
+
+    /// [`Wide::traverse`] from the node or leaf `start` down, with the nearest hit found so far
+    /// `best` at `t_max` (both updated): returns the first hit with `ANY`, else `None`. A packet
+    /// hands a subtree that only one of its rays enters to this walk ([`packets`]).
+    ///
+    /// # Safety
+    /// The CPU must have the instructions `L` uses, and `start` must be 0 in a tree with nodes or
+    /// a child's entry of one of its nodes.
+    #[inline(always)]
+    unsafe fn traverse_from<L: Lanes, const ANY: bool, const CAREFUL: bool, const STACK: usize>(
+        &self,
+        query: &Query,
+        start: u32,
+        best: &mut Option<Hit>,
+        t_max: &mut f32,
+    ) -> Option<Hit> {
+        let t_min = query.t_min;
         let box_ray = BoxRay::new(query.prepared);
         let packet_ray = PacketRay::new(query.prepared);
-        let mut best = None;
         let mut stack = Stack::<(u32, f32), STACK>::new();
-        let mut current = 0u32;
+        let mut current = start;
         loop {
             if current & LEAF == 0 {
-                // SAFETY: `current` is 0 (the walk starts only in a tree with nodes) or an inner
-                // child's entry of a node.
+                // SAFETY: `current` is `start` (the caller's promise) or an inner child's entry of
+                // a node.
                 let node = unsafe { self.node(current) };
                 // SAFETY: the caller's promise about `L`.
-                let (mut mask, entries) = unsafe { enter::<L, CAREFUL>(node, &box_ray, t_min, t_max) };
+                let (mut mask, entries) = unsafe { enter::<L, CAREFUL>(node, &box_ray, t_min, *t_max) };
                 let child = |i: usize| (node.child[i], entries[i]);
                 if mask != 0 {
                     let first = mask.trailing_zeros() as usize;
@@ -518,14 +539,14 @@ impl Wide {
                 }
             } else if let Some(hit) =
                 // SAFETY: the caller's promise about `L`.
-                unsafe { self.leaf::<L, ANY>(current & !LEAF, query, &packet_ray, &mut best, &mut t_max) }
+                unsafe { self.leaf::<L, ANY>(current & !LEAF, query, &packet_ray, best, t_max) }
             {
                 return Some(hit);
             }
             // Next: the nearest pending child that still starts before the nearest hit.
             loop {
-                let Some((child, entry)) = stack.pop() else { return best };
-                if entry < t_max {
+                let (child, entry) = stack.pop()?;
+                if entry < *t_max {
                     current = child;
                     break;
                 }

@@ -41,9 +41,17 @@
 //! stay the single-ray walk's: a ray the interval test takes into a box it does not enter only
 //! tests triangles it misses.
 //!
-//! What a packet costs instead: a ray that left the others' path is carried along, masked, until
-//! the nodes it enters run out. Incoherent rays (reflections off curved surfaces, refraction)
-//! gain nothing, and are traced one by one.
+//! **One ray alone on a path walks it as a single ray** (Benthin et al., "Combining Single and
+//! Packet-Ray Tracing for Arbitrary Ray Distributions on the Intel MIC Architecture", 2012). Near
+//! the leaves the packet's rays part: on a mesh whose triangles are smaller than a pixel, each
+//! ray of a 4 × 4 block ends in leaves of its own. A child entered by one ray only is handed to
+//! the single-ray walk ([`Wide::traverse_from`]) with that ray's nearest hit so far, and the
+//! packet goes on with its other pending children; the packet's bookkeeping (the rays' masks, one
+//! entry per child for all of them) is spent only where it is shared.
+//!
+//! What a packet costs instead: rays that left each other's path are carried along, masked,
+//! while two or more share it. Incoherent rays (reflections off curved surfaces, refraction) gain
+//! nothing, and are traced one by one.
 
 use super::*;
 
@@ -246,7 +254,24 @@ impl Wide {
         let mut together = bounds.is_some();
         let mut done = 0u32;
         loop {
-            if current & LEAF == 0 {
+            if rays & (rays - 1) == 0 {
+                // One ray left on this path: it walks the subtree alone, as it would on its own.
+                let i = rays.trailing_zeros() as usize;
+                if let Some(member) = &members[i] {
+                    // SAFETY: the caller's promise about `L`; `current` is a child's entry.
+                    let first = unsafe {
+                        self.traverse_from::<L, ANY, false, STACK>(&member.query, current, &mut hits[i], &mut t_max[i])
+                    };
+                    if ANY && first.is_some() {
+                        hits[i] = first;
+                        t_max[i] = f32::NEG_INFINITY;
+                        done |= 1 << i;
+                        if done == active {
+                            return;
+                        }
+                    }
+                }
+            } else if current & LEAF == 0 {
                 // SAFETY: `current` is 0 or an inner child's entry of a node.
                 let node = unsafe { self.node(current) };
                 let settled = match bounds {
