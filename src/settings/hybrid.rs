@@ -3,7 +3,7 @@
 //! approximation costs can be measured (`mirador budget`).
 //!
 //! **The approximations table.** Each approximation with a traced counterpart is one row of
-//! [`approximations!`] below, and everything the program knows of it comes from that row: its
+//! `approximations!` below, and everything the program knows of it comes from that row: its
 //! switch in [`HybridSettings`] (with the switch's documentation), the sections of the settings
 //! the viewer shows the switch in, when a scene makes the approximation at all, what the raster
 //! frame leaves out while it is traced, how many layers of a view's traced image its term fills,
