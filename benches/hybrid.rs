@@ -8,7 +8,7 @@
 use std::time::{Duration, Instant};
 
 use mirador::settings::{Traced, TracedSet};
-use mirador::trace::terms::ViewRays;
+use mirador::trace::terms::{TermsLayout, ViewRays};
 use mirador::trace::{RenderControl, Tracer, primary_cone};
 
 const RUNS: usize = 5;
@@ -22,8 +22,10 @@ fn main() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/scenes/showcase.toml");
     let scene = mirador::Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
     let tracer = Tracer::new(&scene, &scene.settings);
-    let camera = scene.camera.clone();
-    let ray = move |x: f32, y: f32| Some((camera.ray_through(x, y), 0.0));
+    // The main view's rays as the hybrid makes them (`raster::traced`): the camera's frame and
+    // window worked out once.
+    let rays = scene.camera.rays();
+    let ray = move |x: f32, y: f32| Some((rays.through(x, y), 0.0));
     let size = (scene.camera.width, scene.camera.height);
     let lights: Vec<usize> = (0..scene.lights.len()).collect();
     let view = ViewRays {
@@ -50,13 +52,18 @@ fn main() {
         println!("{name:>34}: {:8.1} ms, {rays:>8} rays, {mrays:5.2} Mrays/s", time.as_secs_f64() * 1e3);
         time
     };
-    let colour = rate("terms: colour", &mut || tracer.terms(&view, TracedSet::of(&[Traced::Textures])).rays.total());
-    let visibility =
-        rate("terms: visibility", &mut || tracer.terms(&view, TracedSet::of(&[Traced::Shadows])).rays.total());
+    // Into rows kept from one run to the next, as the hybrid traces a view's terms.
+    let mut rows = Vec::new();
+    let mut terms = |wanted: &[Traced]| {
+        let wanted = TracedSet::of(wanted);
+        let layout = TermsLayout::new(&view, wanted);
+        rows.resize(rows.len().max(layout.pixels()), [0.0; 4]);
+        tracer.terms_into(&view, wanted, &layout, &mut rows).total()
+    };
+    let colour = rate("terms: colour", &mut || terms(&[Traced::Textures]));
+    let visibility = rate("terms: visibility", &mut || terms(&[Traced::Shadows]));
     // The showcase's two lights both have shadow maps: the lights term has no light to add.
-    let other_lights = rate("terms: visibility, other lights", &mut || {
-        tracer.terms(&view, TracedSet::of(&[Traced::Shadows, Traced::Lights])).rays.total()
-    });
+    let other_lights = rate("terms: visibility, other lights", &mut || terms(&[Traced::Shadows, Traced::Lights]));
     let render = rate("Tracer::render (the whole image)", &mut || {
         let (_, stats) = tracer.render(&RenderControl::default()).expect("nothing cancels it");
         stats.rays.total()
