@@ -4,7 +4,7 @@
 //! - the frame's inputs, the same in every view: the shadow maps and how to read them, the
 //!   environment maps;
 //! - the **view images**: images that earlier phases of *that* view made for its shading to
-//!   read ([`ViewImage`](super::targets::ViewImage): the projected-shadow mask, the hybrid's traced terms), layers of the
+//!   read ([`ViewImage`]: the projected-shadow mask, the hybrid's traced terms), layers of the
 //!   view's two arrays ([`ViewArray`]: the drawn images and the copied ones). Each view draws its
 //!   own into its own targets, so a technique that makes one shows in every view: the main
 //!   camera, each mirrored camera and each cube face (STYLE rule 17; Bevy's mesh view bind group
@@ -12,10 +12,12 @@
 //!
 //! [`VIEW_GROUP`] is the one table of the group: its layout and every view's bind group are
 //! made from it, and `tests/layouts.rs` checks it binding by binding against the WGSL. A new view
-//! image is a variant of [`ViewImage`](super::targets::ViewImage) and its first layer in `crate::shaders::constants`: layers
+//! image is a variant of [`ViewImage`] and its first layer in `crate::shaders::constants`: layers
 //! of an array the group binds already, never a binding of its own (the fullest entry point is
 //! at the downlevel limit of 16 sampled textures); the targets then carry it and every view's
 //! group binds the view's own.
+//!
+//! [`ViewImage`]: super::targets::ViewImage
 
 use super::targets::{ViewArray, ViewImages};
 use super::view::{FrameView, ViewSlot, ViewTargets};

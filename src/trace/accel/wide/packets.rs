@@ -22,8 +22,10 @@
 //! which differs between the walks. Likewise a shape found by sphere tracing (a torus) stops its
 //! march at the far bound it is handed, and its polished hit may lie up to its ε before the step
 //! that passed that bound: within ε of a nearer hit, the far bound of the moment decides. No
-//! scene of `assets/` shows either: its 28 scenes trace to the same PNGs both ways. A ray it could not walk the fast way (one that runs exactly along an
-//! axis, whose slab test needs [`enter`]'s careful variant) is walked alone.
+//! scene of `assets/` shows either: its 28 scenes trace to the same PNGs both ways.
+//!
+//! A ray it could not walk the fast way (one that runs exactly along an axis, whose slab test
+//! needs [`enter`]'s careful variant) is walked alone.
 //!
 //! **Shadow rays** ([`Wide::occluded_in_packets`]) walk the same way, each to its own far bound
 //! (its light's distance), and a ray leaves the packet at its first hit: whether anything is hit
@@ -265,7 +267,7 @@ impl Wide {
                 // One ray left on this path: it walks the subtree alone, as it would on its own.
                 let i = rays.trailing_zeros() as usize;
                 if let Some(member) = &members[i] {
-                    // SAFETY: the caller's promise about `L`; `current` is a child's entry.
+                    // SAFETY: the caller's promise about `L`; `current` is 0 or a child's entry.
                     let first = unsafe {
                         self.traverse_from::<L, ANY, false, STACK>(&member.query, current, &mut hits[i], &mut t_max[i])
                     };
