@@ -1071,9 +1071,25 @@ fn budget(args: SceneArgs, trace_args: TraceArgs, sheet: Option<&Path>, json: Op
     let traced = traced_radiance.to_rgba8(mirador::output::OutputTransform::of(&scene.settings));
     let gpu = clock.time("device", Gpu::headless)?;
     gpu.check_image_size((scene.camera.width, scene.camera.height))?;
+    // Twelve frames for the showcase, each tracing its terms: seconds on a CPU rasterizer. The
+    // bar is drawn only where standard error is a terminal.
+    let bar = indicatif::ProgressBar::new(0).with_style(
+        indicatif::ProgressStyle::with_template("budget [{bar:30}] {pos}/{len} frames, {elapsed}: {wide_msg}")
+            .expect("the progress template is valid")
+            .progress_chars("=> "),
+    );
+    let mut drawn = |frame: mirador::budget::Drawn| {
+        bar.set_length(frame.frames as u64);
+        bar.set_position(frame.done as u64);
+        bar.set_message(format!("the last one {}", frame.what));
+    };
+    let scenes = (&scene, &*reference);
     let budget = gpu.checked(|| {
-        clock.time("raster frames", || mirador::budget::budget(&gpu, (&scene, &reference), &scene.settings, traced))
+        clock.time("raster frames", || {
+            mirador::budget::budget_reporting(&gpu, scenes, &scene.settings, traced, &mut drawn)
+        })
     })?;
+    bar.finish_and_clear();
     let text = serde_json::to_string_pretty(&budget.json()).expect("the budget serialises");
     match json {
         Some(path) if path.as_os_str() == "-" => println!("{text}"),

@@ -5,7 +5,7 @@
 mod common;
 
 use mirador::Scene;
-use mirador::budget::{Budget, budget};
+use mirador::budget::{Budget, Drawn, budget_reporting, frames};
 use mirador::scene::file::parse;
 use mirador::settings::RenderSettings;
 
@@ -13,10 +13,23 @@ fn traced(scene: &Scene, settings: &RenderSettings) -> image::RgbaImage {
     mirador::trace::render_image(scene, settings)
 }
 
+/// The budget, and a check of the progress it reports (`mirador budget`'s bar): every frame it
+/// draws, in order, named, and counted against [`frames`].
 fn budget_of(scene: &Scene, settings: &RenderSettings) -> Budget {
     let reference = mirador::budget::reference_scene(scene, settings);
-    let budget = budget(common::gpu(), (scene, &reference), settings, traced(&reference, settings));
+    let mut reported = Vec::new();
+    let mut drawn = |frame: Drawn| reported.push((frame.done, frame.frames, frame.what.to_string()));
+    let budget =
+        budget_reporting(common::gpu(), (scene, &reference), settings, traced(&reference, settings), &mut drawn);
     eprintln!("{}", budget.report());
+    let mut expected = vec!["raster".to_string(), "every approximation traced".to_string()];
+    for item in &budget.items {
+        expected.extend([format!("{} traced alone", item.name), format!("all but {} traced", item.name)]);
+    }
+    let total = frames(budget.items.len());
+    assert_eq!(expected.len(), total, "two frames, and two for each approximation");
+    let wanted: Vec<_> = expected.into_iter().enumerate().map(|(k, what)| (k + 1, total, what)).collect();
+    assert_eq!(reported, wanted, "the frames reported, against those the budget draws");
     budget
 }
 

@@ -104,21 +104,52 @@ pub fn reference_scene<'s>(scene: &'s Scene, settings: &RenderSettings) -> std::
     }
 }
 
+/// The frames a budget of `items` approximations draws: the raster frame, the frame with every
+/// approximation traced, and two for each approximation (it alone traced, all but it traced).
+pub fn frames(items: usize) -> usize {
+    2 + 2 * items
+}
+
+/// A frame the budget has drawn, for a progress report ([`budget_reporting`]).
+pub struct Drawn<'a> {
+    /// Frames drawn so far, this one included, of `frames`.
+    pub done: usize,
+    pub frames: usize,
+    /// Which: "raster", "every approximation traced", "NAME traced alone", "all but NAME traced".
+    pub what: &'a str,
+}
+
 /// The budget of `scene` with `settings`, drawn on `gpu`, against `traced`: the tracer's image of
 /// `reference` ([`reference_scene`]) with `settings`.
-pub fn budget(gpu: &Gpu, (scene, reference): (&Scene, &Scene), settings: &RenderSettings, traced: RgbaImage) -> Budget {
+pub fn budget(gpu: &Gpu, scenes: (&Scene, &Scene), settings: &RenderSettings, traced: RgbaImage) -> Budget {
+    budget_reporting(gpu, scenes, settings, traced, &mut |_| {})
+}
+
+/// [`budget`], calling `drawn` after each of its frames ([`frames`] of them): `mirador budget`'s
+/// progress bar.
+pub fn budget_reporting(
+    gpu: &Gpu,
+    (scene, reference): (&Scene, &Scene),
+    settings: &RenderSettings,
+    traced: RgbaImage,
+    drawn: &mut dyn FnMut(Drawn),
+) -> Budget {
+    let facts = scene.facts();
+    let used: Vec<Traced> = Traced::ALL.iter().copied().filter(|t| (t.row().in_use)(&facts, settings)).collect();
     // The relief's swap draws the displaced scene, the reference: a frame of its own.
     let mut headless = Headless::new(gpu, scene);
     let mut relief: Option<Headless> = None;
-    let mut raster = |settings: &RenderSettings| {
-        if settings.hybrid.relief {
+    let mut done = 0;
+    let mut raster = |settings: &RenderSettings, what: &str| {
+        let image = if settings.hybrid.relief {
             relief.get_or_insert_with(|| Headless::new(gpu, reference)).render(gpu, reference, settings)
         } else {
             headless.render(gpu, scene, settings)
-        }
+        };
+        done += 1;
+        drawn(Drawn { done, frames: frames(used.len()), what });
+        image
     };
-    let facts = scene.facts();
-    let used: Vec<Traced> = Traced::ALL.iter().copied().filter(|t| (t.row().in_use)(&facts, settings)).collect();
     let with = |traced_ones: &mut dyn Iterator<Item = &Traced>| {
         let mut settings = settings.clone();
         settings.hybrid = HybridSettings::default();
@@ -130,13 +161,15 @@ pub fn budget(gpu: &Gpu, (scene, reference): (&Scene, &Scene), settings: &Render
     let flip = |a: &RgbaImage, b: &RgbaImage| {
         difference_beyond(a, b, ROUNDING_LEVELS).expect("every image has the camera's size")
     };
-    let plain = raster(&with(&mut std::iter::empty()));
-    let hybrid = raster(&with(&mut used.iter()));
+    let plain = raster(&with(&mut std::iter::empty()), "raster");
+    let hybrid = raster(&with(&mut used.iter()), "every approximation traced");
     let items = used
         .iter()
         .map(|term| {
-            let added = raster(&with(&mut std::iter::once(term)));
-            let others = raster(&with(&mut used.iter().filter(|other| *other != term)));
+            let name = term.row().budget;
+            let added = raster(&with(&mut std::iter::once(term)), &format!("{name} traced alone"));
+            let others =
+                raster(&with(&mut used.iter().filter(|other| *other != term)), &format!("all but {name} traced"));
             let alone = flip(&plain, &added);
             Item {
                 name: term.row().budget,
