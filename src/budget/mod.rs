@@ -172,7 +172,7 @@ pub fn budget_reporting(
                 raster(&with(&mut used.iter().filter(|other| *other != term)), &format!("all but {name} traced"));
             let alone = flip(&plain, &added);
             Item {
-                name: term.row().budget,
+                name,
                 swap: term.row().swap,
                 alone: alone.flip_mean,
                 left_alone: flip(&traced, &others).flip_mean,
